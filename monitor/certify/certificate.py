@@ -1,0 +1,211 @@
+"""Result objects of a certification: :class:`Certificate`, :class:`PairResult`, :class:`Witness`.
+
+Three verdicts, never collapsed:
+
+* ``"certified"``: for every instant of the window, every candidate pair's
+  clearance exceeds ``margin`` (rounding padded). Holds for the continuous motion.
+* ``"violation"``: an exact static test at ``witness.time`` confirmed that the
+  pair's distance is below ``margin`` (overlap or too close).
+* ``"uncertain"``: neither could be shown before epsilon, the depth cap or the
+  budget ran out.
+
+Combination over pairs: any violation -> ``"violation"`` (the earliest witness
+wins); else any uncertain -> ``"uncertain"``; else ``"certified"``.
+All times are seconds of simulation time; points are world-frame metres.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from monitor.errors import InvalidInputError
+
+Verdict = Literal["certified", "violation", "uncertain"]
+VERDICTS: tuple[str, ...] = ("certified", "violation", "uncertain")
+_RANK = {"certified": 0, "uncertain": 1, "violation": 2}
+
+
+def _f(x: float | None) -> float | None:
+    """JSON-safe float: NaN -> None, +-inf -> +-1e308 (JSON has no inf)."""
+    if x is None:
+        return None
+    x = float(x)
+    if math.isnan(x):
+        return None
+    if math.isinf(x):
+        return 1e308 if x > 0 else -1e308
+    return x
+
+
+@dataclass(frozen=True)
+class Witness:
+    """A confirmed violation.
+
+    Attributes:
+        time: simulation time (s) of the confirmed violation.
+        geoms: (geom_a, geom_b) names.
+        point: (3,) world-frame point (m) in or between the two shapes at ``time``.
+        distance: exact signed static distance (m) of the pair at ``time``
+            (negative = penetration), rounding padded upwards; ``distance < margin``.
+    """
+
+    time: float
+    geoms: tuple[str, str]
+    point: np.ndarray
+    distance: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable form."""
+        return {"time": _f(self.time), "geoms": list(self.geoms),
+                "point": [float(v) for v in np.asarray(self.point, float).reshape(3)],
+                "distance": _f(self.distance)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Witness:
+        """Inverse of :meth:`to_dict`."""
+        return cls(float(d["time"]), (str(d["geoms"][0]), str(d["geoms"][1])),
+                   np.asarray(d["point"], dtype=np.float64).reshape(3),
+                   float(d["distance"]) if d.get("distance") is not None else float("nan"))
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """Outcome for one candidate geom pair.
+
+    Attributes:
+        geoms: (geom_a, geom_b) names.
+        bodies: (body_a, body_b) names.
+        verdict: ``"certified" | "violation" | "uncertain"``.
+        method: checker that decided: ``"culled"`` (broad phase), ``"toleranced"``,
+            ``"extrusion"``, or ``"static"`` (start-pose overlap).
+        tests: number of elementary tests (toleranced) or LP/null tests (extrusion).
+        max_depth: deepest subdivision level reached.
+        intervals: ((t_lo, t_hi), ...) sub-intervals (s) where a violation could not
+            be excluded; empty when certified.
+        clearance: certified lower bound (m) on the pair's distance over the window
+            (may be <= 0 or -inf when unknown).
+        witness: :class:`Witness` if verdict is ``"violation"``.
+    """
+
+    geoms: tuple[str, str]
+    bodies: tuple[str, str]
+    verdict: Verdict
+    method: str
+    tests: int = 0
+    max_depth: int = 0
+    intervals: tuple[tuple[float, float], ...] = ()
+    clearance: float = float("-inf")
+    witness: Witness | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable form."""
+        return {"geoms": list(self.geoms), "bodies": list(self.bodies), "verdict": self.verdict,
+                "method": self.method, "tests": int(self.tests), "max_depth": int(self.max_depth),
+                "intervals": [[float(a), float(b)] for a, b in self.intervals],
+                "clearance": _f(self.clearance),
+                "witness": self.witness.to_dict() if self.witness else None}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> PairResult:
+        """Inverse of :meth:`to_dict`."""
+        c = d.get("clearance")
+        return cls((str(d["geoms"][0]), str(d["geoms"][1])),
+                   (str(d["bodies"][0]), str(d["bodies"][1])), d["verdict"], d["method"],
+                   int(d.get("tests", 0)), int(d.get("max_depth", 0)),
+                   tuple((float(a), float(b)) for a, b in d.get("intervals", [])),
+                   float("-inf") if c is None else float(c),
+                   Witness.from_dict(d["witness"]) if d.get("witness") else None)
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """Result of :func:`monitor.certify` for one window.
+
+    Attributes:
+        verdict: combined verdict (see module docstring).
+        window: (t0, t1) seconds.
+        margin: clearance (m) that counts as safe; distance < margin is a violation.
+        epsilon: termination tolerance (m of body motion).
+        method: requested method (``"auto" | "toleranced" | "extrusion"``).
+        witness: earliest confirmed violation, or None.
+        earliest_time: earliest time (s) at which a violation could not be excluded;
+            None when certified.
+        clearance: certified lower bound (m) on min clearance over the window.
+        pairs: one :class:`PairResult` per candidate pair, in scene order.
+        stats: totals, e.g. ``pairs``, ``pairs_culled``, ``tests``, ``max_depth``,
+            ``wall_seconds``, ``checker_mix`` ({method: count}).
+    """
+
+    verdict: Verdict
+    window: tuple[float, float]
+    margin: float
+    epsilon: float
+    method: str
+    witness: Witness | None
+    earliest_time: float | None
+    clearance: float
+    pairs: tuple[PairResult, ...] = ()
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.verdict not in _RANK:
+            raise InvalidInputError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
+
+    @property
+    def certified(self) -> bool:
+        """True only for the verdict ``"certified"``."""
+        return self.verdict == "certified"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable form (``json.dumps`` works on it directly)."""
+        return {"verdict": self.verdict, "window": [float(self.window[0]), float(self.window[1])],
+                "margin": float(self.margin), "epsilon": float(self.epsilon), "method": self.method,
+                "witness": self.witness.to_dict() if self.witness else None,
+                "earliest_time": _f(self.earliest_time), "clearance": _f(self.clearance),
+                "pairs": [p.to_dict() for p in self.pairs],
+                "stats": _jsonable(self.stats)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Certificate:
+        """Inverse of :meth:`to_dict`; raises InvalidInputError on malformed input."""
+        try:
+            c = d.get("clearance")
+            return cls(d["verdict"], (float(d["window"][0]), float(d["window"][1])),
+                       float(d["margin"]), float(d["epsilon"]), str(d["method"]),
+                       Witness.from_dict(d["witness"]) if d.get("witness") else None,
+                       None if d.get("earliest_time") is None else float(d["earliest_time"]),
+                       float("-inf") if c is None else float(c),
+                       tuple(PairResult.from_dict(p) for p in d.get("pairs", [])),
+                       dict(d.get("stats", {})))
+        except (KeyError, TypeError, IndexError, ValueError) as exc:
+            raise InvalidInputError(f"malformed certificate dict: {exc!r}") from exc
+
+
+def combine_verdicts(verdicts: list[str] | tuple[str, ...]) -> Verdict:
+    """Worst verdict: violation > uncertain > certified (certified if empty)."""
+    worst = "certified"
+    for v in verdicts:
+        if _RANK[v] > _RANK[worst]:
+            worst = v
+    return worst  # type: ignore[return-value]
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _jsonable(x.tolist())
+    if isinstance(x, (np.floating, float)):
+        return _f(float(x))
+    if isinstance(x, (np.integer,)):
+        return int(x)
+    return x
+
+
+__all__ = ["Certificate", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts"]

@@ -1,0 +1,70 @@
+"""All numerical tolerances of `monitor`, in one frozen dataclass.
+
+No algorithm hard-codes an epsilon: it takes a :class:`Tolerances` (default
+:data:`DEFAULT`) and uses the named field. Each field says why it has its value.
+Lengths are metres, angles radians, times seconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Numerical tolerances; every value carries its reason.
+
+    Rounding pads: every radius and threshold that decides "certified" is
+    enlarged by ``pad(x) = rel_pad * |x| + abs_pad`` (plus the scene scale term),
+    so that float64 rounding in the tests can only push a verdict towards
+    "not certified", never towards "certified".
+    """
+
+    quat_norm_tol: float = 1e-6
+    """A waypoint quaternion whose norm differs from 1 by at most this is
+    normalised silently; beyond it the plan is rejected. 1e-6 admits float32
+    round trips (relative error ~6e-8 per component) and rejects real mistakes."""
+
+    rel_pad: float = 64 * 2.0**-52
+    """Relative rounding pad (64 ulp ~ 1.4e-14). Our elementary tests evaluate
+    quadratics with a few dozen flops; Higham's gamma_n bound for n<=32
+    operations is ~n*u = 32*1.1e-16, doubled for safety."""
+
+    abs_pad: float = 1e-12
+    """Absolute pad in metres, added to every clearance threshold. It covers
+    cancellation near the origin where a relative pad vanishes; 1e-12 m is far
+    below any physical clearance (MuJoCo's own mjMINVAL is 1e-15)."""
+
+    scale_pad: float = 1e-13
+    """Pad proportional to the scene's coordinate magnitude (|x|max): points at
+    1e4 m carry absolute rounding ~1e4 * 1.1e-16 ~ 1e-12 per operation; 1e-13
+    per metre of offset covers ~1000 such operations."""
+
+    max_depth: int = 40
+    """Hard cap on subdivision depth. 2^-40 of a 1 s window is ~1 ps: below it
+    the motion bound is dominated by rounding, so deeper splits cannot help."""
+
+    facets: int = 16
+    """Default facet count of circumscribed polytopes for cylinders and
+    ellipsoids. 16 gives a radial over-approximation of r*(1/cos(pi/16)-1) ~ 1.9 %,
+    reported per geom in ``Scene``."""
+
+    extrusion_slack: float = 1e-9
+    """Minimum interior slack (metres) that the extrusion LP must find to call a
+    space-time overlap a collision; below it the contact is boundary-only
+    (regularised semantics, touching is not a collision) but is reported as
+    "near" in stats. Set well above LP solver tolerance (HiGHS ~1e-9 relative
+    to the scaled problem), and the decision is re-checked exactly at the witness."""
+
+    witness_candidates: int = 9
+    """Candidate times per unresolved interval at which exact static tests look
+    for a violation witness (endpoints + 7 interior). More only costs time."""
+
+    def pad(self, magnitude: float) -> float:
+        """Rounding pad for a quantity of the given magnitude (metres)."""
+        return self.rel_pad * abs(magnitude) + self.abs_pad
+
+
+DEFAULT = Tolerances()
+
+__all__ = ["Tolerances", "DEFAULT"]
