@@ -6,8 +6,10 @@ from pathlib import Path
 
 
 def models_dir() -> Path:
-    """Folder holding ``<scene>/scene.xml``: the installed ``monitor.models`` package
-    data, or the repository's top-level ``models/`` when running from a checkout.
+    """Folder holding ``<scene>/scene.xml``.
+
+    The installed ``monitor.models`` package data, or the repository's top-level
+    ``models/`` when running from a checkout.
     """
     try:
         import monitor.models as _m  # installed (package-dir maps models/ -> monitor.models)

@@ -86,9 +86,12 @@ class Trajectory(Protocol):
         """(nbody,) bool: True where the body's pose changes anywhere in the window."""
 
     def translation_segments(self, body: int) -> tuple[np.ndarray, np.ndarray] | None:
-        """If ``body`` only translates with piecewise-constant velocity over the window,
-        return (breakpoints (k+1,) s, velocities (k, 3) m/s), with the body rotation
-        constant; else None. Static bodies return ([t0, t1], zeros((1, 3))).
+        """Piecewise-constant-velocity translation of ``body``, or None.
+
+        If the body's rotation is constant over the window and its origin moves
+        linearly between breakpoints, return ``(breakpoints (k+1,) s, origins (k+1, 3) m)``:
+        the world position of the body origin at each breakpoint (first = t0,
+        last = t1). Static bodies return ``([t0, t1], [p, p])``. Otherwise None.
         """
 
 
