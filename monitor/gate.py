@@ -1,0 +1,592 @@
+"""Plain-MuJoCo safety gate: certify the next window of motion, then step or block.
+
+:class:`Gate` is the gymnasium-free core. It turns (state, control) into a
+:class:`monitor.Plan` for the upcoming window (the *predictor*), certifies it
+with :func:`monitor.certify`, and applies a gating policy:
+
+* ``"block"``: an unsafe control is replaced by the fallback (default: hold the
+  current position where the actuators allow it, else zero). The fallback's
+  own window is certified too; if it fails, the report says so
+  (``fallback_certified=False``), the window is logged and a warning is logged.
+* ``"terminate"``: like ``"block"`` (the unsafe control is never applied), and
+  the report asks the caller to end the episode (``terminated=True``).
+* ``"warn"``: the control is applied anyway and the verdict recorded.
+
+What counts as unsafe: with ``unsafe="uncertain"`` (default) anything that is
+not ``"certified"``; with ``unsafe="violation"`` only a confirmed violation.
+
+Rollout predictor. The full integration state (``mjSTATE_INTEGRATION``: time,
+qpos, qvel, act, warm start, ctrl, mocap, ...) of the caller's ``MjData`` is
+copied into a private scratch ``MjData``; the control is written to
+``scratch.ctrl`` (exactly what gymnasium's ``MujocoEnv.do_simulation`` does)
+and ``nstep`` substeps are integrated, recording qpos after each. The plan
+interpolates between consecutive simulator states, so a body that jumps over a
+thin wall between two substeps (tunnelling, invisible to MuJoCo's discrete
+contacts) is seen by the certifier. The caller's ``MjData`` is never written
+while predicting.
+
+Certificate reuse. Pairs whose two bodies do not move in the window and whose
+poses equal those of an earlier certified window are not re-certified; only
+the other pairs go to :func:`monitor.certify` (its ``pairs=`` argument). The
+reused results are exact: a pair of fixed bodies at identical poses has the
+same clearance.
+
+This module imports mujoco and monitor only (no gymnasium, no mcap).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
+from monitor.errors import InvalidInputError
+from monitor.tolerances import DEFAULT, Tolerances
+
+_LOG = logging.getLogger("monitor.gate")
+
+ON_VIOLATION = ("block", "terminate", "warn")
+UNSAFE = ("uncertain", "violation")
+PREDICTORS = ("rollout",)
+_INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+# --------------------------------------------------------------------------- predictors
+class Rollout:
+    """Exact one-window prediction by integrating a scratch copy of the state.
+
+    Args:
+        model: the ``MjModel``.
+    """
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        self.model = model
+        self.scratch = mujoco.MjData(model)
+        self._state = np.empty(mujoco.mj_stateSize(model, _INTEGRATION))
+
+    def states(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Simulator states of the next ``nstep`` substeps, without touching ``data``.
+
+        Args:
+            data: the live ``MjData`` (read only).
+            ctrl: (nu,) control held over the window, or None to keep ``data.ctrl``.
+            nstep: number of ``mj_step`` substeps (>= 1).
+
+        Returns:
+            times (nstep + 1,) seconds and qpos (nstep + 1, nq): the current state
+            followed by the state after each substep.
+        """
+        m, s = self.model, self.scratch
+        mujoco.mj_getState(m, data, self._state, _INTEGRATION)
+        mujoco.mj_setState(m, s, self._state, _INTEGRATION)
+        if ctrl is not None:
+            s.ctrl[:] = ctrl
+        times = np.empty(nstep + 1)
+        qpos = np.empty((nstep + 1, m.nq))
+        times[0], qpos[0] = data.time, data.qpos
+        for k in range(nstep):
+            mujoco.mj_step(m, s)
+            times[k + 1], qpos[k + 1] = s.time, s.qpos
+        return times, qpos
+
+    def plan(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> Any:
+        """The :class:`monitor.Plan` of the next ``nstep`` substeps (mocap poses held)."""
+        from monitor.motion.plan import Plan
+
+        times, qpos = self.states(data, ctrl, nstep)
+        return Plan(times, qpos, model=self.model, mocap_pos=np.array(data.mocap_pos),
+                    mocap_quat=np.array(data.mocap_quat))
+
+
+def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """A control that holds the current position where the actuators allow it.
+
+    Position-like actuators (affine bias with a length term, e.g. ``<position>``)
+    on a hinge or slide joint get the control whose force vanishes at the
+    current joint position: ``ctrl = -(biasprm[0] + biasprm[1] * gear * q) / gainprm[0]``
+    (``= gear * q`` for ``<position>``). Every other actuator gets 0 (a velocity
+    servo then brakes, a motor coasts). The result is clipped to ``ctrlrange``
+    where the control is limited.
+
+    Returns:
+        (nu,) float64 control.
+    """
+    ctrl = np.zeros(model.nu)
+    hinge_slide = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+    for a in range(model.nu):
+        if (model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT
+                or model.actuator_biastype[a] != mujoco.mjtBias.mjBIAS_AFFINE
+                or model.actuator_gaintype[a] != mujoco.mjtGain.mjGAIN_FIXED):
+            continue
+        gain, b0, b1 = model.actuator_gainprm[a, 0], model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
+        j = model.actuator_trnid[a, 0]
+        if gain == 0.0 or b1 == 0.0 or model.jnt_type[j] not in hinge_slide:
+            continue
+        length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j]]
+        ctrl[a] = -(b0 + b1 * length) / gain
+    limited = model.actuator_ctrllimited.astype(bool)
+    lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
+    ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
+    return ctrl
+
+
+# --------------------------------------------------------------------------- reports
+@dataclass(frozen=True)
+class StepReport:
+    """What the gate decided for one window.
+
+    Attributes:
+        verdict: verdict of the *proposed* control's window.
+        certificate: certificate of the proposed window.
+        proposed_ctrl: (nu,) control (or env action) proposed by the caller.
+        applied_ctrl: (nu,) control actually applied (the fallback when replaced).
+        replaced: True when the proposed control was replaced by the fallback.
+        terminated: True when ``on_violation="terminate"`` and the proposal was unsafe.
+        unsafe: True when the proposed window counted as unsafe (see ``unsafe=``).
+        applied_verdict: verdict of the window actually applied (= ``verdict``
+            unless replaced).
+        fallback_certificate: certificate of the fallback window, or None.
+        fallback_certified: False only when a fallback was applied whose window
+            did not certify.
+        certify_us: wall time (µs) spent certifying (proposal + fallback).
+        time: window start (s).
+        plan: the proposed window's plan.
+        stepped: True when :meth:`Gate.step` advanced the caller's data.
+    """
+
+    verdict: str
+    certificate: Certificate
+    proposed_ctrl: np.ndarray
+    applied_ctrl: np.ndarray
+    replaced: bool
+    terminated: bool
+    unsafe: bool
+    applied_verdict: str
+    fallback_certificate: Certificate | None
+    fallback_certified: bool
+    certify_us: float
+    time: float
+    plan: Any = None
+    stepped: bool = False
+
+    @property
+    def cost(self) -> float:
+        """1.0 when the proposed window has a confirmed violation, else 0.0 (safety-gymnasium)."""
+        return 1.0 if self.verdict == "violation" else 0.0
+
+    def info(self, *, timing: bool = False) -> dict[str, Any]:
+        """Fixed-shape summary for ``info["safety"]`` (stackable by vector envs).
+
+        Absent values are ``inf`` (times, witness point) and ``""`` (geoms), not
+        NaN, so that two identical runs compare equal (gymnasium's determinism
+        checks use ``==`` / ``allclose``, for which NaN != NaN).
+
+        Args:
+            timing: include ``certify_us`` (wall time: differs between identical runs).
+
+        Returns:
+            dict with verdict (str), applied_verdict (str), checker ((P,) str per
+            candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
+            witness_time (float s), witness_geoms ((2,) str), witness_point ((3,) m),
+            earliest_time (float s), clearance (float m), replaced (bool),
+            fallback_certified (bool), terminated (bool), time (float s)
+            and, if ``timing``, certify_us (float µs).
+        """
+        return safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
+                           replaced=self.replaced, fallback_certified=self.fallback_certified,
+                           terminated=self.terminated, time=self.time,
+                           certify_us=self.certify_us if timing else None)
+
+
+def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
+                fallback_certified: bool, terminated: bool, time: float,
+                certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
+    """Build the fixed-shape ``info["safety"]`` dict (see :meth:`StepReport.info`).
+
+    With ``cert=None`` (e.g. after ``reset``) the checker array has ``npairs`` entries of ``""``.
+    """
+    inf = math.inf
+    if cert is None:
+        checker = np.full(int(npairs or 0), "", dtype="<U10")
+        mix, wit, earliest, clearance = "", None, inf, inf
+    else:
+        checker = np.array([p.method for p in cert.pairs], dtype="<U10")
+        methods, counts = np.unique(checker, return_counts=True)
+        mix = " ".join(f"{m}:{c}" for m, c in zip(methods, counts))
+        wit = cert.witness
+        earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
+        clearance = float(cert.clearance)
+    out = {
+        "verdict": verdict,
+        "applied_verdict": applied_verdict,
+        "checker": checker,
+        "checker_mix": mix,
+        "witness_time": inf if wit is None else float(wit.time),
+        "witness_geoms": np.array(["", ""] if wit is None else list(wit.geoms)),
+        "witness_point": np.full(3, inf) if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
+        "earliest_time": earliest,
+        "clearance": clearance,
+        "replaced": bool(replaced),
+        "fallback_certified": bool(fallback_certified),
+        "terminated": bool(terminated),
+        "time": float(time),
+    }
+    if certify_us is not None:
+        out["certify_us"] = float(certify_us)
+    return out
+
+
+# --------------------------------------------------------------------------- the gate
+def _make_budget(budget: Any) -> Any:
+    """A fresh :class:`Budget` per certification from the user's spec (or None)."""
+    if budget is None:
+        return None
+    from monitor.certify.common import Budget
+
+    if isinstance(budget, Budget):
+        return Budget(seconds=budget.seconds, tests=budget.tests)
+    if isinstance(budget, dict):
+        return Budget(seconds=budget.get("seconds"), tests=budget.get("tests"))
+    if isinstance(budget, bool):
+        raise InvalidInputError(f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}")
+    if isinstance(budget, (int, np.integer)):
+        return Budget(tests=int(budget))
+    if isinstance(budget, (float, np.floating)):
+        return Budget(seconds=float(budget))
+    raise InvalidInputError(f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}")
+
+
+class Gate:
+    """Certify-then-step gate on a caller's ``MjModel`` / ``MjData`` (no gymnasium).
+
+    Args:
+        model: the ``MjModel``.
+        pairs: candidate pairs for :meth:`monitor.Scene.from_model` (``"mujoco"``,
+            ``"all"`` or a list of geom-name pairs).
+        margin: clearance (m) that counts as safe.
+        epsilon: certification tolerance (m of body motion).
+        predictor: ``"rollout"`` or a callable ``predictor(data, ctrl, nstep) -> Plan``.
+        on_violation: ``"block" | "terminate" | "warn"``.
+        unsafe: ``"uncertain"`` (anything not certified is unsafe) or ``"violation"``.
+        fallback: None (hold position, see :func:`hold_ctrl`), a (nu,) array, or a
+            callable ``fallback(data) -> ctrl``.
+        budget: per-window work limit: seconds (float), tests (int), a dict
+            ``{"seconds": .., "tests": ..}`` or a :class:`monitor.certify.common.Budget`.
+            An exhausted budget makes the window "uncertain", never "certified".
+        log: None, a path (``.mcap``) or a :class:`monitor.log.MonitorLog`; every
+            window is written.
+        frame_skip: default number of substeps per window (``nstep``).
+        reuse: reuse certified results of pairs whose bodies are fixed and unchanged.
+        tolerances: numerical tolerances.
+
+    Raises:
+        InvalidInputError: on an unknown option, negative margin or epsilon <= 0.
+    """
+
+    def __init__(self, model: mujoco.MjModel, *, pairs: Any = "mujoco", margin: float = 0.0,
+                 epsilon: float = 1e-3, predictor: str | Callable[..., Any] = "rollout",
+                 on_violation: str = "block", unsafe: str = "uncertain",
+                 fallback: Any = None, budget: Any = None, log: Any = None, frame_skip: int = 1,
+                 reuse: bool = True, tolerances: Tolerances = DEFAULT) -> None:
+        if not isinstance(model, mujoco.MjModel):
+            raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
+        if on_violation not in ON_VIOLATION:
+            raise InvalidInputError(f"on_violation must be one of {ON_VIOLATION}, got {on_violation!r}")
+        if unsafe not in UNSAFE:
+            raise InvalidInputError(f"unsafe must be one of {UNSAFE}, got {unsafe!r}")
+        if not (callable(predictor) or predictor in PREDICTORS):
+            raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
+        if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0):
+            raise InvalidInputError(f"margin must be a finite number >= 0, got {margin!r}")
+        if not (isinstance(epsilon, (int, float)) and math.isfinite(epsilon) and epsilon > 0):
+            raise InvalidInputError(f"epsilon must be a finite number > 0, got {epsilon!r}")
+        if int(frame_skip) < 1:
+            raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
+        _make_budget(budget)  # validate early
+        self.model = model
+        self.pairs = pairs
+        self.margin = float(margin)
+        self.epsilon = float(epsilon)
+        self.predictor = predictor
+        self.on_violation = on_violation
+        self.unsafe = unsafe
+        self.fallback = fallback
+        self.budget = budget
+        self.frame_skip = int(frame_skip)
+        self.reuse = bool(reuse)
+        self.tolerances = tolerances
+        self._rollout = Rollout(model)
+        self._scene = None
+        self._cache: dict[int, tuple[bytes, PairResult]] = {}
+        self._log_spec = log
+        self._log = None
+        self._log_owned = False
+        self.last_report: StepReport | None = None
+        self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
+                      "fallback_uncertified": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0}
+
+    # ----------------------------------------------------------------- scene / certify
+    @property
+    def scene(self) -> Any:
+        """The :class:`monitor.Scene` (built on first use)."""
+        if self._scene is None:
+            from monitor.scene import Scene
+
+            self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances)
+        return self._scene
+
+    @property
+    def npairs(self) -> int:
+        """Number of candidate pairs."""
+        return len(self.scene.candidate_pairs)
+
+    def predict(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int | None = None) -> Any:
+        """The plan of the next window under ``ctrl`` (the configured predictor)."""
+        n = self.frame_skip if nstep is None else int(nstep)
+        if callable(self.predictor):
+            return self.predictor(data, ctrl, n)
+        return self._rollout.plan(data, ctrl, n)
+
+    def certify_plan(self, plan: Any) -> Certificate:
+        """Certify an explicit plan (with pair reuse and the gate's budget)."""
+        return self._certify(plan)[0]
+
+    def _certify(self, plan: Any) -> tuple[Certificate, float]:
+        """Certificate of ``plan`` and the wall time in µs."""
+        from monitor.certify.engine import certify
+
+        t_start = time.perf_counter()
+        scene = self.scene
+        todo, reused, keys = self._split_reuse(scene, plan)
+        if todo is None:  # nothing reusable: one plain call
+            cert = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
+                           budget=_make_budget(self.budget), tolerances=self.tolerances)
+        else:
+            cert = self._certify_subset(certify, scene, plan, todo, reused)
+        if self.reuse:
+            self._remember(cert, keys)
+        us = (time.perf_counter() - t_start) * 1e6
+        self.stats["reused_pairs"] += len(reused)
+        self.stats["pairs"] += len(cert.pairs)
+        return cert, us
+
+    def _split_reuse(self, scene: Any, plan: Any) -> tuple[list[int] | None, dict[int, PairResult],
+                                                             dict[int, bytes]]:
+        """Indices of pairs to certify (None = all), reusable results, cache keys of fixed pairs."""
+        if not self.reuse:
+            return None, {}, {}
+        moving = np.asarray(plan.moving_bodies(), bool)
+        pair_bodies = [(scene.geoms[a].body_id, scene.geoms[b].body_id) for a, b in scene.pair_ids]
+        fixed = [i for i, (ba, bb) in enumerate(pair_bodies) if not moving[ba] and not moving[bb]]
+        if not fixed:
+            return None, {}, {}
+        pos, rot = plan.body_poses(np.array([plan.t0]))
+        keys, reused = {}, {}
+        for i in fixed:
+            ba, bb = pair_bodies[i]
+            key = (pos[0, ba].tobytes() + rot[0, ba].tobytes() + pos[0, bb].tobytes()
+                   + rot[0, bb].tobytes())
+            keys[i] = key
+            hit = self._cache.get(i)
+            if hit is not None and hit[0] == key:
+                reused[i] = hit[1]
+        if not reused:
+            return None, {}, keys
+        todo = [i for i in range(len(pair_bodies)) if i not in reused]
+        return todo, reused, keys
+
+    def _certify_subset(self, certify: Callable[..., Certificate], scene: Any, plan: Any,
+                        todo: list[int], reused: dict[int, PairResult]) -> Certificate:
+        """Certify only ``todo`` and merge in the reused pair results (scene order)."""
+        t0, t1 = float(plan.t0), float(plan.t1)
+        if todo:
+            names = [scene.candidate_pairs[i] for i in todo]
+            fresh = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
+                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names)
+            by_geoms = {p.geoms: p for p in fresh.pairs}
+            fresh_pairs = [by_geoms[tuple(scene.candidate_pairs[i])] for i in todo]
+        else:
+            fresh = None
+            fresh_pairs = []
+        results: dict[int, PairResult] = dict(zip(todo, fresh_pairs))
+        results.update(reused)
+        pairs = tuple(results[i] for i in range(len(scene.candidate_pairs)))
+        verdict = combine_verdicts([p.verdict for p in pairs])
+        clearance = min((p.clearance for p in pairs), default=math.inf)
+        stats = dict(fresh.stats) if fresh is not None else {}
+        stats["reused_pairs"] = len(reused)
+        stats["pairs"] = len(pairs)
+        if fresh is None:
+            return Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
+                               clearance, pairs, stats)
+        return Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method, fresh.witness,
+                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats)
+
+    def _remember(self, cert: Certificate, keys: dict[int, bytes]) -> None:
+        for i, key in keys.items():
+            p = cert.pairs[i]
+            if p.verdict == "certified":
+                self._cache[i] = (key, p)
+            else:
+                self._cache.pop(i, None)
+
+    # ----------------------------------------------------------------- decisions
+    def is_unsafe(self, verdict: str) -> bool:
+        """Whether ``verdict`` counts as unsafe under the gate's ``unsafe=`` policy."""
+        if self.unsafe == "violation":
+            return verdict == "violation"
+        return verdict != "certified"
+
+    def fallback_ctrl(self, data: mujoco.MjData) -> np.ndarray:
+        """The fallback control for the current state (see ``fallback=``)."""
+        fb = self.fallback
+        if fb is None:
+            return hold_ctrl(self.model, data)
+        if callable(fb):
+            return np.asarray(fb(data), dtype=np.float64)
+        return np.asarray(fb, dtype=np.float64)
+
+    def decide(self, data: mujoco.MjData, ctrl: Any, *, nstep: int | None = None,
+               predict: Callable[[Any], Any] | None = None,
+               fallback: Callable[[], Any] | None = None) -> StepReport:
+        """Certify the proposed window and pick the control to apply; does NOT step.
+
+        This is the whole gating logic; :meth:`step` and :class:`monitor.SafetyGate`
+        only add the stepping.
+
+        Args:
+            data: the live ``MjData`` (read only).
+            ctrl: proposed control / action.
+            nstep: substeps in the window (default ``frame_skip``).
+            predict: optional ``predict(action) -> Plan`` replacing the gate's predictor
+                (used by adapters whose action is not ``data.ctrl``).
+            fallback: optional zero-argument callable giving the fallback action
+                (default :meth:`fallback_ctrl`).
+
+        Returns:
+            the :class:`StepReport` (``stepped=False``).
+        """
+        n = self.frame_skip if nstep is None else int(nstep)
+        if n < 1:
+            raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
+        ctrl = np.asarray(ctrl)
+        if predict is None:
+            def predict(c: Any) -> Any:
+                return self.predict(data, c, n)
+        t_win = float(data.time)
+        plan = predict(ctrl)
+        cert, us = self._certify(plan)
+        unsafe = self.is_unsafe(cert.verdict)
+        applied, replaced, terminated = ctrl, False, False
+        fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
+        applied_plan = plan
+        if unsafe and self.on_violation != "warn":
+            applied = np.asarray(fallback() if fallback is not None else self.fallback_ctrl(data))
+            replaced, terminated = True, self.on_violation == "terminate"
+            applied_plan = predict(applied)
+            fb_cert, fb_us = self._certify(applied_plan)
+            us += fb_us
+            applied_verdict = fb_cert.verdict
+            fb_ok = fb_cert.verdict == "certified"
+            if not fb_ok:
+                self.stats["fallback_uncertified"] += 1
+                _LOG.warning("t=%.6f s: fallback window is %s (proposal was %s)", t_win,
+                             fb_cert.verdict, cert.verdict)
+        report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
+                            applied_verdict, fb_cert, fb_ok, us, t_win, plan)
+        self._account(report)
+        self._write_log(report, applied_plan)
+        self.last_report = report
+        return report
+
+    def step(self, data: mujoco.MjData, ctrl: Any, nstep: int | None = None) -> StepReport:
+        """Certify the window of ``ctrl``; then step ``data`` with the applied control.
+
+        ``data.ctrl`` is set to the applied control (the proposal, or the fallback
+        when blocked) and ``mj_step`` runs ``nstep`` times, as gymnasium's
+        ``MujocoEnv.do_simulation`` does.
+
+        Args:
+            data: the caller's ``MjData`` (advanced in place).
+            ctrl: (nu,) proposed control.
+            nstep: substeps (default ``frame_skip``).
+
+        Returns:
+            the :class:`StepReport` (``stepped=True``).
+        """
+        n = self.frame_skip if nstep is None else int(nstep)
+        ctrl = np.asarray(ctrl, dtype=np.float64)
+        if ctrl.shape != (self.model.nu,):
+            raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
+        if not np.all(np.isfinite(ctrl)):
+            raise InvalidInputError("ctrl contains NaN or inf")
+        report = self.decide(data, ctrl, nstep=n)
+        data.ctrl[:] = report.applied_ctrl
+        mujoco.mj_step(self.model, data, nstep=n)
+        report = replace(report, stepped=True)
+        self.last_report = report
+        return report
+
+    def _account(self, r: StepReport) -> None:
+        s = self.stats
+        s["windows"] += 1
+        s[r.verdict] += 1
+        s["replaced"] += int(r.replaced)
+        s["certify_us"] += r.certify_us
+
+    def summary(self) -> dict[str, Any]:
+        """Counts so far: windows, verdicts, replaced, fallback_uncertified, mean µs per window."""
+        s = dict(self.stats)
+        s["mean_certify_us"] = s["certify_us"] / s["windows"] if s["windows"] else 0.0
+        return s
+
+    # ----------------------------------------------------------------- logs
+    def _open_log(self) -> Any:
+        if self._log is not None or self._log_spec is None:
+            return self._log
+        spec = self._log_spec
+        if isinstance(spec, (str, Path)):
+            from monitor.log.writer import MonitorLog  # lazy: mcap only when logging
+
+            meta = {"margin": self.margin, "epsilon": self.epsilon, "pairs": str(self.pairs),
+                    "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
+                    "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip}
+            self._log = MonitorLog(spec, model=self.model, metadata=meta)
+            self._log.__enter__()
+            self._log_owned = True
+        else:
+            self._log = spec
+        return self._log
+
+    def _write_log(self, r: StepReport, applied_plan: Any) -> None:
+        log = self._open_log()
+        if log is None:
+            return
+        log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, r.replaced)
+        if r.replaced and not r.fallback_certified and r.fallback_certificate is not None:
+            log.write_window(r.time, applied_plan, r.fallback_certificate, r.applied_ctrl,
+                             r.applied_ctrl, True)
+
+    def close(self) -> None:
+        """Finish the log if the gate opened it."""
+        if self._log is not None and self._log_owned:
+            self._log.__exit__(None, None, None)
+        self._log, self._log_owned = None, False
+
+    def __enter__(self) -> Gate:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+__all__ = ["Gate", "StepReport", "Rollout", "hold_ctrl", "safety_info", "ON_VIOLATION", "UNSAFE"]
