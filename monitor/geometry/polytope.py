@@ -1,0 +1,438 @@
+"""Build :class:`~monitor.geometry.shapes.ConvexShape` objects for MuJoCo primitives.
+
+Pure numpy/scipy (no MuJoCo). Every constructor returns a shape in its own
+*geom* frame; :mod:`monitor.scene` moves it into the body frame with
+:meth:`ConvexShape.transformed`.
+
+Soundness rule: a shape always **contains** the true geom. Exact shapes
+(sphere, capsule, box, mesh hull, half-space) have ``approx_error == 0``.
+Circumscribed shapes (cylinder, ellipsoid, thickened flat point sets) report
+in ``approx_error`` an upper bound (m) on the distance from any point of the
+shape to the true geom (the one-sided Hausdorff excess).
+
+Containment of the primitives is *verified* after construction with the exact
+support function of the true geom in every face normal direction: if rounding
+made any face cut the geom, all vertices are scaled about the centre until no
+face does (plus a relative rounding pad), so the polytope's H-representation
+contains the geom.
+
+Degenerate point sets (:func:`polytope_from_points`): a coplanar, collinear or
+single-point set has no 3-D hull. By default this raises
+:class:`~monitor.errors.InvalidInputError`. With ``thicken=t > 0`` the set is
+thickened **outwards** by ``t`` (flat: a prism of half-height ``t`` about the
+best-fit plane; collinear: a square box of half-width ``t`` about the line;
+point: a cube of half-size ``t``). Outward thickening is an over-approximation,
+so it is sound for certification; the excess is reported in ``approx_error``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError, cKDTree
+
+from monitor.errors import InvalidInputError
+from monitor.geometry.shapes import ConvexShape
+from monitor.tolerances import DEFAULT, Tolerances
+
+_COPLANAR_REL = 1e-12
+"""Two adjacent hull triangles are merged into one face when each one's vertices
+lie within ``_COPLANAR_REL * scale`` of the other's plane (scale = the point
+set's largest extent). This is ~4500 ulp: it merges the triangles qhull splits
+a flat facet into (identical planes up to rounding) but never two genuinely
+distinct faces of a float32 mesh (whose noise is ~1e-7 relative). Merging is
+not a soundness decision: every offset is recomputed as the max over all
+vertices, so the H-rep always contains the vertex set."""
+
+_DEDUP_REL = 1e-12
+"""Vertices of a half-space intersection closer than ``_DEDUP_REL * scale`` are
+one vertex (a vertex where more than three tangent planes meet is returned once
+per plane triple, with rounding differences)."""
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _as_points(points: np.ndarray, what: str = "points") -> np.ndarray:
+    """Validate an (n, 3) finite float array."""
+    try:
+        P = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"{what}: not a numeric array ({exc})") from None
+    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] < 1:
+        raise InvalidInputError(f"{what}: expected shape (n>=1, 3), got {P.shape}")
+    bad = np.flatnonzero(~np.isfinite(P).all(axis=1))
+    if bad.size:
+        raise InvalidInputError(f"{what}: row {int(bad[0])} is not finite: {P[bad[0]].tolist()}")
+    return P
+
+
+def _positive(value: float, what: str) -> float:
+    v = float(value)
+    if not np.isfinite(v) or v <= 0.0:
+        raise InvalidInputError(f"{what} must be finite and > 0, got {value!r}")
+    return v
+
+
+def _facet_count(facets: int) -> int:
+    if isinstance(facets, bool) or int(facets) != facets or int(facets) < 3:
+        raise InvalidInputError(f"facets must be an integer >= 3, got {facets!r}")
+    return int(facets)
+
+
+def _plane_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors u, w with (u, w, n) right-handed orthonormal."""
+    a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(n, a)
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    return u, w
+
+
+def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
+    """Polytope from a full-rank point set (raises QhullError if degenerate)."""
+    hull = ConvexHull(P)
+    simp = hull.simplices
+    eq = hull.equations  # (nf, 4): n . x + d <= 0 inside, n outward unit
+    nrm, d = eq[:, :3], eq[:, 3]
+    tol = _COPLANAR_REL * scale
+    nt = len(simp)
+
+    # union-find over adjacent coplanar triangles
+    parent = np.arange(nt)
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i in range(nt):
+        for j in hull.neighbors[i]:
+            if j <= i or nrm[i] @ nrm[j] <= 0.0:
+                continue
+            di = np.abs(P[simp[j]] @ nrm[i] + d[i]).max()
+            dj = np.abs(P[simp[i]] @ nrm[j] + d[j]).max()
+            if di <= tol and dj <= tol:
+                ri, rj = find(i), find(j)
+                if ri != rj:
+                    parent[rj] = ri
+    roots = np.array([find(i) for i in range(nt)])
+
+    used = np.unique(simp)
+    remap = -np.ones(len(P), np.int64)
+    remap[used] = np.arange(len(used))
+    V = P[used]
+
+    faces: list[np.ndarray] = []
+    normals: list[np.ndarray] = []
+    for r in np.unique(roots):
+        tri = np.flatnonzero(roots == r)
+        # area-weighted normal of the group (qhull's normals are outward)
+        a = P[simp[tri, 1]] - P[simp[tri, 0]]
+        b = P[simp[tri, 2]] - P[simp[tri, 0]]
+        cr = np.cross(a, b)
+        area = np.linalg.norm(cr, axis=1)
+        n = (nrm[tri] * area[:, None]).sum(axis=0) if area.sum() > 0 else nrm[tri].sum(axis=0)
+        n /= np.linalg.norm(n)
+        idx = remap[np.unique(simp[tri])]
+        u, w = _plane_basis(n)
+        q = V[idx] - V[idx].mean(axis=0)
+        ang = np.arctan2(q @ w, q @ u)  # CCW about n, i.e. seen from outside
+        faces.append(idx[np.argsort(ang, kind="stable")].astype(np.int64))
+        normals.append(n)
+    N = np.array(normals)
+    offsets = (N @ V.T).max(axis=1)  # H-rep contains every vertex by construction
+    edges = set()
+    for loop in faces:
+        for k in range(len(loop)):
+            i, j = int(loop[k]), int(loop[(k + 1) % len(loop)])
+            edges.add((min(i, j), max(i, j)))
+    E = np.array(sorted(edges), dtype=np.int64).reshape(-1, 2)
+    return ConvexShape("polytope", V, 0.0, E, tuple(faces), N, offsets, 0.0)
+
+
+# --------------------------------------------------------------------------- public builders
+
+
+def polytope_from_points(points: np.ndarray, *, thicken: float = 0.0) -> ConvexShape:
+    """Convex hull of a point set as a polytope :class:`ConvexShape`.
+
+    Coplanar hull triangles are merged into convex face loops ordered
+    counter-clockwise seen from outside; edges are unique vertex pairs; the
+    H-representation has one row per merged face, with offsets equal to the
+    max of ``normal . v`` over all vertices (so it contains the vertex set).
+    Duplicate and interior points are dropped.
+
+    Args:
+        points: (n, 3) points, metres, any frame.
+        thicken: metres. 0 (default): a degenerate set (coplanar, collinear,
+            single point) raises. > 0: such a set is thickened outwards by this
+            amount (see module docstring); full-rank sets are never thickened.
+
+    Returns:
+        A polytope shape; ``approx_error`` is 0 for a full-rank set, else an
+        upper bound on the outward excess of the thickened shape.
+
+    Raises:
+        InvalidInputError: bad shape / non-finite values, or a degenerate set
+            with ``thicken == 0``.
+    """
+    P = _as_points(points)
+    t = float(thicken)
+    if not np.isfinite(t) or t < 0.0:
+        raise InvalidInputError(f"thicken must be finite and >= 0, got {thicken!r}")
+    P = np.unique(P, axis=0)
+    c = P.mean(axis=0)
+    scale = float(np.ptp(P, axis=0).max()) if len(P) > 1 else 0.0
+    scale = max(scale, float(np.abs(P).max()) * 1e-3, t)
+    if len(P) >= 4:
+        try:
+            return _hull_polytope(P, scale)
+        except QhullError:
+            pass
+    # degenerate: find the rank with an SVD of the centred set
+    Q = P - c
+    _, s, Vt = np.linalg.svd(Q, full_matrices=True) if len(P) > 1 else (None, np.zeros(3), np.eye(3))
+    s = np.concatenate([s, np.zeros(3 - len(s))])
+    rank = 2 if s[1] > 1e-9 * max(s[0], 1e-300) and len(P) >= 3 else (1 if s[0] > 0 else 0)
+    names = {2: "coplanar", 1: "collinear", 0: "a single point"}
+    if t == 0.0:
+        raise InvalidInputError(
+            f"points are {names[rank]} (singular values {s.tolist()}): no 3-D hull; "
+            "pass thicken > 0 to thicken the set outwards")
+    if rank == 2:
+        n = Vt[2]
+        u, w = _plane_basis(n)
+        r = Q @ n
+        q2 = np.stack([Q @ u, Q @ w], axis=1)
+        try:
+            h2 = ConvexHull(q2)
+            ring = q2[h2.vertices]
+        except QhullError:
+            rank = 1
+        else:
+            lo, hi = r.min() - t, r.max() + t
+            base = c + ring[:, :1] * u + ring[:, 1:] * w
+            V = np.concatenate([base + hi * n, base + lo * n])
+            shape = _hull_polytope(V, scale)
+            err = float(r.max() - r.min()) + t
+            return _with_error(shape, err)
+    if rank == 1:
+        d = Vt[0]
+        u, w = _plane_basis(d)
+        sd = Q @ d
+        rho = float(np.sqrt((Q @ u) ** 2 + (Q @ w) ** 2).max()) + t
+        V = np.array([c + a * d + su * rho * u + sw * rho * w
+                      for a in (sd.min(), sd.max()) for su in (-1, 1) for sw in (-1, 1)])
+        return _with_error(_hull_polytope(V, scale), float(np.sqrt(2.0) * 2 * rho))
+    rho = float(np.linalg.norm(Q, axis=1).max()) + t
+    shape = box_polytope(np.array([rho, rho, rho]))
+    return _with_error(shape.transformed(np.eye(3), c), float(np.sqrt(3.0) * 2 * rho))
+
+
+def _with_error(shape: ConvexShape, err: float) -> ConvexShape:
+    return ConvexShape(shape.kind, shape.points, shape.radius, shape.edges, shape.faces,
+                       shape.normals, shape.offsets, float(err))
+
+
+def _contain(shape: ConvexShape, support, tol: Tolerances) -> ConvexShape:
+    """Scale a centred polytope about the origin until its H-rep contains the true geom.
+
+    Args:
+        shape: polytope whose interior contains the origin (the geom centre).
+        support: callable (f, 3) unit directions -> (f,) support values h(n) of the
+            true geom (exact closed form).
+        tol: tolerances (``rel_pad`` pads the scale factor).
+    """
+    h = support(shape.normals)
+    ratio = float((h / shape.offsets).max())
+    k = max(ratio, 1.0) * (1.0 + tol.rel_pad)
+    return ConvexShape("polytope", shape.points * k, 0.0, shape.edges, shape.faces,
+                       shape.normals, shape.offsets * k, shape.approx_error)
+
+
+def box_polytope(half_extents: np.ndarray) -> ConvexShape:
+    """Axis-aligned box centred at the origin (exact).
+
+    Args:
+        half_extents: (3,) half sizes, metres, each > 0.
+    """
+    h = np.asarray(half_extents, dtype=np.float64).reshape(-1)
+    if h.shape != (3,):
+        raise InvalidInputError(f"half_extents: expected shape (3,), got {h.shape}")
+    for i in range(3):
+        _positive(h[i], f"half_extents[{i}]")
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
+    return _hull_polytope(signs * h, float(2 * h.max()))
+
+
+def cylinder_polytope(radius: float, half_length: float, facets: int = DEFAULT.facets,
+                      *, tolerances: Tolerances = DEFAULT) -> ConvexShape:
+    """Regular prism circumscribing a cylinder with axis z, centred at the origin.
+
+    The N-gon has circumradius ``radius / cos(pi / N)``, so its apothem is the
+    cylinder radius and it contains the cylinder. ``approx_error`` is measured
+    over the final vertices (the radial excess, analytically
+    ``radius * (1 / cos(pi / N) - 1)``, plus the containment pad).
+
+    Args:
+        radius: metres, > 0.
+        half_length: metres, > 0.
+        facets: N >= 3 side faces.
+        tolerances: rounding pads.
+    """
+    r = _positive(radius, "radius")
+    hl = _positive(half_length, "half_length")
+    N = _facet_count(facets)
+    R = r / np.cos(np.pi / N)
+    th = 2.0 * np.pi * np.arange(N) / N
+    ring = np.stack([R * np.cos(th), R * np.sin(th)], axis=1)
+    V = np.concatenate([np.c_[ring, np.full(N, -hl)], np.c_[ring, np.full(N, hl)]])
+    shape = _hull_polytope(V, float(2 * max(R, hl)))
+
+    def support(n: np.ndarray) -> np.ndarray:
+        return r * np.hypot(n[:, 0], n[:, 1]) + hl * np.abs(n[:, 2])
+
+    shape = _contain(shape, support, tolerances)
+    P = shape.points
+    radial = np.maximum(np.hypot(P[:, 0], P[:, 1]) - r, 0.0)
+    axial = np.maximum(np.abs(P[:, 2]) - hl, 0.0)
+    err = float(np.hypot(radial, axial).max())
+    return _with_error(shape, err * (1.0 + tolerances.rel_pad))
+
+
+def _sphere_directions(facets: int) -> np.ndarray:
+    """Well-spread unit directions: poles plus latitude rings, ~facets^2/pi of them."""
+    n_rings = max(2, facets // 2)
+    dirs = [np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.0, 1.0])]
+    for k in range(1, n_rings):
+        lat = -0.5 * np.pi + k * np.pi / n_rings
+        cnt = max(3, round(facets * np.cos(lat)))
+        lon = 2.0 * np.pi * (np.arange(cnt) + 0.5 * (k % 2)) / cnt
+        dirs.extend(np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon),
+                              np.full(cnt, np.sin(lat))], axis=1))
+    return np.array(dirs)
+
+
+def ellipsoid_distance_upper(points: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Upper bounds (n,) on the distance from points (n, 3) to an axis-aligned ellipsoid.
+
+    For a point y outside, the closest point is x_i = e_i^2 y_i / (t + e_i^2)
+    with t >= 0 the root of sum (e_i y_i / (t + e_i^2))^2 = 1 (decreasing in t,
+    bracketed by [0, max(e) |y|]); bisection to machine precision, then x is
+    rescaled onto the surface, so ``|y - x|`` is >= the true distance up to
+    rounding. Points inside give 0.
+
+    Args:
+        points: (n, 3) metres, ellipsoid frame.
+        radii: (3,) semi-axes, metres.
+    """
+    Y = np.asarray(points, dtype=np.float64)
+    e = np.asarray(radii, dtype=np.float64)
+    inside = ((Y / e) ** 2).sum(axis=1) <= 1.0
+    lo = np.zeros(len(Y))
+    hi = e.max() * np.linalg.norm(Y, axis=1) + e.max() ** 2
+    e2 = e**2
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        f = (((e * Y) / (mid[:, None] + e2)) ** 2).sum(axis=1) - 1.0
+        big = f > 0
+        lo = np.where(big, mid, lo)
+        hi = np.where(big, hi, mid)
+    X = e2 * Y / (hi[:, None] + e2)
+    X /= np.sqrt(((X / e) ** 2).sum(axis=1))[:, None]
+    d = np.linalg.norm(Y - X, axis=1)
+    return np.where(inside, 0.0, d)
+
+
+def ellipsoid_polytope(radii: np.ndarray, facets: int = DEFAULT.facets,
+                       *, tolerances: Tolerances = DEFAULT) -> ConvexShape:
+    """Polytope circumscribing an axis-aligned ellipsoid centred at the origin.
+
+    Tangent planes of the unit sphere at well-spread directions (poles plus
+    ``facets // 2 - 1`` latitude rings with up to ``facets`` planes each; about
+    ``facets^2 / pi`` faces, 82 for 16) are mapped by ``diag(radii)``; an affine
+    map keeps tangency, so every plane touches the ellipsoid. Vertices come from
+    scipy's ``HalfspaceIntersection``. ``approx_error`` is the max over vertices
+    of an upper bound on the vertex-to-ellipsoid distance
+    (:func:`ellipsoid_distance_upper`); the distance to a convex set is convex,
+    so the max over the polytope is attained at a vertex.
+
+    Args:
+        radii: (3,) semi-axes, metres, each > 0.
+        facets: angular resolution (>= 3); 4 gives the bounding box.
+        tolerances: rounding pads.
+    """
+    e = np.asarray(radii, dtype=np.float64).reshape(-1)
+    if e.shape != (3,):
+        raise InvalidInputError(f"radii: expected shape (3,), got {e.shape}")
+    for i in range(3):
+        _positive(e[i], f"radii[{i}]")
+    N = _facet_count(facets)
+    U = _sphere_directions(N)
+    # plane u . z <= 1 on the unit sphere, z = x / e  ->  (u / e) . x <= 1
+    A = U / e
+    nA = np.linalg.norm(A, axis=1)
+    halfspaces = np.c_[A / nA[:, None], -1.0 / nA]
+    hs = HalfspaceIntersection(halfspaces, np.zeros(3))
+    V = hs.intersections
+    scale = float(2 * e.max())
+    # merge near-duplicate vertices (more than three planes through one vertex)
+    tree = cKDTree(V)
+    keep = np.ones(len(V), bool)
+    for i, j in sorted(tree.query_pairs(_DEDUP_REL * scale)):
+        if keep[i]:
+            keep[j] = False
+    shape = _hull_polytope(V[keep], scale)
+
+    def support(n: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(n * e, axis=1)
+
+    shape = _contain(shape, support, tolerances)
+    err = float(ellipsoid_distance_upper(shape.points, e).max())
+    return _with_error(shape, err * (1.0 + tolerances.rel_pad))
+
+
+def sphere_shape(radius: float, center: np.ndarray | None = None) -> ConvexShape:
+    """Sphere: a point core plus the radius (exact).
+
+    Args:
+        radius: metres, > 0.
+        center: (3,) centre, default the origin.
+    """
+    r = _positive(radius, "radius")
+    c = np.zeros(3) if center is None else _as_points(np.reshape(center, (1, 3)), "center")[0]
+    return ConvexShape("sphere", c.reshape(1, 3).copy(), r)
+
+
+def capsule_shape(radius: float, half_length: float) -> ConvexShape:
+    """Capsule with axis z: segment (0, 0, -h)-(0, 0, h) plus the radius (exact).
+
+    Args:
+        radius: metres, > 0.
+        half_length: half the segment length, metres, >= 0.
+    """
+    r = _positive(radius, "radius")
+    hl = float(half_length)
+    if not np.isfinite(hl) or hl < 0.0:
+        raise InvalidInputError(f"half_length must be finite and >= 0, got {half_length!r}")
+    pts = np.array([[0.0, 0.0, -hl], [0.0, 0.0, hl]])
+    return ConvexShape("capsule", pts, r, np.array([[0, 1]], dtype=np.int64))
+
+
+def halfspace_shape() -> ConvexShape:
+    """Half-space ``{z <= 0}`` (a MuJoCo plane in its geom frame; exact)."""
+    return ConvexShape("halfspace", np.zeros((1, 3)), 0.0,
+                       normals=np.array([[0.0, 0.0, 1.0]]), offsets=np.zeros(1))
+
+
+__all__ = [
+    "polytope_from_points",
+    "box_polytope",
+    "cylinder_polytope",
+    "ellipsoid_polytope",
+    "ellipsoid_distance_upper",
+    "sphere_shape",
+    "capsule_shape",
+    "halfspace_shape",
+]

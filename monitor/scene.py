@@ -1,0 +1,388 @@
+"""MjModel -> :class:`Scene`: convex geom shapes in body frames and the candidate pairs.
+
+This is the only module that reads geoms from MuJoCo. Shapes are built with
+:mod:`monitor.geometry.polytope` (pure numpy/scipy) in the geom frame and moved
+into the frame of the body that carries the geom (``geom_pos``/``geom_quat``).
+
+Geom type -> shape (body frame):
+
+=========  =====================================================================
+sphere     point + radius (exact)
+capsule    segment + radius (exact)
+box        polytope (exact)
+mesh       convex hull of the vertices MuJoCo collides: the ``mesh_graph`` hull
+           vertices when the compiler stored a hull (respects ``maxhullvert``),
+           else all ``mesh_vert`` (float32, mesh frame == geom frame) (exact)
+cylinder   circumscribed regular prism (``facets`` sides), reported
+ellipsoid  circumscribed tangent-plane polytope, reported
+plane      half-space ``{z <= 0}`` in the geom frame (exact; MuJoCo planes are
+           infinite for collision)
+hfield/sdf :class:`~monitor.errors.UnsupportedGeometryError` naming the geom
+           when it takes part in a candidate pair; ``shape is None`` otherwise
+=========  =====================================================================
+
+Pair modes:
+
+* ``"mujoco"``: MuJoCo's static candidate filter (mj_collision without the
+  bounding-volume test): no plane/hfield-plane/hfield pairs; ``<pair>`` geoms
+  always (bypassing every other rule); otherwise skip the same weld group,
+  pairs whose weld groups both have no dof (static or mocap: MuJoCo >= 3.12
+  never collides them), parent-child weld groups when ``filterparent`` is on and
+  neither weld group is the world, ``<exclude>`` body pairs, and pairs failing
+  ``(contype1 & conaffinity2) || (contype2 & conaffinity1)``. The global
+  ``contact``/``constraint`` disable flags are ignored (the geometry still
+  counts for safety).
+* ``"all"``: every non plane-plane pair of geoms on distinct weld groups that
+  are not parent-child (neither being the world, regardless of
+  ``filterparent``) and not both static (``body_weldid == 0``). Mocap bodies
+  are moving here, so mocap-vs-static pairs are included (MuJoCo skips them).
+  ``contype``/``conaffinity`` and ``<exclude>`` are ignored.
+* explicit list of ``(geom_a, geom_b)`` (names or ids), validated.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from monitor.errors import InvalidInputError, UnsupportedGeometryError
+from monitor.geometry.polytope import (
+    box_polytope,
+    capsule_shape,
+    cylinder_polytope,
+    ellipsoid_polytope,
+    halfspace_shape,
+    polytope_from_points,
+    sphere_shape,
+)
+from monitor.geometry.shapes import ConvexShape
+from monitor.tolerances import DEFAULT, Tolerances
+
+FLAT_MESH_THICKNESS = 1e-6
+"""Metres by which a flat (coplanar) mesh would be thickened outwards. MuJoCo
+4.0's compiler rejects coplanar meshes ("cannot compute convex hull"), so this
+only guards against future compilers; the excess is reported in
+``Scene.approximations`` and is an over-approximation (sound)."""
+
+_GEOM_TYPES = {int(v): k.removeprefix("mjGEOM_").lower() for k, v in mujoco.mjtGeom.__members__.items()}
+_PLANE = int(mujoco.mjtGeom.mjGEOM_PLANE)
+_HFIELD = int(mujoco.mjtGeom.mjGEOM_HFIELD)
+_SDF = int(mujoco.mjtGeom.mjGEOM_SDF)
+_UNSUPPORTED = (_HFIELD, _SDF)
+_CHUNK = 1 << 20  # geom pairs per vectorised filter block
+
+
+@dataclass(frozen=True, eq=False)
+class GeomInfo:
+    """One MuJoCo geom as the monitor sees it.
+
+    Attributes:
+        name: geom name (``"geom<id>"`` when unnamed).
+        id: MuJoCo geom id (== index in ``Scene.geoms``).
+        body: name of the body carrying the geom.
+        body_id: MuJoCo body id.
+        type: MuJoCo geom type name (``"sphere"``, ``"capsule"``, ``"box"``,
+            ``"mesh"``, ``"cylinder"``, ``"ellipsoid"``, ``"plane"``, ``"hfield"``, ``"sdf"``).
+        shape: convex shape in the BODY frame, or None for unsupported types
+            (hfield, sdf) that take part in no candidate pair.
+        margin: ``geom_margin`` (m), informational; the certification margin is
+            an argument of ``certify``.
+        static: the body is welded to the world (``body_weldid == 0``).
+        mocap: the body is a mocap body or a dof-less descendant of one.
+    """
+
+    name: str
+    id: int
+    body: str
+    body_id: int
+    type: str
+    shape: ConvexShape | None
+    margin: float
+    static: bool
+    mocap: bool
+
+
+def _quat_to_mat(q: np.ndarray) -> np.ndarray:
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, np.asarray(q, dtype=np.float64))
+    return R.reshape(3, 3)
+
+
+def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape | None:
+    """Shape of geom ``g`` in its geom frame (None for unsupported types)."""
+    t = int(model.geom_type[g])
+    size = np.asarray(model.geom_size[g], dtype=np.float64)
+    name = _GEOM_TYPES.get(t, str(t))
+    if t == int(mujoco.mjtGeom.mjGEOM_SPHERE):
+        return sphere_shape(size[0])
+    if t == int(mujoco.mjtGeom.mjGEOM_CAPSULE):
+        return capsule_shape(size[0], size[1])
+    if t == int(mujoco.mjtGeom.mjGEOM_BOX):
+        return box_polytope(size)
+    if t == int(mujoco.mjtGeom.mjGEOM_CYLINDER):
+        return cylinder_polytope(size[0], size[1], facets, tolerances=tol)
+    if t == int(mujoco.mjtGeom.mjGEOM_ELLIPSOID):
+        return ellipsoid_polytope(size, facets, tolerances=tol)
+    if t == _PLANE:
+        return halfspace_shape()
+    if t == int(mujoco.mjtGeom.mjGEOM_MESH):
+        mid = int(model.geom_dataid[g])
+        a, n = int(model.mesh_vertadr[mid]), int(model.mesh_vertnum[mid])
+        V = np.asarray(model.mesh_vert[a:a + n], dtype=np.float64)
+        ga = int(model.mesh_graphadr[mid])
+        if ga >= 0:
+            nv = int(model.mesh_graph[ga])
+            vid = np.asarray(model.mesh_graph[ga + 2 + nv: ga + 2 + 2 * nv], dtype=np.int64)
+            V = V[vid]
+        try:
+            return polytope_from_points(V)
+        except InvalidInputError:
+            return polytope_from_points(V, thicken=FLAT_MESH_THICKNESS)
+    if t in _UNSUPPORTED:
+        return None
+    raise UnsupportedGeometryError(f"geom {g} has unknown type {name!r}")
+
+
+class Scene:
+    """Convex shapes of every geom of an ``MjModel`` plus the pairs to certify.
+
+    Build with :meth:`from_model`. Attributes (read-only by convention):
+
+    Attributes:
+        model: the ``mujoco.MjModel`` (kept; plans are checked against it).
+        geoms: tuple of :class:`GeomInfo`, index == geom id.
+        candidate_pairs: tuple of (name_a, name_b), sorted by (id_a, id_b), id_a < id_b.
+        pair_ids: (P, 2) int64 geom ids, same order.
+        body_names: tuple of body names (nbody), ``"body<id>"`` when unnamed.
+        body_static: (nbody,) bool, welded to the world with no dof (mocap is not static).
+        approximations: {geom name: approx_error (m)} for circumscribed shapes.
+        facets: facet count used for cylinders and ellipsoids.
+        tolerances: the :class:`Tolerances` used.
+    """
+
+    def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
+                 body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
+                 tolerances: Tolerances):
+        self.model = model
+        self.geoms = geoms
+        self.pair_ids = pair_ids
+        self.candidate_pairs = tuple((geoms[a].name, geoms[b].name) for a, b in pair_ids.tolist())
+        self.body_names = body_names
+        self.body_static = body_static
+        self.facets = facets
+        self.tolerances = tolerances
+        self.approximations = {g.name: float(g.shape.approx_error) for g in geoms
+                               if g.shape is not None and g.shape.approx_error > 0.0}
+        self._by_name = {g.name: g for g in geoms}
+
+    # ------------------------------------------------------------------ construction
+
+    @classmethod
+    def from_model(cls, model: Any, pairs: str | Iterable[tuple[str | int, str | int]] = "mujoco",
+                   *, facets: int | None = None, tolerances: Tolerances = DEFAULT) -> Scene:
+        """Read every geom of ``model`` and select the candidate pairs.
+
+        Args:
+            model: a ``mujoco.MjModel``.
+            pairs: ``"mujoco"`` (MuJoCo's own candidate filter), ``"all"`` (every
+                pair that can move relative to each other, see module docstring),
+                or an iterable of (geom_a, geom_b) names or ids.
+            facets: facet count of circumscribed cylinders/ellipsoids (>= 3);
+                default ``tolerances.facets`` (16).
+            tolerances: numerical tolerances.
+
+        Returns:
+            The scene.
+
+        Raises:
+            InvalidInputError: unknown pairs mode, unknown geom in a pair, a geom
+                paired with itself, a plane-plane pair, bad ``facets``.
+            UnsupportedGeometryError: an hfield/sdf geom in a candidate pair.
+        """
+        if not isinstance(model, mujoco.MjModel):
+            raise InvalidInputError(f"model must be a mujoco.MjModel, got {type(model).__name__}")
+        nf = tolerances.facets if facets is None else facets
+        if isinstance(nf, bool) or not isinstance(nf, int | np.integer) or nf < 3:
+            raise InvalidInputError(f"facets must be an integer >= 3, got {facets!r}")
+        nf = int(nf)
+
+        nbody, ngeom = int(model.nbody), int(model.ngeom)
+        body_names = tuple(model.body(b).name or f"body{b}" for b in range(nbody))
+        weld = np.asarray(model.body_weldid, dtype=np.int64)
+        body_static = weld == 0
+        body_mocap = np.asarray(model.body_mocapid, dtype=np.int64)[weld] >= 0
+        names = [model.geom(g).name or f"geom{g}" for g in range(ngeom)]
+        if len(set(names)) != ngeom:  # an explicit name like "geom3" clashing with a generated one
+            seen: dict[str, int] = {}
+            for g, nm in enumerate(names):
+                if nm in seen:
+                    raise InvalidInputError(f"geom name {nm!r} is used by geoms {seen[nm]} and {g}")
+                seen[nm] = g
+
+        pair_ids = cls._select_pairs(model, pairs, names)
+        types = np.asarray(model.geom_type, dtype=np.int64)
+        if len(pair_ids):
+            in_pair = np.unique(pair_ids.ravel())
+            bad = in_pair[np.isin(types[in_pair], _UNSUPPORTED)]
+            if bad.size:
+                g = int(bad[0])
+                other = pair_ids[(pair_ids == g).any(axis=1)][0]
+                partner = int(other[0] if other[1] == g else other[1])
+                raise UnsupportedGeometryError(
+                    f"geom {names[g]!r} (id {g}) has type {_GEOM_TYPES[int(types[g])]!r}, which the "
+                    f"checkers cannot represent; it is in candidate pair ({names[g]!r}, "
+                    f"{names[partner]!r}). Exclude it (contype/conaffinity, <exclude>) or pass "
+                    "an explicit pair list without it")
+
+        geoms = []
+        for g in range(ngeom):
+            b = int(model.geom_bodyid[g])
+            shape_G = _geom_shape(model, g, nf, tolerances)
+            shape_B = None
+            if shape_G is not None:
+                shape_B = shape_G.transformed(_quat_to_mat(model.geom_quat[g]),
+                                              np.asarray(model.geom_pos[g], dtype=np.float64).copy())
+            geoms.append(GeomInfo(
+                name=names[g], id=g, body=body_names[b], body_id=b,
+                type=_GEOM_TYPES.get(int(types[g]), str(int(types[g]))), shape=shape_B,
+                margin=float(model.geom_margin[g]), static=bool(body_static[b]),
+                mocap=bool(body_mocap[b])))
+        return cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+
+    @staticmethod
+    def _select_pairs(model: Any, pairs: Any, names: Sequence[str]) -> np.ndarray:
+        ngeom = int(model.ngeom)
+        if isinstance(pairs, str):
+            if pairs not in ("mujoco", "all"):
+                raise InvalidInputError(
+                    f"pairs must be 'mujoco', 'all' or a list of geom pairs, got {pairs!r}")
+            return _filter_pairs(model, mode=pairs)
+        try:
+            items = list(pairs)
+        except TypeError:
+            raise InvalidInputError(f"pairs must be 'mujoco', 'all' or a list of geom pairs, "
+                                    f"got {type(pairs).__name__}") from None
+        index = {n: i for i, n in enumerate(names)}
+
+        def resolve(x: Any, k: int) -> int:
+            if isinstance(x, str):
+                if x not in index:
+                    raise InvalidInputError(f"pairs[{k}]: unknown geom {x!r}")
+                return index[x]
+            if isinstance(x, int | np.integer) and not isinstance(x, bool):
+                if not 0 <= int(x) < ngeom:
+                    raise InvalidInputError(f"pairs[{k}]: geom id {x} out of range [0, {ngeom})")
+                return int(x)
+            raise InvalidInputError(f"pairs[{k}]: geom must be a name or id, got {x!r}")
+
+        out = set()
+        types = np.asarray(model.geom_type)
+        for k, item in enumerate(items):
+            if isinstance(item, str) or not hasattr(item, "__len__") or len(item) != 2:
+                raise InvalidInputError(f"pairs[{k}]: expected a (geom_a, geom_b) pair, got {item!r}")
+            a, b = resolve(item[0], k), resolve(item[1], k)
+            if a == b:
+                raise InvalidInputError(f"pairs[{k}]: geom {names[a]!r} is paired with itself")
+            if types[a] == _PLANE and types[b] == _PLANE:
+                raise InvalidInputError(f"pairs[{k}]: ({names[a]!r}, {names[b]!r}) are both planes; "
+                                        "plane-plane pairs have no collision test")
+            out.add((min(a, b), max(a, b)))
+        return np.array(sorted(out), dtype=np.int64).reshape(-1, 2)
+
+    # ------------------------------------------------------------------ queries
+
+    def geom(self, name_or_id: str | int) -> GeomInfo:
+        """The :class:`GeomInfo` of a geom given by name or id.
+
+        Raises:
+            InvalidInputError: unknown name or id out of range.
+        """
+        if isinstance(name_or_id, str):
+            try:
+                return self._by_name[name_or_id]
+            except KeyError:
+                raise InvalidInputError(f"unknown geom {name_or_id!r}") from None
+        if isinstance(name_or_id, int | np.integer) and not isinstance(name_or_id, bool):
+            if 0 <= int(name_or_id) < len(self.geoms):
+                return self.geoms[int(name_or_id)]
+            raise InvalidInputError(f"geom id {name_or_id} out of range [0, {len(self.geoms)})")
+        raise InvalidInputError(f"geom must be a name or id, got {name_or_id!r}")
+
+    @cached_property
+    def model_hash(self) -> str:
+        """sha256 hex digest of the model's binary (MJB) serialisation.
+
+        Equal for two loads of the same XML; changes with any edit of model fields.
+        """
+        return model_hash(self.model)
+
+    def __repr__(self) -> str:
+        return (f"Scene(ngeom={len(self.geoms)}, nbody={len(self.body_names)}, "
+                f"pairs={len(self.candidate_pairs)})")
+
+
+def model_hash(model: Any) -> str:
+    """sha256 hex digest of ``mj_saveModel`` bytes (MJB) of an ``MjModel``."""
+    buf = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buf)
+    return hashlib.sha256(buf.tobytes()).hexdigest()
+
+
+def _filter_pairs(model: Any, mode: str) -> np.ndarray:
+    """Vectorised candidate filter; returns (P, 2) int64 sorted geom id pairs (see module docstring)."""
+    ngeom = int(model.ngeom)
+    if ngeom < 2:
+        return np.zeros((0, 2), np.int64)
+    types = np.asarray(model.geom_type, dtype=np.int64)
+    gbody = np.asarray(model.geom_bodyid, dtype=np.int64)
+    weld = np.asarray(model.body_weldid, dtype=np.int64)
+    parent = np.asarray(model.body_parentid, dtype=np.int64)
+    dofnum = np.asarray(model.body_dofnum, dtype=np.int64)
+    contype = np.asarray(model.geom_contype, dtype=np.int64)
+    conaff = np.asarray(model.geom_conaffinity, dtype=np.int64)
+    gweld = weld[gbody]
+    wparent = weld[parent]  # weld group of each body's parent
+    planeish = np.isin(types, (_PLANE, _HFIELD))
+    filterparent = not (int(model.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT))
+    excl = np.sort(np.asarray(model.exclude_signature, dtype=np.int64))
+    explicit = set()
+    for a, b in zip(np.asarray(model.pair_geom1).tolist(), np.asarray(model.pair_geom2).tolist()):
+        explicit.add((min(a, b), max(a, b)))
+
+    out = []
+    rows = max(1, _CHUNK // ngeom)
+    for r0 in range(0, ngeom - 1, rows):
+        ii, jj = np.meshgrid(np.arange(r0, min(r0 + rows, ngeom - 1)), np.arange(ngeom), indexing="ij")
+        upper = jj > ii
+        i, j = ii[upper], jj[upper]
+        w1, w2 = gweld[i], gweld[j]
+        keep = ~(planeish[i] & planeish[j])
+        keep &= w1 != w2
+        if mode == "mujoco":
+            keep &= (dofnum[w1] > 0) | (dofnum[w2] > 0)
+            if filterparent:
+                keep &= ~((w1 != 0) & (w2 != 0) & ((w1 == wparent[w2]) | (w2 == wparent[w1])))
+            b1, b2 = gbody[i], gbody[j]
+            sig = (np.minimum(b1, b2) << 16) + np.maximum(b1, b2)
+            if len(excl):
+                keep &= ~np.isin(sig, excl)
+            keep &= ((contype[i] & conaff[j]) != 0) | ((contype[j] & conaff[i]) != 0)
+        else:
+            keep &= ~((w1 == 0) & (w2 == 0))
+            keep &= ~((w1 != 0) & (w2 != 0) & ((w1 == wparent[w2]) | (w2 == wparent[w1])))
+        out.append(np.stack([i[keep], j[keep]], axis=1))
+    sel = np.concatenate(out).astype(np.int64)
+    if mode == "mujoco" and explicit:
+        ex = np.array(sorted(explicit), dtype=np.int64).reshape(-1, 2)
+        ex = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]])]
+        sel = np.unique(np.concatenate([sel, ex]), axis=0)
+    return sel.reshape(-1, 2)
+
+
+__all__ = ["Scene", "GeomInfo", "model_hash", "FLAT_MESH_THICKNESS"]

@@ -1,0 +1,427 @@
+"""Scene.from_model: candidate pairs against mj_collision, shapes against the true geoms."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+import trimesh
+from conftest import ASSETS
+
+from monitor.errors import InvalidInputError, UnsupportedGeometryError
+from monitor.scene import GeomInfo, Scene
+
+REPO = Path(__file__).resolve().parents[1]
+PAIR_SCENES = sorted(p.name for p in ASSETS.glob("*.xml") if p.name != "hfield.xml")
+MODEL_SCENES = sorted(str(p.relative_to(REPO)) for p in (REPO / "models").glob("*/scene*.xml"))
+ALL_SCENES = [ASSETS / n for n in PAIR_SCENES] + [REPO / p for p in MODEL_SCENES]
+TYPES = mujoco.mjtGeom
+
+
+def _reported(model: mujoco.MjModel, data: mujoco.MjData) -> set[tuple[int, int]]:
+    mujoco.mj_forward(model, data)
+    return {tuple(sorted(int(g) for g in c.geom)) for c in data.contact[: data.ncon]}
+
+
+def contact_pairs(path: Path) -> set[tuple[int, int]]:
+    """Geom pairs for which mj_collision reports a contact in either of two overlap setups.
+
+    (a) Every geom and <pair> gets a margin (50 m) far above the scene size, at qpos0.
+    (b) Every body and geom position is zeroed (all geoms centred at the world origin,
+        free joints at the origin) with a 5 cm margin, so every pair overlaps deeply.
+    (a) alone is not enough: MuJoCo 4.0's box-box collider reports nothing for separated
+    boxes in many configurations whatever the margin (palm vs shelf in models/arm), and
+    (b) alone could hit the capsule-box piercing defect (reference section 6). MuJoCo never
+    reports a pair outside its candidate set, so the union is still a subset of it.
+    """
+    a = mujoco.MjModel.from_xml_path(str(path))
+    a.geom_margin[:] = 50.0
+    a.pair_margin[:] = 100.0
+    da = mujoco.MjData(a)
+    mujoco.mj_setConst(a, da)
+    b = mujoco.MjModel.from_xml_path(str(path))
+    b.geom_margin[:] = 0.05
+    b.pair_margin[:] = 0.1
+    b.body_pos[:] = 0.0
+    b.geom_pos[:] = 0.0
+    db = mujoco.MjData(b)
+    mujoco.mj_setConst(b, db)
+    for j in range(b.njnt):
+        if b.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            db.qpos[b.jnt_qposadr[j]: b.jnt_qposadr[j] + 3] = 0.0
+    return _reported(a, da) | _reported(b, db)
+
+
+class PairSet(set):
+    """Order-insensitive membership for (name_a, name_b) pairs."""
+
+    def __init__(self, pairs):
+        super().__init__(frozenset(p) for p in pairs)
+
+    def __contains__(self, pair):
+        return super().__contains__(frozenset(pair))
+
+
+def load(path: Path) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_path(str(path))
+
+
+# --------------------------------------------------------------------------- candidate pairs
+
+
+@pytest.mark.parametrize("path", ALL_SCENES, ids=lambda p: p.name if p.parent == ASSETS else str(p))
+def test_mujoco_pairs_equal_mj_collision(path):
+    scene = Scene.from_model(load(path), pairs="mujoco")
+    got = {tuple(p) for p in scene.pair_ids.tolist()}
+    want = contact_pairs(path)
+    names = [g.name for g in scene.geoms]
+    assert got == want, (
+        f"extra {[(names[a], names[b]) for a, b in sorted(got - want)]}, "
+        f"missing {[(names[a], names[b]) for a, b in sorted(want - got)]}")
+    assert len(got) > 0
+
+
+def test_pair_order_and_names(load_asset):
+    scene = Scene.from_model(load_asset("arm_table.xml"))
+    ids = scene.pair_ids
+    assert ids.dtype == np.int64 and ids.shape == (len(scene.candidate_pairs), 2)
+    assert (ids[:, 0] < ids[:, 1]).all()
+    assert ids.tolist() == sorted(ids.tolist())
+    for (a, b), (na, nb) in zip(ids.tolist(), scene.candidate_pairs):
+        assert (scene.geoms[a].name, scene.geoms[b].name) == (na, nb)
+
+
+def test_arm_table_rules(load_asset):
+    scene = Scene.from_model(load_asset("arm_table.xml"))
+    pairs = PairSet(scene.candidate_pairs)
+    assert ("pedestal_geom", "upper_arm") in pairs  # world-welded parent collides with its child
+    assert ("upper_arm", "fore_arm") not in pairs  # parent-child
+    assert ("bench_top", "claw_geom") in pairs  # <pair>; claw contype 2 would not match bench
+    assert ("ground", "claw_geom") not in pairs  # contype mask
+    assert ("upper_arm", "claw_geom") not in pairs  # parent-child through the dof-less wrist
+    assert ("bench_top", "block_geom") not in pairs  # <exclude>
+    assert ("bench_leg", "block_geom") not in pairs  # <exclude> is per body
+    assert ("ground", "goal_ball") not in pairs  # mocap vs static: MuJoCo skips (no dof)
+    assert ("goal_ball", "block_geom") in pairs
+    assert not any("wrist_marker" in p for p in pairs)
+
+
+def test_mocap_weld_groups(load_asset):
+    scene = Scene.from_model(load_asset("mocap_group.xml"))
+    pairs = PairSet(scene.candidate_pairs)
+    assert ("hand_a_geom", "hand_b_geom") not in pairs  # two mocap bodies: neither has a dof
+    assert ("hand_a_geom", "finger_a_geom") not in pairs  # same weld group
+    assert ("hand_a_geom", "thumb_geom") not in pairs  # parent-child (mocap weld != 0)
+    assert ("hand_b_geom", "thumb_geom") in pairs
+    assert ("shelf_geom", "egg_geom") in pairs
+    g = scene.geom
+    assert g("finger_a_geom").mocap and not g("finger_a_geom").static
+    assert g("hand_b_geom").mocap and not g("hand_b_geom").static
+    assert not g("thumb_geom").mocap and not g("thumb_geom").static
+    assert g("post_geom").static and not g("post_geom").mocap
+    assert not g("egg_geom").static
+    assert scene.body_static.tolist() == [True, True, True, False, False, False, False, False]
+    assert scene.body_names[:3] == ("world", "shelf", "shelf_post")
+
+
+def test_all_pairs(load_asset):
+    model = load_asset("arm_table.xml")
+    scene = Scene.from_model(model, pairs="all")
+    pairs = PairSet(scene.candidate_pairs)
+    assert ("ground", "goal_ball") in pairs  # mocap is moving in "all" mode
+    assert ("wrist_marker", "bench_top") in pairs  # contype 0 ignored
+    assert ("bench_top", "block_geom") in pairs  # exclude ignored
+    assert ("upper_arm", "claw_geom") not in pairs  # parent-child through the dof-less wrist
+    assert ("pedestal_geom", "upper_arm") in pairs  # world exception
+    assert ("upper_arm", "fore_arm") not in pairs  # parent-child
+    assert ("fore_arm", "claw_geom") not in pairs  # same weld group (wrist has no dof)
+    assert ("ground", "bench_top") not in pairs  # both static
+    assert ("bench_top", "bench_leg") not in pairs  # same body
+    # independent brute force over the rule text
+    weld, parent = model.body_weldid, model.body_parentid
+    want = set()
+    for a in range(model.ngeom):
+        for b in range(a + 1, model.ngeom):
+            wa, wb = weld[model.geom_bodyid[a]], weld[model.geom_bodyid[b]]
+            if wa == wb or (wa == 0 and wb == 0):
+                continue
+            if wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+                continue
+            if model.geom_type[a] == model.geom_type[b] == TYPES.mjGEOM_PLANE:
+                continue
+            want.add((a, b))
+    assert {tuple(p) for p in scene.pair_ids.tolist()} == want
+
+
+def test_all_pairs_superset_of_mujoco_in_masks(load_asset):
+    model = load_asset("masks.xml")
+    mj = {tuple(p) for p in Scene.from_model(model).pair_ids.tolist()}
+    allp = {tuple(p) for p in Scene.from_model(model, pairs="all").pair_ids.tolist()}
+    # filterparent is disabled in masks.xml, so MuJoCo keeps parent-child pairs that "all" drops
+    names = [model.geom(i).name for i in range(model.ngeom)]
+    extra = {(names[a], names[b]) for a, b in mj - allp}
+    assert extra == {("cart_geom", "pole_geom")}  # pole-tip fails the contype mask
+
+
+def test_explicit_pairs(load_asset):
+    model = load_asset("arm_table.xml")
+    scene = Scene.from_model(model, pairs=[("block_geom", "ground"), ("ground", "block_geom"),
+                                           (3, "goal_ball"), ("wrist_marker", "upper_arm")])
+    assert scene.candidate_pairs == (("ground", "block_geom"), ("pedestal_geom", "goal_ball"),
+                                     ("upper_arm", "wrist_marker"))
+    with pytest.raises(InvalidInputError, match="nope"):
+        Scene.from_model(model, pairs=[("ground", "nope")])
+    with pytest.raises(InvalidInputError, match="paired with itself"):
+        Scene.from_model(model, pairs=[("ground", "ground")])
+    with pytest.raises(InvalidInputError, match="out of range"):
+        Scene.from_model(model, pairs=[(0, 99)])
+    with pytest.raises(InvalidInputError, match=r"pairs\[1\]"):
+        Scene.from_model(model, pairs=[("ground", "block_geom"), ("ground",)])
+    with pytest.raises(InvalidInputError, match="pairs must be"):
+        Scene.from_model(model, pairs="some")
+    with pytest.raises(InvalidInputError, match="pairs must be"):
+        Scene.from_model(model, pairs=5)
+    assert Scene.from_model(model, pairs=[]).pair_ids.shape == (0, 2)
+
+
+def test_plane_plane_explicit_rejected():
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><geom name="p1" type="plane" size="1 1 1"/>'
+        '<geom name="p2" type="plane" size="1 1 1" pos="0 0 1"/><body><freejoint/><geom size="0.1"/></body>'
+        "</worldbody></mujoco>")
+    with pytest.raises(InvalidInputError, match="planes"):
+        Scene.from_model(model, pairs=[("p1", "p2")])
+    assert ("p1", "p2") not in Scene.from_model(model, pairs="all").candidate_pairs
+
+
+def test_hfield_raises_naming_geom(load_asset):
+    model = load_asset("hfield.xml")
+    for mode in ("mujoco", "all"):
+        with pytest.raises(UnsupportedGeometryError, match="terrain_geom"):
+            Scene.from_model(model, pairs=mode)
+    with pytest.raises(UnsupportedGeometryError, match="terrain_geom"):
+        Scene.from_model(model, pairs=[("ball_geom", "terrain_geom")])
+    scene = Scene.from_model(model, pairs=[("ball_geom", "shadow_geom")])
+    assert scene.geom("terrain_geom").shape is None
+    assert scene.geom("terrain_geom").type == "hfield"
+
+
+def test_hfield_outside_pairs_is_fine():
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><asset><hfield name="h" nrow="2" ncol="2" size="1 1 .1 .1"/></asset><worldbody>'
+        '<geom name="terrain" type="hfield" hfield="h" contype="0" conaffinity="0"/>'
+        '<body><freejoint/><geom name="a" size="0.1"/></body>'
+        '<body pos="1 0 0"><freejoint/><geom name="b" size="0.1"/></body></worldbody></mujoco>')
+    scene = Scene.from_model(model)
+    assert scene.candidate_pairs == (("a", "b"),)
+
+
+def test_unnamed_geoms_and_lookup(load_asset):
+    scene = Scene.from_model(load_asset("meshes.xml"))
+    assert scene.geoms[0].name == "geom0" and scene.geoms[1].name == "geom1"
+    assert scene.geom("geom1") is scene.geoms[1]
+    assert scene.geom(2).name == "base_cap_geom"
+    assert scene.geom(np.int64(2)) is scene.geoms[2]
+    for bad in ("missing", 99, -1, 1.5):
+        with pytest.raises(InvalidInputError):
+            scene.geom(bad)
+    assert all(isinstance(g, GeomInfo) and g.id == i for i, g in enumerate(scene.geoms))
+    assert scene.geoms[1].body == "base" and scene.geoms[1].body_id == 1
+
+
+def test_geom_info_fields(load_asset):
+    model = load_asset("arm_table.xml")
+    model.geom_margin[model.geom("upper_arm").id] = 0.015
+    scene = Scene.from_model(model)
+    g = scene.geom("upper_arm")
+    assert (g.type, g.body, g.margin, g.static, g.mocap) == ("capsule", "shoulder", 0.015, False, False)
+    assert scene.geom("ground").type == "plane" and scene.geom("ground").shape.kind == "halfspace"
+    assert scene.geom("claw_geom").shape.kind == "polytope"
+    assert scene.model is model
+
+
+def test_approximations_reported(load_asset):
+    scene = Scene.from_model(load_asset("meshes.xml"), facets=12)
+    assert set(scene.approximations) == {"base_cap_geom", "tool_cyl", "link_geom"}
+    r = 0.02
+    assert scene.approximations["tool_cyl"] == pytest.approx(r * (1 / np.cos(np.pi / 12) - 1), rel=1e-9)
+    assert scene.facets == 12
+    assert all(scene.geom(n).shape.approx_error == v for n, v in scene.approximations.items())
+    with pytest.raises(InvalidInputError, match="facets"):
+        Scene.from_model(load_asset("meshes.xml"), facets=2)
+
+
+def test_model_hash(load_asset):
+    a = Scene.from_model(load_asset("arm_table.xml")).model_hash
+    b = Scene.from_model(load_asset("arm_table.xml")).model_hash
+    m = load_asset("arm_table.xml")
+    m.geom_size[0, 2] += 0.01
+    c = Scene.from_model(m).model_hash
+    assert a == b and a != c and len(a) == 64
+
+
+def test_bad_model():
+    with pytest.raises(InvalidInputError, match="MjModel"):
+        Scene.from_model("scene.xml")
+
+
+# --------------------------------------------------------------------------- shapes vs true geoms
+
+
+def _unit(rng, n):
+    u = rng.normal(size=(n, 3))
+    return u / np.linalg.norm(u, axis=1, keepdims=True)
+
+
+def _mesh_hull(model, g):
+    """Vertices (mesh frame) of the hull MuJoCo collides, and its triangles (from mesh_graph)."""
+    mid = model.geom_dataid[g]
+    a, n = model.mesh_vertadr[mid], model.mesh_vertnum[mid]
+    V = model.mesh_vert[a:a + n].astype(float)
+    G = model.mesh_graph[model.mesh_graphadr[mid]:]
+    nv, nf = G[0], G[1]
+    tri = G[2 + 3 * nv + 3 * nf: 2 + 3 * nv + 6 * nf].reshape(nf, 3)
+    return V, tri
+
+
+def true_surface_points(model, g, rng, n=400):
+    """(k, 3) points on the true geom's surface in the GEOM frame (independent of monitor)."""
+    t, s = model.geom_type[g], model.geom_size[g]
+    if t == TYPES.mjGEOM_SPHERE:
+        return s[0] * _unit(rng, n)
+    if t == TYPES.mjGEOM_CAPSULE:
+        z = rng.uniform(-s[1], s[1], n)
+        return np.c_[np.zeros(n), np.zeros(n), z] + s[0] * _unit(rng, n)
+    if t == TYPES.mjGEOM_ELLIPSOID:
+        return s * _unit(rng, n)
+    if t == TYPES.mjGEOM_BOX:
+        p = rng.uniform(-1, 1, (n, 3))
+        k = rng.integers(0, 3, n)
+        p[np.arange(n), k] = rng.choice([-1.0, 1.0], n)
+        corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+        return np.concatenate([p, corners]) * s
+    if t == TYPES.mjGEOM_CYLINDER:
+        th = rng.uniform(0, 2 * np.pi, n)
+        side = np.c_[s[0] * np.cos(th), s[0] * np.sin(th), rng.uniform(-s[1], s[1], n)]
+        rr = s[0] * np.sqrt(rng.uniform(0, 1, n))
+        cap = np.c_[rr * np.cos(th), rr * np.sin(th), rng.choice([-s[1], s[1]], n)]
+        rim = np.c_[s[0] * np.cos(th), s[0] * np.sin(th), rng.choice([-s[1], s[1]], n)]
+        return np.concatenate([side, cap, rim])
+    if t == TYPES.mjGEOM_MESH:
+        V, tri = _mesh_hull(model, g)
+        w = rng.dirichlet(np.ones(3), n)
+        k = rng.integers(0, len(tri), n)
+        return np.concatenate([V[np.unique(tri)], np.einsum("nj,njk->nk", w, V[tri[k]])])
+    if t == TYPES.mjGEOM_PLANE:
+        return np.c_[rng.uniform(-5, 5, (n, 2)), np.zeros(n)]
+    raise AssertionError(f"type {t}")
+
+
+def true_support(model, g, d_G):
+    """Support values (k,) of the true geom for unit directions d_G (k, 3) in the geom frame."""
+    t, s = model.geom_type[g], model.geom_size[g]
+    if t == TYPES.mjGEOM_SPHERE:
+        return np.full(len(d_G), s[0])
+    if t == TYPES.mjGEOM_CAPSULE:
+        return s[1] * np.abs(d_G[:, 2]) + s[0]
+    if t == TYPES.mjGEOM_BOX:
+        return np.abs(d_G) @ s
+    if t == TYPES.mjGEOM_MESH:
+        V, tri = _mesh_hull(model, g)
+        return (d_G @ V[np.unique(tri)].T).max(axis=1)
+    raise AssertionError(f"type {t}")
+
+
+def shape_support(shape, d):
+    return (d @ shape.points.T).max(axis=1) + shape.radius
+
+
+def inside_excess(shape, p):
+    """(k,) how far points (k, 3) lie outside the shape (<= 0 inside), body frame."""
+    if shape.kind in ("polytope", "halfspace"):
+        return (p @ shape.normals.T - shape.offsets).max(axis=1)
+    if shape.kind == "sphere":
+        return np.linalg.norm(p - shape.points[0], axis=1) - shape.radius
+    a, b = shape.points
+    ab = b - a
+    t = np.clip((p - a) @ ab / max(ab @ ab, 1e-300), 0, 1)
+    return np.linalg.norm(p - (a + t[:, None] * ab), axis=1) - shape.radius
+
+
+@pytest.mark.parametrize("name", PAIR_SCENES)
+def test_shapes_contain_true_geoms_in_body_frame(name):
+    """At random joint poses, MuJoCo's world geom pose composed with the body pose places the true
+    geom inside the scene's body-frame shape; exact shapes have the true support function."""
+    model = load(ASSETS / name)
+    scene = Scene.from_model(model)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        data.qpos[:] = model.qpos0 + rng.uniform(-1, 1, model.nq)
+        for j in range(model.njnt):  # keep quaternions unit
+            a = model.jnt_qposadr[j]
+            if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+                data.qpos[a + 3: a + 7] /= np.linalg.norm(data.qpos[a + 3: a + 7])
+            elif model.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
+                data.qpos[a: a + 4] /= np.linalg.norm(data.qpos[a: a + 4])
+        mujoco.mj_kinematics(model, data)
+        for g, info in enumerate(scene.geoms):
+            b = model.geom_bodyid[g]
+            R_WB, p_WB = data.xmat[b].reshape(3, 3), data.xpos[b]
+            R_WG, p_WG = data.geom_xmat[g].reshape(3, 3), data.geom_xpos[g]
+            pts_W = true_surface_points(model, g, rng) @ R_WG.T + p_WG
+            pts_B = (pts_W - p_WB) @ R_WB
+            exc = inside_excess(info.shape, pts_B)
+            assert exc.max() <= 1e-12, (info.name, exc.max())
+            if info.type in ("sphere", "capsule", "box", "mesh"):
+                assert info.shape.approx_error == 0.0
+                d_B = _unit(rng, 200)
+                d_G = d_B @ R_WB.T @ R_WG  # body-frame direction -> geom frame
+                offset = d_B @ (R_WB.T @ (p_WG - p_WB))
+                np.testing.assert_allclose(shape_support(info.shape, d_B),
+                                           true_support(model, g, d_G) + offset, atol=1e-12)
+            if info.type == "plane":
+                n_B = R_WB.T @ R_WG[:, 2]
+                np.testing.assert_allclose(info.shape.normals[0], n_B, atol=1e-12)
+                below = pts_B - 0.3 * n_B
+                above = pts_B + 0.3 * n_B
+                assert (inside_excess(info.shape, below) < 0).all()
+                assert (inside_excess(info.shape, above) > 0).all()
+
+
+def _polytope_volume(shape):
+    vol = 0.0
+    for loop in shape.faces:
+        v = shape.points[loop]
+        for k in range(1, len(v) - 1):
+            vol += np.dot(v[0], np.cross(v[k], v[k + 1])) / 6.0
+    return vol
+
+
+def test_mesh_hull_volume_matches_trimesh(load_asset):
+    model = load_asset("meshes.xml")
+    scene = Scene.from_model(model)
+    g = model.geom("tool_geom").id
+    mid = model.geom_dataid[g]
+    a, n = model.mesh_vertadr[mid], model.mesh_vertnum[mid]
+    fa, fn = model.mesh_faceadr[mid], model.mesh_facenum[mid]
+    V = model.mesh_vert[a:a + n].astype(float)
+    F = model.mesh_face[fa:fa + fn]
+    shape = scene.geom(g).shape
+    want = trimesh.Trimesh(V, F, process=False).convex_hull.volume
+    assert _polytope_volume(shape) == pytest.approx(want, rel=1e-10)
+    # the L-prism is not convex: its hull is strictly bigger than the mesh
+    assert want > trimesh.Trimesh(V, F, process=False).volume * 1.2
+
+
+def test_maxhullvert_mesh_uses_mujoco_hull(load_asset):
+    model = load_asset("meshes.xml")
+    scene = Scene.from_model(model)
+    shape = scene.geom("stone_geom").shape
+    assert len(shape.points) == 8  # maxhullvert="8"
+    V, tri = _mesh_hull(model, model.geom("stone_geom").id)
+    mj = trimesh.Trimesh(V, tri, process=False)
+    assert mj.is_watertight
+    assert _polytope_volume(shape) == pytest.approx(abs(mj.volume), rel=1e-10)
