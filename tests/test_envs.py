@@ -1,0 +1,116 @@
+"""Our gymnasium environments: registration, check_env, no MuJoCo warnings, scene facts."""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import envs  # noqa: F401  (registers the ids)
+from monitor._paths import scene_path
+
+OWN_ENVS = ["monitor/Arm-v0", "monitor/Tunnel-v0"]
+
+
+def _agv_available() -> bool:
+    try:
+        import envs.agv_v0  # noqa: F401
+
+        scene_path("agv_trays")
+    except (ImportError, FileNotFoundError):
+        return False
+    return True
+
+
+ALL_ENVS = OWN_ENVS + (["monitor/AGV-v0"] if _agv_available() else [])
+
+
+@pytest.mark.parametrize("env_id", ALL_ENVS)
+def test_check_env_passes(env_id):
+    env = gym.make(env_id)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # gymnasium's advisory warnings (unbounded obs, asymmetric box)
+        check_env(env.unwrapped, skip_render_check=True)
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", ALL_ENVS)
+def test_steps_without_mujoco_warnings(env_id):
+    env = gym.make(env_id)
+    env.reset(seed=3)
+    env.action_space.seed(3)
+    for _ in range(150):
+        env.step(env.action_space.sample())
+    u = env.unwrapped
+    assert [w.number for w in u.data.warning] == [0] * len(u.data.warning)
+    assert np.all(np.isfinite(u.data.qpos))
+    env.close()
+
+
+@pytest.mark.parametrize("name", ["arm", "tunnel"])
+def test_scene_compiles_and_has_readme(name):
+    p = scene_path(name)
+    m = mujoco.MjModel.from_xml_path(str(p))
+    d = mujoco.MjData(m)
+    if m.nkey:
+        mujoco.mj_resetDataKeyframe(m, d, 0)
+    mujoco.mj_forward(m, d)
+    assert d.ncon == 0, "initial pose must be contact free"
+    assert (p.parent / "README.md").is_file()
+
+
+def test_arm_scene_requirements():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+    hinges = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
+    assert len(hinges) >= 3
+    assert m.nu == 3 and np.all(m.actuator_ctrllimited)
+    assert np.all(m.actuator_biastype == mujoco.mjtBias.mjBIAS_AFFINE)  # position servos
+    mesh_geoms = [g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
+    assert {"finger_l", "finger_r"} <= {m.geom(g).name for g in mesh_geoms}
+    for g in mesh_geoms:
+        assert m.body(int(m.geom_bodyid[g])).name == "gripper"
+
+
+def test_arm_planned_trajectory_matches_step():
+    env = gym.make("monitor/Arm-v0").unwrapped
+    env.reset(seed=1)
+    a = np.array([0.4, -0.3, 0.6], dtype=np.float32)
+    plan = env.planned_trajectory(a)
+    qpos_before = env.data.qpos.copy()
+    env.step(a)
+    assert np.array_equal(plan.qpos[-1], env.data.qpos)  # exact prediction
+    assert np.array_equal(plan.qpos[0], qpos_before)
+    assert plan.qpos.shape == (env.frame_skip + 1, env.model.nq)
+
+
+def _ncon_between(m, d, geoms_a, geoms_b):
+    n = 0
+    for c in d.contact[: d.ncon] if d.ncon else []:
+        g1, g2 = int(c.geom[0]), int(c.geom[1])
+        if (g1 in geoms_a and g2 in geoms_b) or (g2 in geoms_a and g1 in geoms_b):
+            n += 1
+    return n
+
+
+def test_tunnel_mujoco_misses_the_wall():
+    """At the env timestep MuJoCo's contacts never see the wall, yet the ball crosses it."""
+    env = gym.make("monitor/Tunnel-v0").unwrapped
+    env.reset(seed=0)
+    m, d = env.model, env.data
+    xs, ncons = [float(d.qpos[0])], []
+    for _ in range(12):
+        env.step(np.array([5.0], dtype=np.float32))
+        mujoco.mj_forward(m, d)
+        xs.append(float(d.qpos[0]))
+        ncons.append(d.ncon)
+    xs = np.array(xs)
+    assert xs[0] < 0 < xs[-1], "ball crossed the wall"
+    assert sum(ncons) == 0, "MuJoCo never reported a contact"
+    # the crossing step jumps over the whole contact band |x| < r + half thickness
+    k = int(np.argmax(xs > 0))
+    band = 0.01 + 0.005
+    assert xs[k - 1] < -band and xs[k] > band
