@@ -1,0 +1,613 @@
+"""numba kernels of the exact static distance test (see :mod:`monitor.geometry.distance`).
+
+Everything here works on the *cores* (convex hulls of vertex sets: a point, a
+segment or a polytope) in a **relative frame** whose origin is the translation
+of shape A. Distances are translation invariant, so only the rounded offset
+``p_B - p_A`` enters, never the absolute world coordinates: a pair 1e4 m from
+the origin is as accurate as one at the origin.
+
+Bounds (D = A - B, the Minkowski difference of the cores, h_D its support function):
+
+* For every direction n, ``-h_D(n) / |n|`` is a lower bound on the signed core
+  distance (separated: a separating-axis gap; overlapping: minus an upper bound
+  on the penetration depth, which is ``min_n h_D(n)``).
+* A convex combination ``x = sum lam_i (a_i - b_i)`` of Minkowski-difference
+  vertices with ``lam >= 0`` gives the points ``sum lam_i a_i`` of A and
+  ``sum lam_i b_i`` of B at distance ``|x| / sum lam``: an upper bound.
+* A tetrahedron of Minkowski-difference vertices containing the ball B(0, r)
+  proves a penetration depth >= r: the upper bound ``-r``.
+
+All returned bounds are rounding padded with ``pad = 2 * rel_pad * S + abs_pad``
+(S = largest coordinate magnitude in the relative frame): the factor 2 covers
+the transform to the relative frame (<= 4 ulp * S per coordinate) plus the
+dot products / sums of the kernel (<= ~20 ulp * S), against rel_pad = 64 ulp.
+
+GJK (Gilbert-Johnson-Keerthi) uses an enumerating distance sub-algorithm: for
+the simplex (<= 4 points) every face, edge and vertex whose affine projection
+of the origin has positive barycentric coordinates is a candidate and the
+smallest one wins. Each candidate is a genuine convex combination, so rounding
+can make GJK sub-optimal but never make a bound wrong. Projections are computed
+in the numerically stable form (triangle: cross-product normal; edge:
+re-orthogonalised perpendicular), so the direction is accurate to ~1 ulp even
+at 1e-9 m separation, which keeps the separating-axis lower bound tight.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_U = 2.0**-53
+"""Unit roundoff of float64."""
+
+# status codes written to out[0]
+SEPARATED = 0
+"""Cores separated: ``upper`` from the closest points, ``lower`` from their direction."""
+TOUCHING = 1
+"""Core distance below rounding: a common point (up to rounding), SAT lower bound."""
+OVERLAP = 2
+"""A GJK tetrahedron encloses the origin: common point; maybe a negative upper bound."""
+
+OUT_SIZE = 12
+"""Layout of the output row: status, estimate, lower, upper, p_a (3), p_b (3), pad, iters."""
+
+
+@njit(cache=True)
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True)
+def _transform(P, R, t, out):
+    """out[i] = R @ P[i] + t."""
+    for i in range(P.shape[0]):
+        for r in range(3):
+            out[i, r] = R[r, 0] * P[i, 0] + R[r, 1] * P[i, 1] + R[r, 2] * P[i, 2] + t[r]
+
+
+@njit(cache=True)
+def _rotate(N, R, out):
+    for i in range(N.shape[0]):
+        for r in range(3):
+            out[i, r] = R[r, 0] * N[i, 0] + R[r, 1] * N[i, 1] + R[r, 2] * N[i, 2]
+
+
+@njit(cache=True)
+def _support_max(V, d):
+    """(index, value) of max_i V[i] . d."""
+    best = -np.inf
+    bi = 0
+    for i in range(V.shape[0]):
+        s = V[i, 0] * d[0] + V[i, 1] * d[1] + V[i, 2] * d[2]
+        if s > best:
+            best = s
+            bi = i
+    return bi, best
+
+
+@njit(cache=True)
+def _support_min(V, d):
+    """(index, value) of min_i V[i] . d."""
+    best = np.inf
+    bi = 0
+    for i in range(V.shape[0]):
+        s = V[i, 0] * d[0] + V[i, 1] * d[1] + V[i, 2] * d[2]
+        if s < best:
+            best = s
+            bi = i
+    return bi, best
+
+
+@njit(cache=True)
+def _axis_bound(VA, VB, n):
+    """-h_D(n) / |n| = (min_b n.b - max_a n.a) / |n|: a lower bound on the signed distance.
+
+    Here the direction n points from A to B. Returns -inf for a zero direction.
+    """
+    nn = np.sqrt(_dot(n, n))
+    if not nn > 0.0:
+        return -np.inf
+    _, ha = _support_max(VA, n)
+    _, lb = _support_min(VB, n)
+    return (lb - ha) / nn
+
+
+@njit(cache=True)
+def _subalgorithm(W, k, lam_out, v_out, tiny_len2, tiny_area2):
+    """Min-norm point of conv(W[:k]) (k <= 4) by enumerating faces, edges, vertices.
+
+    Args:
+        W: (4, 3) simplex points.
+        k: number of points in use.
+        lam_out: (4,) barycentric coordinates of the result (>= 0, sum 1).
+        v_out: (3,) the min-norm point (stably computed).
+        tiny_len2: squared edge length below which an edge is degenerate.
+        tiny_area2: squared (2 x area) below which a triangle is degenerate.
+
+    Returns:
+        (mask, inside): bit mask of the supporting sub-simplex; ``inside`` True
+        when k == 4 and the origin lies in the tetrahedron (v_out = 0).
+    """
+    best = np.inf
+    best_mask = 0
+    e = np.empty(3)
+    f = np.empty(3)
+    n = np.empty(3)
+    v = np.empty(3)
+    tmp = np.empty(3)
+    tmp2 = np.empty(3)
+    c = np.empty(3)
+    lam = np.zeros(4)
+    # tetrahedron: origin inside?
+    if k == 4:
+        # barycentric coordinates of the origin by signed volumes
+        vol = 0.0
+        lt = np.zeros(4)
+        for i in range(3):
+            e[i] = W[1, i] - W[0, i]
+            f[i] = W[2, i] - W[0, i]
+            tmp[i] = W[3, i] - W[0, i]
+        _cross(f, tmp, n)
+        vol = _dot(e, n)
+        if vol != 0.0:
+            # lam_j = det with column j replaced by -W0
+            for i in range(3):
+                c[i] = -W[0, i]
+            _cross(f, tmp, n)
+            lt[1] = _dot(c, n) / vol
+            _cross(c, tmp, n)
+            lt[2] = _dot(e, n) / vol
+            _cross(f, c, n)
+            lt[3] = _dot(e, n) / vol
+            lt[0] = 1.0 - lt[1] - lt[2] - lt[3]
+            if lt[0] >= 0.0 and lt[1] >= 0.0 and lt[2] >= 0.0 and lt[3] >= 0.0:
+                for j in range(4):
+                    lam_out[j] = lt[j]
+                v_out[0] = 0.0
+                v_out[1] = 0.0
+                v_out[2] = 0.0
+                return 15, True
+    # vertices
+    for i in range(k):
+        d = W[i, 0] ** 2 + W[i, 1] ** 2 + W[i, 2] ** 2
+        if d < best:
+            best = d
+            best_mask = 1 << i
+            for j in range(4):
+                lam[j] = 0.0
+            lam[i] = 1.0
+            for j in range(3):
+                v[j] = W[i, j]
+    # edges
+    for i in range(k):
+        for j in range(i + 1, k):
+            for r in range(3):
+                e[r] = W[j, r] - W[i, r]
+            ee = _dot(e, e)
+            if ee <= tiny_len2:
+                continue
+            t = -(_dot(W[i], e)) / ee
+            if not (t > 0.0 and t < 1.0):
+                continue
+            for r in range(3):
+                tmp[r] = W[i, r] + t * e[r]
+            # re-orthogonalise: removes the along-edge rounding residue
+            s = _dot(tmp, e) / ee
+            for r in range(3):
+                tmp[r] -= s * e[r]
+            d = _dot(tmp, tmp)
+            if d < best:
+                best = d
+                best_mask = (1 << i) | (1 << j)
+                for q in range(4):
+                    lam[q] = 0.0
+                lam[i] = 1.0 - t
+                lam[j] = t
+                for r in range(3):
+                    v[r] = tmp[r]
+    # triangles
+    for i in range(k):
+        for j in range(i + 1, k):
+            for m in range(j + 1, k):
+                for r in range(3):
+                    e[r] = W[j, r] - W[i, r]
+                    f[r] = W[m, r] - W[i, r]
+                _cross(e, f, n)
+                nn = _dot(n, n)
+                if nn <= tiny_area2:
+                    continue
+                s = _dot(n, W[i]) / nn
+                for r in range(3):
+                    tmp[r] = s * n[r]
+                # barycentric coordinates of tmp (in the plane) by signed areas
+                for r in range(3):
+                    e[r] = W[j, r] - tmp[r]
+                    f[r] = W[m, r] - tmp[r]
+                _cross(e, f, tmp2)
+                li = _dot(tmp2, n) / nn
+                for r in range(3):
+                    e[r] = W[m, r] - tmp[r]
+                    f[r] = W[i, r] - tmp[r]
+                _cross(e, f, tmp2)
+                lj = _dot(tmp2, n) / nn
+                lm = 1.0 - li - lj
+                if not (li > 0.0 and lj > 0.0 and lm > 0.0):
+                    continue
+                d = _dot(tmp, tmp)
+                if d < best:
+                    best = d
+                    best_mask = (1 << i) | (1 << j) | (1 << m)
+                    for q in range(4):
+                        lam[q] = 0.0
+                    lam[i] = li
+                    lam[j] = lj
+                    lam[m] = lm
+                    for r in range(3):
+                        v[r] = tmp[r]
+    for q in range(4):
+        lam_out[q] = lam[q]
+    for r in range(3):
+        v_out[r] = v[r]
+    return best_mask, False
+
+
+@njit(cache=True)
+def _compact(mask, k, W, IA, IB, lam):
+    """Keep the simplex points in ``mask``; returns the new count."""
+    m = 0
+    for i in range(k):
+        if mask & (1 << i):
+            if m != i:
+                for r in range(3):
+                    W[m, r] = W[i, r]
+                IA[m] = IA[i]
+                IB[m] = IB[i]
+                lam[m] = lam[i]
+            m += 1
+    for i in range(m, 4):
+        lam[i] = 0.0
+    return m
+
+
+@njit(cache=True)
+def _tetra_inradius(W, pad_coord, rel_pad):
+    """Certified radius r of a ball B(0, r) inside the tetrahedron W (4, 3), or 0.
+
+    ``pad_coord`` bounds the coordinate error of every W row; the plane
+    distance pads cover that perturbation and the cross-product rounding.
+    """
+    e = np.empty(3)
+    f = np.empty(3)
+    n = np.empty(3)
+    g = np.empty(3)
+    r_min = np.inf
+    for o in range(4):
+        i = (o + 1) % 4
+        j = (o + 2) % 4
+        m = (o + 3) % 4
+        for r in range(3):
+            e[r] = W[j, r] - W[i, r]
+            f[r] = W[m, r] - W[i, r]
+            g[r] = W[o, r] - W[i, r]
+        _cross(e, f, n)
+        nn = np.sqrt(_dot(n, n))
+        if not nn > 0.0:
+            return 0.0
+        # outward: away from the opposite vertex
+        sgn = -1.0 if _dot(n, g) > 0.0 else 1.0
+        dist = sgn * _dot(n, W[i]) / nn  # distance from origin to the plane, + if inside
+        le = np.sqrt(_dot(e, e))
+        lf = np.sqrt(_dot(f, f))
+        lw = np.sqrt(_dot(W[i], W[i]))
+        dn = 4.0 * pad_coord * (le + lf) + 4.0 * rel_pad * le * lf
+        pad = pad_coord + 2.0 * dn * lw / nn + rel_pad * abs(dist)
+        r = dist - pad
+        if r < r_min:
+            r_min = r
+    return max(r_min, 0.0)
+
+
+@njit(cache=True)
+def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
+    """Max over candidate directions of -h_D(n)/|n| (A-to-B directions).
+
+    Candidates: the GJK direction, coordinate axes, face normals of both cores
+    (both signs), cross products of edge pairs (both signs; capped at
+    ``max_edge_pairs``) and, when no core is a polytope, crosses of edges with
+    the axes. For two polytopes with complete edge/face lists this is the exact
+    signed distance (separating-axis theorem); in general a valid lower bound.
+    """
+    best = -np.inf
+    n = np.empty(3)
+    a = np.empty(3)
+    b = np.empty(3)
+    for s in (-1.0, 1.0):
+        for r in range(3):
+            n[r] = s * v[r]
+        best = max(best, _axis_bound(VA, VB, n))
+        for ax in range(3):
+            for r in range(3):
+                n[r] = 0.0
+            n[ax] = s
+            best = max(best, _axis_bound(VA, VB, n))
+        for i in range(NA.shape[0]):
+            for r in range(3):
+                n[r] = s * NA[i, r]
+            best = max(best, _axis_bound(VA, VB, n))
+        for i in range(NB.shape[0]):
+            for r in range(3):
+                n[r] = s * NB[i, r]
+            best = max(best, _axis_bound(VA, VB, n))
+    if EA.shape[0] * EB.shape[0] <= max_edge_pairs:
+        for i in range(EA.shape[0]):
+            for r in range(3):
+                a[r] = VA[EA[i, 1], r] - VA[EA[i, 0], r]
+            for j in range(EB.shape[0]):
+                for r in range(3):
+                    b[r] = VB[EB[j, 1], r] - VB[EB[j, 0], r]
+                _cross(a, b, n)
+                best = max(best, _axis_bound(VA, VB, n))
+                for r in range(3):
+                    n[r] = -n[r]
+                best = max(best, _axis_bound(VA, VB, n))
+    if not any_polytope:
+        for side in range(2):
+            V = VA if side == 0 else VB
+            E = EA if side == 0 else EB
+            for i in range(E.shape[0]):
+                for r in range(3):
+                    a[r] = V[E[i, 1], r] - V[E[i, 0], r]
+                for ax in range(3):
+                    for r in range(3):
+                        b[r] = 0.0
+                    b[ax] = 1.0
+                    _cross(a, b, n)
+                    best = max(best, _axis_bound(VA, VB, n))
+                    for r in range(3):
+                        n[r] = -n[r]
+                    best = max(best, _axis_bound(VA, VB, n))
+    return best
+
+
+@njit(cache=True)
+def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad, abs_pad,
+                  eps_rel, max_iter, max_edge_pairs, out):
+    """Signed distance bounds of two cores (point / segment / polytope vertex sets).
+
+    Args:
+        PA, PB: (n, 3) body-frame core vertices.
+        RA, RB: (3, 3) rotations (body -> world).
+        tA, tB: (3,) translations (body -> world).
+        EA, EB: (m, 2) int64 edges (vertex index pairs).
+        NA, NB: (f, 3) body-frame face normals (empty for point / segment).
+        any_polytope: True if either core is a polytope.
+        rel_pad, abs_pad: rounding pads (``Tolerances``).
+        eps_rel: GJK relative duality-gap tolerance.
+        max_iter: GJK iteration cap.
+        max_edge_pairs: cap on edge-pair cross products in the SAT lower bound.
+        out: (OUT_SIZE,) float64 output: status, estimate, lower, upper (core
+            signed distance, metres), p_a (3), p_b (3) in the frame shifted by
+            tA (add tA for world), pad, iterations.
+    """
+    na = PA.shape[0]
+    nb = PB.shape[0]
+    VA = np.empty((na, 3))
+    VB = np.empty((nb, 3))
+    d = np.empty(3)
+    z = np.zeros(3)
+    for r in range(3):
+        d[r] = tB[r] - tA[r]
+    _transform(PA, RA, z, VA)
+    _transform(PB, RB, d, VB)
+    WNA = np.empty((NA.shape[0], 3))
+    WNB = np.empty((NB.shape[0], 3))
+    _rotate(NA, RA, WNA)
+    _rotate(NB, RB, WNB)
+    S = 0.0
+    for i in range(na):
+        for r in range(3):
+            S = max(S, abs(VA[i, r]))
+    for i in range(nb):
+        for r in range(3):
+            S = max(S, abs(VB[i, r]))
+    pad = 2.0 * rel_pad * S + abs_pad
+    pad_coord = 2.0 * rel_pad * S
+    tiny = 8.0 * _U * S
+    tiny_len2 = (1e-14 * S) ** 2
+    tiny_area2 = (1e-14 * S * S) ** 2
+
+    W = np.zeros((4, 3))
+    IA = np.zeros(4, np.int64)
+    IB = np.zeros(4, np.int64)
+    lam = np.zeros(4)
+    v = np.empty(3)
+    vn = np.empty(3)
+    w = np.empty(3)
+    # best snapshot
+    bW = np.zeros((4, 3))
+    bIA = np.zeros(4, np.int64)
+    bIB = np.zeros(4, np.int64)
+    blam = np.zeros(4)
+    # start: the pair of first vertices
+    k = 1
+    IA[0] = 0
+    IB[0] = 0
+    lam[0] = 1.0
+    for r in range(3):
+        W[0, r] = VA[0, r] - VB[0, r]
+        v[r] = W[0, r]
+    vv = _dot(v, v)
+    best_lower = -np.inf
+    status = SEPARATED
+    it = 0
+    while it < max_iter:
+        it += 1
+        if vv <= tiny * tiny:
+            status = TOUCHING
+            break
+        # support of D in -v: w = a - b with a minimising v.a, b maximising v.b
+        ia, sa = _support_min(VA, v)
+        ib, sb = _support_max(VB, v)
+        for r in range(3):
+            w[r] = VA[ia, r] - VB[ib, r]
+        vw = _dot(v, w)
+        # every x in D has v.x >= v.w (up to rounding): a separating-axis lower bound
+        lb = (sa - sb) / np.sqrt(vv)
+        if lb > best_lower:
+            best_lower = lb
+        if vv - vw <= eps_rel * vv:
+            break
+        dup = False
+        for q in range(k):
+            if IA[q] == ia and IB[q] == ib:
+                dup = True
+        if dup:
+            break
+        # save snapshot
+        for q in range(4):
+            for r in range(3):
+                bW[q, r] = W[q, r]
+            bIA[q] = IA[q]
+            bIB[q] = IB[q]
+            blam[q] = lam[q]
+        bk = k
+        for r in range(3):
+            W[k, r] = w[r]
+        IA[k] = ia
+        IB[k] = ib
+        k += 1
+        mask, inside = _subalgorithm(W, k, lam, vn, tiny_len2, tiny_area2)
+        if inside:
+            status = OVERLAP
+            for r in range(3):
+                v[r] = 0.0
+            vv = 0.0
+            break
+        vnn = _dot(vn, vn)
+        if not vnn < vv:
+            # no progress (rounding): restore the previous simplex and stop
+            for q in range(4):
+                for r in range(3):
+                    W[q, r] = bW[q, r]
+                IA[q] = bIA[q]
+                IB[q] = bIB[q]
+                lam[q] = blam[q]
+            k = bk
+            break
+        k = _compact(mask, k, W, IA, IB, lam)
+        for r in range(3):
+            v[r] = vn[r]
+        vv = vnn
+
+    # points of A and B from the barycentric coordinates (exact convex combinations)
+    ls = 0.0
+    for q in range(k):
+        ls += lam[q]
+    pa = np.zeros(3)
+    pb = np.zeros(3)
+    dv = np.zeros(3)
+    lw = 0.0
+    for q in range(k):
+        lq = lam[q] / ls
+        for r in range(3):
+            pa[r] += lq * VA[IA[q], r]
+            pb[r] += lq * VB[IB[q], r]
+            dv[r] += lq * (VA[IA[q], r] - VB[IB[q], r])
+        lw = max(lw, np.sqrt(_dot(W[q], W[q])))
+    upper = np.sqrt(_dot(dv, dv)) + pad + 8.0 * _U * lw
+
+    if status == SEPARATED and vv > tiny * tiny:
+        # final separating-axis bound in the (stably computed) direction -v (A to B)
+        for r in range(3):
+            vn[r] = -v[r]
+        lb = _axis_bound(VA, VB, vn)
+        if lb > best_lower:
+            best_lower = lb
+        lower = best_lower - pad
+        est = np.sqrt(vv)
+        if est > upper:
+            est = upper
+        if est < lower:
+            est = lower
+    else:
+        if status == SEPARATED:
+            status = TOUCHING
+        sat = _sat_lower(VA, VB, EA, EB, WNA, WNB, any_polytope, max_edge_pairs, v)
+        if best_lower > sat:
+            sat = best_lower
+        lower = sat - pad
+        if status == OVERLAP:
+            r_in = _tetra_inradius(W, pad_coord, rel_pad)
+            if r_in > 0.0 and -r_in < upper:
+                upper = -r_in
+        est = sat
+        if est > upper:
+            est = upper
+        if est < lower:
+            est = lower
+    out[0] = status
+    out[1] = est
+    out[2] = lower
+    out[3] = upper
+    for r in range(3):
+        out[4 + r] = pa[r]
+        out[7 + r] = pb[r]
+    out[10] = pad
+    out[11] = it
+
+
+@njit(cache=True)
+def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, any_polytope, rel_pad, abs_pad,
+                        eps_rel, max_iter, max_edge_pairs, out):
+    """:func:`core_distance` for T poses: RAs (T, 3, 3), tAs (T, 3), ...; out (T, OUT_SIZE)."""
+    for t in range(RAs.shape[0]):
+        core_distance(PA, RAs[t], tAs[t], EA, NA, PB, RBs[t], tBs[t], EB, NB, any_polytope,
+                      rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out[t])
+
+
+@njit(cache=True)
+def halfspace_distance(nH, bH, RH, tH, PC, RC, tC, rel_pad, abs_pad, out):
+    """Signed distance of a core (vertex set PC posed by RC, tC) from a half-space.
+
+    The half-space is ``{x : nH . x <= bH}`` in its body frame, posed by RH, tH.
+    Closed form: min over core vertices of the plane's signed distance, in the
+    frame shifted by tC. Output layout as :func:`core_distance` (p_a on the
+    half-space: the projection of the deepest vertex, or the vertex itself when
+    it is inside; p_b the vertex), coordinates relative to tC.
+    """
+    n = np.empty(3)
+    for r in range(3):
+        n[r] = RH[r, 0] * nH[0] + RH[r, 1] * nH[1] + RH[r, 2] * nH[2]
+    nn = np.sqrt(_dot(n, n))
+    dlt = np.empty(3)
+    for r in range(3):
+        dlt[r] = tH[r] - tC[r]
+    # plane n . x <= b' in the frame shifted by tC
+    bp = bH + _dot(n, dlt)
+    V = np.empty((PC.shape[0], 3))
+    z = np.zeros(3)
+    _transform(PC, RC, z, V)
+    S = abs(bH) + np.sqrt(_dot(dlt, dlt))
+    for i in range(V.shape[0]):
+        for r in range(3):
+            S = max(S, abs(V[i, r]))
+    pad = 2.0 * rel_pad * S + abs_pad
+    bi, smin = _support_min(V, n)
+    dist = (smin - bp) / nn
+    pb = V[bi]
+    out[0] = SEPARATED if dist > 0.0 else OVERLAP
+    out[1] = dist
+    out[2] = dist - pad
+    out[3] = dist + pad
+    for r in range(3):
+        out[7 + r] = pb[r]
+        out[4 + r] = pb[r] - max(dist, 0.0) * n[r] / nn
+    out[10] = pad
+    out[11] = 0
