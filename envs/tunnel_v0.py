@@ -64,7 +64,8 @@ class TunnelEnv(MujocoEnv, utils.EzPickle):
 
     def reset_model(self) -> np.ndarray:
         """Sphere at rest at x0 (plus optional noise)."""
-        x = self.x0 + (self.np_random.uniform(-self.reset_noise, self.reset_noise) if self.reset_noise else 0.0)
+        noise = self.np_random.uniform(-self.reset_noise, self.reset_noise) if self.reset_noise else 0.0
+        x = self.x0 + noise
         self.set_state(np.array([x]), np.zeros(1))
         return self._get_obs()
 

@@ -121,15 +121,16 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         (nu,) float64 control.
     """
     ctrl = np.zeros(model.nu)
-    hinge_slide = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+    hinge_slide = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
     for a in range(model.nu):
-        if (model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT
-                or model.actuator_biastype[a] != mujoco.mjtBias.mjBIAS_AFFINE
-                or model.actuator_gaintype[a] != mujoco.mjtGain.mjGAIN_FIXED):
+        if (int(model.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT)
+                or int(model.actuator_biastype[a]) != int(mujoco.mjtBias.mjBIAS_AFFINE)
+                or int(model.actuator_gaintype[a]) != int(mujoco.mjtGain.mjGAIN_FIXED)):
             continue
-        gain, b0, b1 = model.actuator_gainprm[a, 0], model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
+        gain = model.actuator_gainprm[a, 0]
+        b0, b1 = model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
         j = model.actuator_trnid[a, 0]
-        if gain == 0.0 or b1 == 0.0 or model.jnt_type[j] not in hinge_slide:
+        if gain == 0.0 or b1 == 0.0 or int(model.jnt_type[j]) not in hinge_slide:
             continue
         length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j]]
         ctrl[a] = -(b0 + b1 * length) / gain
@@ -256,13 +257,14 @@ def _make_budget(budget: Any) -> Any:
         return Budget(seconds=budget.seconds, tests=budget.tests)
     if isinstance(budget, dict):
         return Budget(seconds=budget.get("seconds"), tests=budget.get("tests"))
+    bad = f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}"
     if isinstance(budget, bool):
-        raise InvalidInputError(f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}")
+        raise InvalidInputError(bad)
     if isinstance(budget, (int, np.integer)):
         return Budget(tests=int(budget))
     if isinstance(budget, (float, np.floating)):
         return Budget(seconds=float(budget))
-    raise InvalidInputError(f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}")
+    raise InvalidInputError(bad)
 
 
 class Gate:

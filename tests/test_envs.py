@@ -68,7 +68,7 @@ def test_arm_scene_requirements():
     hinges = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
     assert len(hinges) >= 3
     assert m.nu == 3 and np.all(m.actuator_ctrllimited)
-    assert np.all(m.actuator_biastype == mujoco.mjtBias.mjBIAS_AFFINE)  # position servos
+    assert np.all(m.actuator_biastype == int(mujoco.mjtBias.mjBIAS_AFFINE))  # position servos
     mesh_geoms = [g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
     assert {"finger_l", "finger_r"} <= {m.geom(g).name for g in mesh_geoms}
     for g in mesh_geoms:

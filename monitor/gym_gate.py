@@ -1,0 +1,139 @@
+"""Gymnasium wrapper: certify the next ``env.step`` before it happens and gate the action.
+
+:class:`SafetyGate` is a thin adapter over :class:`monitor.gate.Gate`: it finds
+the ``MjModel``/``MjData`` through ``env.unwrapped``, turns the gate's
+decision into an ``env.step`` call, and reports in ``info``:
+
+* ``info["safety"]``: the fixed-shape dict of :meth:`monitor.gate.StepReport.info`
+  (verdict, checker per pair, witness, earliest time, clearance, replaced, ...).
+* ``info["cost"]``: 1.0 when the proposed action's window has a confirmed
+  violation, else 0.0 (safety-gymnasium's convention in the 5-tuple API).
+
+The action is assumed to be written to ``data.ctrl`` by the env (what
+gymnasium's ``MujocoEnv.do_simulation`` does) when ``predictor="rollout"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import gymnasium
+import mujoco
+import numpy as np
+
+from monitor.errors import InvalidInputError
+from monitor.gate import Gate, StepReport, safety_info
+
+
+class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
+    """Certify-then-step wrapper for MuJoCo gymnasium environments.
+
+    Args:
+        env: a gymnasium env whose ``unwrapped`` has ``model`` (MjModel) and
+            ``data`` (MjData), e.g. any ``MujocoEnv``.
+        predictor: ``"rollout"`` (scratch rollout of ``frame_skip`` substeps with
+            ``ctrl = action``), ``"plan"`` (``env.unwrapped.planned_trajectory(action)``)
+            or a callable ``predictor(env, obs, action) -> Plan``.
+        pairs: candidate pairs (``"mujoco"``, ``"all"`` or geom-name pairs).
+        margin: clearance (m) that counts as safe.
+        epsilon: certification tolerance (m).
+        on_violation: ``"block" | "terminate" | "warn"`` (see :class:`monitor.Gate`).
+        fallback: None (hold position where actuators allow, else zeros), an
+            action array, or a callable ``fallback(env, obs) -> action``.
+        budget: per-step work limit (seconds float, tests int, dict or Budget).
+        log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`.
+        unsafe: ``"uncertain"`` (default: anything not certified is unsafe) or ``"violation"``.
+        timing: add ``info["safety"]["certify_us"]`` (wall time, µs). Off by default
+            because a wall time differs between identical runs, which fails
+            gymnasium's step-determinism check in ``check_env``; the time is always
+            in ``gate.last_report.certify_us`` and ``gate.summary()``.
+
+    Raises:
+        InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data or an option is invalid.
+    """
+
+    def __init__(self, env: gymnasium.Env, *, predictor: str | Callable[..., Any] = "rollout",
+                 pairs: Any = "mujoco", margin: float = 0.0, epsilon: float = 1e-3,
+                 on_violation: str = "block", fallback: Any = None, budget: Any = None, log: Any = None,
+                 unsafe: str = "uncertain", timing: bool = False) -> None:
+        gymnasium.utils.RecordConstructorArgs.__init__(
+            self, predictor=predictor, pairs=pairs, margin=margin, epsilon=epsilon,
+            on_violation=on_violation, fallback=fallback, budget=budget, log=log, unsafe=unsafe,
+            timing=timing)
+        gymnasium.Wrapper.__init__(self, env)
+        u = env.unwrapped
+        model, data = getattr(u, "model", None), getattr(u, "data", None)
+        if not isinstance(model, mujoco.MjModel) or not isinstance(data, mujoco.MjData):
+            raise InvalidInputError(
+                f"SafetyGate needs a MuJoCo env: {type(u).__name__} (env.unwrapped) has no "
+                "mujoco.MjModel `model` and mujoco.MjData `data` attributes")
+        if not (predictor in ("rollout", "plan") or callable(predictor)):
+            raise InvalidInputError(f"predictor must be 'rollout', 'plan' or a callable, got {predictor!r}")
+        if predictor == "plan" and not callable(getattr(u, "planned_trajectory", None)):
+            raise InvalidInputError(
+                f"predictor='plan' needs env.unwrapped.planned_trajectory(action); "
+                f"{type(u).__name__} has none")
+        if not isinstance(env.action_space, gymnasium.spaces.Box):
+            raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
+        self.predictor_mode = predictor
+        self.user_fallback = fallback
+        self.timing = bool(timing)
+        self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
+                         on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
+                         frame_skip=int(getattr(u, "frame_skip", 1)))
+        self._obs: Any = None
+
+    # ----------------------------------------------------------------- helpers
+    def _as_action(self, a: Any) -> np.ndarray:
+        space = self.env.action_space
+        return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
+
+    def _predict_fn(self) -> Callable[[Any], Any] | None:
+        u, mode = self.env.unwrapped, self.predictor_mode
+        if mode == "rollout":
+            return None
+        if mode == "plan":
+            return u.planned_trajectory
+        return lambda a: mode(self.env, self._obs, a)
+
+    def _fallback_fn(self) -> Callable[[], np.ndarray]:
+        fb, u = self.user_fallback, self.env.unwrapped
+        if fb is None:
+            return lambda: self._as_action(self.gate.fallback_ctrl(u.data))
+        if callable(fb):
+            return lambda: self._as_action(fb(self.env, self._obs))
+        return lambda: self._as_action(fb)
+
+    # ----------------------------------------------------------------- gymnasium API
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Certify the window of ``action``, gate it, then step the wrapped env."""
+        report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
+                                              fallback=self._fallback_fn())
+        obs, reward, terminated, truncated, info = self.env.step(report.applied_ctrl)
+        self._obs = obs
+        info = dict(info)
+        info["safety"] = report.info(timing=self.timing)
+        info["cost"] = report.cost
+        return obs, reward, bool(terminated or report.terminated), truncated, info
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[Any, dict[str, Any]]:
+        """Reset the wrapped env; ``info["safety"]`` has the same keys with verdict ``""``."""
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._obs = obs
+        info = dict(info)
+        info["safety"] = safety_info(None, verdict="", applied_verdict="", replaced=False,
+                                     fallback_certified=True, terminated=False,
+                                     time=float(self.env.unwrapped.data.time),
+                                     certify_us=0.0 if self.timing else None, npairs=self.gate.npairs)
+        info["cost"] = 0.0
+        return obs, info
+
+    def close(self) -> None:
+        """Close the log (if the gate opened one) and the wrapped env."""
+        self.gate.close()
+        super().close()
+
+
+__all__ = ["SafetyGate"]

@@ -1,0 +1,192 @@
+"""monitor.Gate: rollout predictor, hold-position fallback, gating policies, reuse, budget."""
+
+from __future__ import annotations
+
+import logging
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import pytest
+
+import envs  # noqa: F401
+from monitor._paths import scene_path
+from monitor.certify.certificate import Certificate, Witness
+from monitor.errors import InvalidInputError
+from monitor.gate import Gate, Rollout, _make_budget, hold_ctrl
+
+
+def _arm():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+    return m, mujoco.MjData(m)
+
+
+# ----------------------------------------------------------------------------- predictor
+def test_rollout_is_bit_identical_to_env_step_and_leaves_live_data_alone():
+    env = gym.make("Pusher-v5").unwrapped
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    ro = Rollout(env.model)
+    for _ in range(20):
+        a = rng.uniform(-2, 2, size=7).astype(np.float32)
+        before = (env.data.qpos.copy(), env.data.qvel.copy(), env.data.time)
+        times, qpos = ro.states(env.data, a, env.frame_skip)
+        assert np.array_equal(env.data.qpos, before[0]) and np.array_equal(env.data.qvel, before[1])
+        assert env.data.time == before[2]
+        env.step(a)
+        assert np.array_equal(qpos[-1], env.data.qpos)
+        assert times[-1] == env.data.time
+        assert qpos.shape == (env.frame_skip + 1, env.model.nq)
+        assert np.all(np.diff(times) > 0)
+
+
+def test_rollout_plan_holds_mocap_pose():
+    env = gym.make("monitor/Arm-v0").unwrapped
+    env.reset(seed=4)
+    plan = Rollout(env.model).plan(env.data, np.zeros(3), 3)
+    assert np.array_equal(plan.mocap_pos, env.data.mocap_pos)
+    assert plan.window == (env.data.time, env.data.time + 3 * env.model.opt.timestep)
+
+
+# ----------------------------------------------------------------------------- fallback
+def test_hold_ctrl_position_servos_exert_no_force_at_rest():
+    m, d = _arm()
+    rng = np.random.default_rng(1)
+    for _ in range(10):
+        lo, hi = m.jnt_range[:, 0], m.jnt_range[:, 1]
+        d.qpos[:] = rng.uniform(lo, hi)
+        d.qvel[:] = 0
+        d.ctrl[:] = hold_ctrl(m, d)
+        mujoco.mj_forward(m, d)
+        np.testing.assert_allclose(d.actuator_force, 0.0, atol=1e-9)
+
+
+def test_hold_ctrl_clips_to_ctrlrange_and_zero_for_other_actuators():
+    m, d = _arm()
+    d.qpos[:] = [3.5, 0.0, 0.0]  # beyond the yaw ctrlrange (+-2.9)
+    np.testing.assert_array_equal(hold_ctrl(m, d), [2.9, 0.0, 0.0])
+    t = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))  # velocity servo
+    td = mujoco.MjData(t)
+    td.qpos[0] = 0.2
+    np.testing.assert_array_equal(hold_ctrl(t, td), [0.0])
+    p = gym.make("Pusher-v5").unwrapped  # motors
+    p.reset(seed=0)
+    np.testing.assert_array_equal(hold_ctrl(p.model, p.data), np.zeros(7))
+
+
+# ----------------------------------------------------------------------------- options
+@pytest.mark.parametrize("kwargs", [dict(on_violation="stop"), dict(unsafe="never"), dict(margin=-0.1),
+                                    dict(epsilon=0.0), dict(predictor="psychic"), dict(frame_skip=0),
+                                    dict(budget="lots")])
+def test_bad_options_raise(kwargs):
+    m, _ = _arm()
+    with pytest.raises(InvalidInputError):
+        Gate(m, **kwargs)
+
+
+def test_gate_rejects_non_model():
+    with pytest.raises(InvalidInputError, match="MjModel"):
+        Gate("scene.xml")
+
+
+def test_budget_spec():
+    from monitor.certify.common import Budget
+
+    assert _make_budget(None) is None
+    assert _make_budget(0.5).seconds == 0.5 and _make_budget(0.5).tests is None
+    assert _make_budget(100).tests == 100 and _make_budget(100).seconds is None
+    b = _make_budget({"tests": 5})
+    assert isinstance(b, Budget) and b.tests == 5
+    template = Budget(tests=3)
+    template.charge(10)
+    fresh = _make_budget(template)
+    assert fresh.tests == 3 and not fresh.exhausted  # a fresh budget per window
+
+
+# ----------------------------------------------------------------------------- gating logic (stub checker)
+def _stub(gate, verdict_of):
+    """Replace the certifier by ``verdict_of(plan) -> verdict`` (logic tests only)."""
+
+    def fake(plan):
+        v = verdict_of(plan)
+        wit = Witness(plan.t1, ("a", "b"), np.zeros(3), -0.01) if v == "violation" else None
+        cert = Certificate(v, plan.window, gate.margin, gate.epsilon, "auto", wit,
+                           None if v == "certified" else plan.t0, 0.1 if v == "certified" else -np.inf)
+        return cert, 7.0
+
+    gate._certify = fake
+    gate._scene = type("S", (), {"candidate_pairs": ()})()
+
+
+def _unsafe_if_yaw_moves(plan):
+    return "violation" if abs(plan.qpos[-1, 0] - plan.qpos[0, 0]) > 1e-4 else "certified"
+
+
+@pytest.mark.parametrize("mode", ["block", "terminate", "warn"])
+def test_policies(mode):
+    m, d = _arm()
+    gate = Gate(m, on_violation=mode, frame_skip=5)
+    _stub(gate, _unsafe_if_yaw_moves)
+    ref = mujoco.MjData(m)
+    proposal = np.array([1.0, 0.0, 0.0])
+    r = gate.step(d, proposal)
+    assert r.verdict == "violation" and r.unsafe and r.stepped
+    if mode == "warn":
+        assert not r.replaced and np.array_equal(r.applied_ctrl, proposal)
+    else:
+        assert r.replaced and np.array_equal(r.applied_ctrl, hold_ctrl(m, ref))
+        assert r.applied_verdict == "certified" and r.fallback_certified
+    assert r.terminated == (mode == "terminate")
+    # the caller's data advanced exactly as mj_step with the applied control
+    ref.ctrl[:] = r.applied_ctrl
+    mujoco.mj_step(m, ref, nstep=5)
+    assert np.array_equal(ref.qpos, d.qpos)
+    info = r.info()
+    assert info["verdict"] == "violation" and info["replaced"] == (mode != "warn")
+    assert info["witness_geoms"].tolist() == ["a", "b"] and info["witness_point"].shape == (3,)
+    assert r.cost == 1.0
+
+
+def test_unsafe_violation_admits_uncertain():
+    m, d = _arm()
+    for unsafe, replaced in (("uncertain", True), ("violation", False)):
+        gate = Gate(m, unsafe=unsafe)
+        _stub(gate, lambda plan: "uncertain")
+        r = gate.step(d, np.array([0.5, 0.0, 0.0]))
+        assert r.verdict == "uncertain" and r.replaced == replaced and r.cost == 0.0
+
+
+def test_uncertified_fallback_is_marked_and_logged(caplog):
+    m, d = _arm()
+    gate = Gate(m, fallback=np.array([0.3, 0.0, 0.0]))
+    _stub(gate, _unsafe_if_yaw_moves)  # the fallback moves the yaw joint too
+    with caplog.at_level(logging.WARNING, logger="monitor.gate"):
+        r = gate.step(d, np.array([1.0, 0.0, 0.0]))
+    assert r.replaced and not r.fallback_certified and r.applied_verdict == "violation"
+    assert r.info()["fallback_certified"] is False
+    assert gate.summary()["fallback_uncertified"] == 1
+    assert any("fallback" in rec.message for rec in caplog.records)
+
+
+def test_callable_predictor_and_fallback_used():
+    m, d = _arm()
+    calls = []
+
+    def predictor(data, ctrl, nstep):
+        calls.append(np.array(ctrl))
+        return Rollout(m).plan(data, ctrl, nstep)
+
+    gate = Gate(m, predictor=predictor, fallback=lambda data: np.array([0.0, 0.1, 0.0]))
+    _stub(gate, _unsafe_if_yaw_moves)
+    r = gate.step(d, np.array([1.0, 0.0, 0.0]), nstep=2)
+    assert len(calls) == 2 and np.array_equal(calls[1], [0.0, 0.1, 0.0])
+    assert np.array_equal(r.applied_ctrl, [0.0, 0.1, 0.0])
+
+
+def test_step_rejects_bad_ctrl():
+    m, d = _arm()
+    gate = Gate(m)
+    with pytest.raises(InvalidInputError, match="shape"):
+        gate.step(d, np.zeros(2))
+    with pytest.raises(InvalidInputError, match="NaN"):
+        gate.step(d, np.array([np.nan, 0, 0]))
