@@ -1,0 +1,465 @@
+"""MCAP certificate logs: :class:`MonitorLog`.
+
+File layout (one MCAP file per run, written with the plain ``mcap`` Writer):
+
+* header, then the ``monitor.run`` metadata (package and MuJoCo versions, margin,
+  epsilon, pair policy, predictor, ... as JSON values) and the model attachments
+  (``model.xml`` + ``assets/*.stl`` + ``model.mjb``) **first**, so that even a
+  killed writer leaves a log that review can re-verify;
+* per window: ``/monitor/plan``, ``/monitor/certificate``, ``/monitor/violation``
+  (violation or uncertain only), ``/monitor/action``, and with foxglove-sdk
+  ``/monitor/tf`` (+ ``/monitor/scene`` for the geoms once and witness markers).
+  ``log_time = publish_time = round(sim_time * 1e9)`` ns; wall clock in the payload.
+
+Flush policy (crash tolerance): records are written **unchunked** (``use_chunking=False``)
+and the file is flushed at the end of every :meth:`MonitorLog.write_window`.
+A process killed between two windows therefore loses nothing; a process killed
+inside ``write_window`` loses at most the messages of that one window
+(:data:`MAX_MESSAGES_PER_WINDOW`). :func:`monitor.log.reader.read_log` recovers
+every complete record of such a file. ``fsync=True`` additionally survives power loss
+(not measured). The price: no compression (~1.5-2x larger files than zstd chunks).
+
+Model export: the exact compiled model is always attached as MJB
+(``mj_saveModel``; loadable by the same MuJoCo version). The MJCF XML comes from an
+``MjSpec`` (pass ``model_source=`` a path or spec) or, failing that, from
+``mj_saveLastXML`` (which only works when ``model`` is the last model MuJoCo
+compiled); every mesh is replaced by its compiled vertices/faces as a binary STL
+asset and its geoms get the compiled poses, so the XML needs no original files.
+The XML is recompiled before it is attached and kept only if its world geometry
+matches the model within :data:`XML_GEOMETRY_TOL` (MuJoCo writes 6 significant digits).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import importlib.metadata
+import json
+import math
+import os
+import platform
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from mcap.writer import CompressionType, Writer
+
+from monitor.errors import InvalidInputError
+from monitor.log import topics
+
+MAX_MESSAGES_PER_WINDOW = 7
+"""Upper bound on records one window writes (plan, certificate, violation, action,
+tf, and up to two scene updates on the first window): the most a killed writer can
+lose under the per-window flush policy."""
+
+XML_GEOMETRY_TOL = 1e-4
+"""Largest world-frame geometry difference (m) accepted between the attached XML
+(after recompilation) and the live model. MuJoCo's XML writer keeps 6 significant
+digits, i.e. ~1e-6 relative; 1e-4 m also tolerates scenes a few tens of metres wide."""
+
+DEFAULT_LOG_DIR = "logs"
+
+
+def default_path(env_id: str | None = None, log_dir: str | os.PathLike[str] = DEFAULT_LOG_DIR) -> Path:
+    """``logs/<env-id>-<UTC timestamp>.mcap`` (creates the folder; never reuses a name)."""
+    d = Path(log_dir)
+    d.mkdir(parents=True, exist_ok=True)
+    safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in (env_id or "monitor"))
+    stamp = _dt.datetime.now(_dt.UTC).strftime("%Y%m%dT%H%M%S.%fZ")
+    p = d / f"{safe}-{stamp}.mcap"
+    k = 1
+    while p.exists():
+        p = d / f"{safe}-{stamp}-{k}.mcap"
+        k += 1
+    return p
+
+
+def _jsonable(x: Any) -> Any:
+    """Numpy -> Python, non-finite floats -> None (strict JSON)."""
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _jsonable(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (np.integer,)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        f = float(x)
+        return f if math.isfinite(f) else None
+    return x
+
+
+def _dumps(obj: Any) -> bytes:
+    return json.dumps(_jsonable(obj), allow_nan=False, separators=(",", ":")).encode("utf-8")
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of monitor, mujoco, numpy, scipy, mcap, foxglove-sdk (if installed), Python."""
+    out = {"python": platform.python_version()}
+    for dist in ("monitor", "mujoco", "numpy", "scipy", "numba", "mcap", "foxglove-sdk", "gymnasium"):
+        try:
+            out[dist] = importlib.metadata.version(dist)
+        except importlib.metadata.PackageNotFoundError:
+            continue
+    if "monitor" not in out:
+        import monitor
+
+        out["monitor"] = monitor.__version__
+    return out
+
+
+# --------------------------------------------------------------------------- model export
+
+
+@dataclass
+class ModelExport:
+    """A model ready to attach.
+
+    Attributes:
+        mjb: exact compiled model (``mj_saveModel``) bytes.
+        xml: self-contained MJCF text or None when it could not be produced.
+        assets: file name referenced by ``xml`` -> bytes (binary STL meshes).
+        info: how the XML was produced, its geometry deviation (m), or why it failed.
+    """
+
+    mjb: bytes
+    xml: str | None = None
+    assets: dict[str, bytes] = field(default_factory=dict)
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def _stl_bytes(V: np.ndarray, F: np.ndarray) -> bytes:
+    """Binary STL of triangles F (n, 3) over vertices V (m, 3) (float32, exact for mesh_vert)."""
+    V = np.asarray(V, np.float32)
+    F = np.asarray(F, np.int64)
+    tri = V[F]  # (n, 3, 3)
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).astype(np.float64)
+    ln = np.linalg.norm(n, axis=1, keepdims=True)
+    n = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0).astype(np.float32)
+    rec = np.zeros(len(F), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    rec["n"], rec["v"] = n, tri
+    header = b"monitor: compiled MuJoCo mesh".ljust(80, b" ")
+    return header + np.uint32(len(F)).tobytes() + rec.tobytes()
+
+
+def _mesh_arrays(model: Any, i: int) -> tuple[np.ndarray, np.ndarray]:
+    va, nv = model.mesh_vertadr[i], model.mesh_vertnum[i]
+    fa, nf = model.mesh_faceadr[i], model.mesh_facenum[i]
+    return model.mesh_vert[va:va + nv], model.mesh_face[fa:fa + nf]
+
+
+def _spec_from(model: Any, source: Any) -> tuple[Any, str]:
+    import mujoco
+
+    if isinstance(source, mujoco.MjSpec):
+        return source.copy(), "MjSpec (given)"
+    if source is not None:
+        return mujoco.MjSpec.from_file(str(source)), f"MjSpec.from_file({Path(source).name})"
+    with tempfile.TemporaryDirectory() as td:
+        tmp = os.path.join(td, "last.xml")
+        mujoco.mj_saveLastXML(tmp, model)  # raises FatalError when model is not the last compiled one
+        return mujoco.MjSpec.from_file(tmp), "mj_saveLastXML"
+
+
+def _self_contained_xml(model: Any, spec: Any) -> tuple[str, dict[str, bytes]]:
+    """Replace every mesh of ``spec`` by the compiled one (STL asset) and pin mesh geom poses."""
+    import mujoco
+
+    assets: dict[str, bytes] = {}
+    for k, ms in enumerate(spec.meshes):
+        mid = k
+        if ms.name:
+            found = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, ms.name)
+            mid = found if found >= 0 else k
+        V, F = _mesh_arrays(model, mid)
+        fname = f"mesh{mid}.stl"
+        assets[fname] = _stl_bytes(V, F)
+        ms.file = fname
+        ms.content_type = "model/stl"
+        ms.scale = [1.0, 1.0, 1.0]
+        ms.refpos = [0.0, 0.0, 0.0]
+        ms.refquat = [1.0, 0.0, 0.0, 0.0]
+        ms.uservert = []
+        ms.userface = []
+    for tex in spec.textures:  # visual only: textures from files become flat builtins
+        if tex.file:
+            tex.file = ""
+            tex.builtin = mujoco.mjtBuiltin.mjBUILTIN_FLAT
+            tex.width = tex.height = 8
+    spec.meshdir = ""
+    spec.texturedir = ""
+    spec.assets = dict(assets)
+    spec.compile()  # assigns compiled ids to spec elements
+    for g in spec.geoms:
+        if g.type == mujoco.mjtGeom.mjGEOM_MESH and 0 <= g.id < model.ngeom:
+            g.pos = model.geom_pos[g.id].copy()
+            g.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT
+            g.quat = model.geom_quat[g.id].copy()
+    return spec.to_xml(), assets
+
+
+def export_model(model: Any, source: Any = None) -> ModelExport:
+    """Exact MJB plus (when possible) a self-contained MJCF XML of ``model``.
+
+    Args:
+        model: the compiled ``mujoco.MjModel``.
+        source: optional ``mujoco.MjSpec`` or path of the MJCF the model was loaded
+            from (most robust); otherwise ``mj_saveLastXML`` is tried.
+
+    Returns:
+        :class:`ModelExport`; ``xml`` is None (with ``info["xml_error"]``) if no XML
+        could be produced whose recompiled geometry matches ``model``.
+    """
+    import mujoco
+
+    from monitor.log.reader import geometry_deviation
+
+    buf = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buf)
+    out = ModelExport(mjb=buf.tobytes())
+    try:
+        spec, how = _spec_from(model, source)
+        xml, assets = _self_contained_xml(model, spec)
+        back = mujoco.MjModel.from_xml_string(xml, assets=assets)
+        dev = geometry_deviation(model, back)
+        q = np.random.default_rng(0).uniform(-1.0, 1.0, model.nq) if model.nq else None
+        if q is not None:
+            dev = max(dev, geometry_deviation(model, back, qpos=_valid_qpos(model, q)))
+        out.info = {"xml_from": how, "xml_geometry_deviation_m": dev}
+        if dev <= XML_GEOMETRY_TOL:
+            out.xml, out.assets = xml, assets
+        else:
+            out.info["xml_error"] = f"recompiled XML differs from the model by {dev:.3g} m"
+    except (mujoco.FatalError, ValueError, TypeError, OSError) as exc:
+        out.info["xml_error"] = f"{type(exc).__name__}: {exc}"
+    return out
+
+
+def _valid_qpos(model: Any, q: np.ndarray) -> np.ndarray:
+    """qpos0 perturbed by ``q`` on hinge/slide coordinates (quaternions left valid)."""
+    import mujoco
+
+    qpos = model.qpos0.copy()
+    for j in range(model.njnt):
+        if model.jnt_type[j] in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+            a = model.jnt_qposadr[j]
+            qpos[a] += 0.5 * q[a]
+    return qpos
+
+
+# --------------------------------------------------------------------------- writer
+
+
+def _plan_payload(plan: Any) -> dict[str, Any]:
+    if hasattr(plan, "qpos"):
+        return {"kind": "plan", "times": np.asarray(plan.times, np.float64),
+                "qpos": np.asarray(plan.qpos, np.float64),
+                "mocap_pos": getattr(plan, "mocap_pos", None),
+                "mocap_quat": getattr(plan, "mocap_quat", None)}
+    if hasattr(plan, "pos") and hasattr(plan, "quat"):
+        return {"kind": "bodymotion", "times": np.asarray(plan.times, np.float64),
+                "pos": np.asarray(plan.pos, np.float64), "quat": np.asarray(plan.quat, np.float64)}
+    raise InvalidInputError(f"plan must be a monitor.Plan or BodyMotion, got {type(plan).__name__}")
+
+
+class MonitorLog:
+    """MCAP log of certificates, violations, plans and actions (context manager).
+
+    Args:
+        path: output file; default ``logs/<env-id>-<UTC timestamp>.mcap``. An existing
+            file is overwritten.
+        model: the ``mujoco.MjModel`` to attach (else taken from the first plan's
+            ``plan.model``).
+        metadata: run metadata (margin, epsilon, pairs, predictor, tolerances,
+            budget, ...); JSON-serialisable values.
+        env_id: used in the default file name and the metadata.
+        foxglove: also write foxglove ``SceneUpdate``/``FrameTransforms`` (skipped
+            silently when foxglove-sdk is not installed).
+        model_source: optional ``MjSpec`` or MJCF path of ``model`` (robust XML export).
+        fsync: ``os.fsync`` after every window (power-loss durability; slower).
+
+    Example:
+        >>> with MonitorLog("run.mcap", model=model, metadata={"margin": 0.01}) as log:
+        ...     log.write_window(data.time, plan, cert)
+    """
+
+    def __init__(self, path: str | os.PathLike[str] | None = None, *, model: Any = None,
+                 metadata: dict[str, Any] | None = None, env_id: str | None = None, foxglove: bool = True,
+                 model_source: Any = None, fsync: bool = False) -> None:
+        self.path = Path(path) if path is not None else default_path(env_id)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._fsync = bool(fsync)
+        self._f = open(self.path, "wb")  # noqa: SIM115 - closed in close()
+        self._w = Writer(self._f, use_chunking=False, compression=CompressionType.NONE,
+                         enable_crcs=True, enable_data_crcs=False)
+        self._w.start(profile=topics.PROFILE, library=f"{topics.LIBRARY}/{package_versions()['monitor']}")
+        self._channels: dict[str, int] = {}
+        for topic, (name, _) in topics.JSON_TOPICS.items():
+            sid = self._w.register_schema(name=name, encoding="jsonschema",
+                                          data=topics.schema_text(topic).encode("utf-8"))
+            self._channels[topic] = self._w.register_channel(topic=topic, message_encoding="json",
+                                                             schema_id=sid)
+        self._index = 0
+        self._seq = 0
+        self._closed = False
+        self._model = None
+        self._model_source = model_source
+        self._scene = None
+        self._want_foxglove = bool(foxglove)
+        self.foxglove_enabled = False
+        self.foxglove_error: str | None = None
+        run = {"env_id": env_id, "created_utc": _dt.datetime.now(_dt.UTC).isoformat(),
+               "flush_policy": "unchunked; flush per window" + ("; fsync" if fsync else ""),
+               "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW}
+        versions = package_versions()
+        run.update({f"version.{k}": v for k, v in versions.items()})
+        run["mujoco_version"] = versions.get("mujoco")
+        run.update(metadata or {})
+        self.add_metadata(run)
+        if model is not None:
+            self._attach_model(model)
+        self._flush()
+
+    # ----------------------------------------------------------------- context manager
+    def __enter__(self) -> MonitorLog:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def windows(self) -> int:
+        """Number of windows written so far."""
+        return self._index
+
+    @property
+    def closed(self) -> bool:
+        """True after :meth:`close`."""
+        return self._closed
+
+    def add_metadata(self, values: dict[str, Any], name: str = topics.METADATA_RUN) -> None:
+        """Write a metadata record (values JSON-encoded); readers merge records of one name."""
+        self._check_open()
+        enc = {str(k): json.dumps(_jsonable(v), allow_nan=False) for k, v in values.items()}
+        self._w.add_metadata(name, enc)
+        self._flush()
+
+    def _attach_model(self, model: Any) -> None:
+        exp = export_model(model, self._model_source)
+        self._model = model
+        if exp.xml is not None:
+            self._w.add_attachment(create_time=0, log_time=0, name=topics.ATTACHMENT_XML,
+                                   media_type="application/xml", data=exp.xml.encode("utf-8"))
+            for fname, data in exp.assets.items():
+                self._w.add_attachment(create_time=0, log_time=0, name=topics.ASSET_PREFIX + fname,
+                                       media_type="model/stl", data=data)
+        self._w.add_attachment(create_time=0, log_time=0, name=topics.ATTACHMENT_MJB,
+                               media_type="application/x-mujoco-mjb", data=exp.mjb)
+        info = dict(exp.info)
+        info.update({"nq": int(model.nq), "nbody": int(model.nbody), "ngeom": int(model.ngeom),
+                     "nmocap": int(model.nmocap), "assets": sorted(exp.assets)})
+        self.add_metadata(info, name=topics.METADATA_MODEL)
+        if self._want_foxglove:
+            try:
+                from monitor.log.foxglove_scene import FoxgloveScene
+
+                self._scene = FoxgloveScene(model)
+            except ImportError as exc:
+                self.foxglove_error = f"foxglove-sdk not installed ({exc}); pip install 'monitor[foxglove]'"
+                return
+            for topic, (name, enc, data) in self._scene.schemas().items():
+                sid = self._w.register_schema(name=name, encoding=enc, data=data)
+                self._channels[topic] = self._w.register_channel(topic=topic, message_encoding="protobuf",
+                                                                 schema_id=sid)
+            self.foxglove_enabled = True
+
+    # ----------------------------------------------------------------- writing
+    def _check_open(self) -> None:
+        if self._closed:
+            raise InvalidInputError(f"MonitorLog {self.path} is closed")
+
+    def _put(self, topic: str, t_ns: int, data: bytes) -> None:
+        self._w.add_message(self._channels[topic], log_time=t_ns, data=data, publish_time=t_ns,
+                            sequence=self._seq)
+        self._seq += 1
+
+    def _flush(self) -> None:
+        self._f.flush()
+        if self._fsync:
+            os.fsync(self._f.fileno())
+
+    def write_window(self, sim_time: float, plan: Any, certificate: Any, proposed_action: Any = None,
+                     applied_action: Any = None, replaced: bool = False,
+                     wall_time: float | None = None) -> int:
+        """Log one certified window; flushes the file before returning.
+
+        Args:
+            sim_time: simulation time (s) at which the window was certified (``data.time``).
+            plan: the certified ``monitor.Plan`` (times (K,), qpos (K, nq), mocap_pos
+                (nmocap, 3), mocap_quat (nmocap, 4)) or ``BodyMotion``; None to skip.
+            certificate: the ``Certificate`` (or its ``to_dict()``).
+            proposed_action: (nu,) action proposed by the policy, or None.
+            applied_action: (nu,) action actually applied, or None.
+            replaced: True if the gate replaced/blocked the proposed action.
+            wall_time: Unix seconds; default ``time.time()``.
+
+        Returns:
+            The window index in this log.
+
+        Raises:
+            InvalidInputError: non-finite or negative ``sim_time``, closed log, bad plan.
+        """
+        self._check_open()
+        t = float(sim_time)
+        if not math.isfinite(t) or t < 0:
+            raise InvalidInputError(f"sim_time must be finite and >= 0, got {sim_time!r}")
+        t_ns = int(round(t * 1e9))
+        wall = time.time() if wall_time is None else float(wall_time)
+        cert = certificate.to_dict() if hasattr(certificate, "to_dict") else dict(certificate)
+        if cert.get("verdict") not in ("certified", "violation", "uncertain"):
+            raise InvalidInputError(f"certificate verdict must be certified/violation/uncertain, "
+                                    f"got {cert.get('verdict')!r}")
+        k = self._index
+        if self._model is None and plan is not None and getattr(plan, "model", None) is not None:
+            self._attach_model(plan.model)
+        head = {"index": k, "sim_time": t, "wall_time": wall}
+        if plan is not None:
+            self._put(topics.PLAN, t_ns, _dumps({**head, **_plan_payload(plan)}))
+        self._put(topics.CERTIFICATE, t_ns, _dumps({**head, **cert}))
+        if cert["verdict"] != "certified":
+            bad = [p for p in cert.get("pairs", []) if p.get("verdict") != "certified"]
+            self._put(topics.VIOLATION, t_ns, _dumps({
+                **head, "verdict": cert["verdict"], "window": cert.get("window"),
+                "margin": cert.get("margin"), "earliest_time": cert.get("earliest_time"),
+                "clearance": cert.get("clearance"),
+                "witness": cert.get("witness"), "pairs": bad, "replaced": bool(replaced)}))
+        if proposed_action is not None or applied_action is not None or replaced:
+            self._put(topics.ACTION, t_ns, _dumps({
+                **head, "proposed": None if proposed_action is None else np.ravel(proposed_action),
+                "applied": None if applied_action is None else np.ravel(applied_action),
+                "replaced": bool(replaced)}))
+        if self._scene is not None and plan is not None and hasattr(plan, "qpos"):
+            for topic, data in self._scene.window_messages(t_ns, plan, cert):
+                self._put(topic, t_ns, data)
+        self._index += 1
+        self._flush()
+        return k
+
+    def close(self) -> None:
+        """Write the MCAP summary/footer and close the file (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._w.finish()
+        finally:
+            self._f.close()
+
+
+__all__ = ["MonitorLog", "ModelExport", "export_model", "default_path", "package_versions",
+           "MAX_MESSAGES_PER_WINDOW", "XML_GEOMETRY_TOL"]
