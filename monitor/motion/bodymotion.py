@@ -1,0 +1,207 @@
+r"""Explicit per-body motions: world poses at waypoints, lerp + slerp per body.
+
+:class:`BodyMotion` implements the :class:`monitor.motion.base.Trajectory`
+protocol without a MuJoCo model (numpy only): each body's origin is lerped and
+its orientation slerped (shortest arc, about the body origin) between waypoint
+poses.
+
+Motion bound (derivation). For body b on [ta, tb] with midpoint m, origin x(t),
+rotation R(t) and reference point r = ``ref_points[b]`` (body frame): for any
+body point p,
+
+    X(t)p - X(m)p = [x(t) - x(m)] + (R(t) - R(m)) r + (R(t) - R(m)) (p - r),
+
+and ||(R(t) - R(m)) v|| <= chord(angle(R(t) R(m)^T)) ||v||. So with
+``angle`` >= max_t angle(R(t) R(m)^T) and
+``trans`` = max_t ||x(t) - x(m)|| + chord(angle) ||r|| the contract holds.
+max_t ||x(t) - x(m)|| is attained at a vertex (ta, tb or a waypoint inside: a
+norm of an affine function is convex on each linear piece); the angle is the
+slerp path length from m on the midpoint's segment and the exact waypoint angle
+plus the path length beyond it on the others
+(:func:`monitor.motion._kinematics.rotation_deviation`). With the default
+reference point (the body origin) both are exact up to the vertex maximum.
+Rounding: the position deviation is padded by rel_pad * max|x| (a difference
+of numbers of that size), the angle by rel_pad * (path length + 1) and then
+both by ``Tolerances.pad``-style terms as in :mod:`monitor.motion.plan`.
+A body whose pose is identical at all waypoints gets exactly zero (lerp is
+``a + s (b - a)`` and slerp of equal quaternions returns them bit-exactly).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from monitor.errors import InvalidInputError
+from monitor.motion import _kinematics as K
+from monitor.motion.base import MotionBounds, chord
+from monitor.tolerances import DEFAULT, Tolerances
+
+
+class BodyMotion:
+    """Explicit world poses of every body at waypoint times (Trajectory protocol).
+
+    Args:
+        times: (K,) strictly increasing times (s), K >= 2.
+        pos: (K, nbody, 3) world positions of the body origins (m).
+        quat: (K, nbody, 4) world orientations (w, x, y, z); normalised when
+            within ``tolerances.quat_norm_tol`` of unit norm.
+        ref_points: optional (nbody, 3) body-frame reference points of the
+            bounds (default: the body origins). Choose them near the geometry:
+            the bound grows with the distance from them.
+        tolerances: rounding pads and the quaternion norm tolerance.
+
+    Raises:
+        InvalidInputError: NaN/inf, wrong shapes, non-increasing times, fewer
+            than 2 waypoints, non-unit quaternions, or a moving world body
+            (body 0); the message names the offending index.
+    """
+
+    def __init__(self, times: object, pos: object, quat: object, *, ref_points: object = None,
+                 tolerances: Tolerances = DEFAULT):
+        t = K.check_times(times)
+        p = K.as_float_array("pos", pos)
+        q = K.as_float_array("quat", quat)
+        if p.ndim != 3 or p.shape[0] != t.shape[0] or p.shape[2] != 3:
+            raise InvalidInputError(f"pos must have shape (K, nbody, 3) with K = {t.shape[0]}, got {p.shape}")
+        nbody = p.shape[1]
+        if nbody < 1:
+            raise InvalidInputError("pos must hold at least the world body (nbody >= 1)")
+        if q.shape != (t.shape[0], nbody, 4):
+            raise InvalidInputError(f"quat must have shape ({t.shape[0]}, {nbody}, 4), got {q.shape}")
+        K.check_finite("pos", p)
+        K.check_finite("quat", q)
+        q = K.normalize_quats("quat", q, tolerances)
+        if ref_points is None:
+            ref = np.zeros((nbody, 3))
+        else:
+            ref = K.as_float_array("ref_points", ref_points)
+            if ref.shape != (nbody, 3):
+                raise InvalidInputError(f"ref_points must have shape ({nbody}, 3), got {ref.shape}")
+            K.check_finite("ref_points", ref)
+        moved0 = np.any(p[:, 0] != p[0, 0], axis=-1) | np.any(q[:, 0] != q[0, 0], axis=-1)
+        if moved0.any():
+            k = int(np.argmax(moved0))
+            raise InvalidInputError(f"the world body (body 0) must be constant; it moves at waypoint {k}")
+        self._tol = tolerances
+        self._times = t
+        self._pos = p
+        self._quat = q
+        self._ref = ref
+        for arr in (t, p, q, ref):
+            arr.setflags(write=False)
+        self._seg = K.Segments(t)
+        self._tracks = [K.QuatTrack(q[:, b]) for b in range(nbody)]
+        pos_moves = np.any(p != p[0], axis=(0, 2))
+        rot_moves = np.any(q != q[0], axis=(0, 2))
+        self._moving = pos_moves | rot_moves
+        self._rotating = rot_moves
+        self._pos_mag = float(np.max(np.abs(p), initial=0.0))
+        ref_norm = np.linalg.norm(ref, axis=-1)
+        self._scale = float(np.max(np.linalg.norm(p, axis=-1), initial=0.0)) + 3.0 * float(
+            np.max(ref_norm, initial=0.0))
+
+    @property
+    def times(self) -> np.ndarray:
+        """(K,) waypoint times (s)."""
+        return self._times
+
+    @property
+    def pos(self) -> np.ndarray:
+        """(K, nbody, 3) waypoint positions (m)."""
+        return self._pos
+
+    @property
+    def quat(self) -> np.ndarray:
+        """(K, nbody, 4) waypoint quaternions (normalised)."""
+        return self._quat
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """(t0, t1) the motion's time span (s)."""
+        return float(self._times[0]), float(self._times[-1])
+
+    @property
+    def t0(self) -> float:
+        """Window start (s)."""
+        return float(self._times[0])
+
+    @property
+    def t1(self) -> float:
+        """Window end (s)."""
+        return float(self._times[-1])
+
+    @property
+    def nbody(self) -> int:
+        """Number of bodies (world included)."""
+        return int(self._pos.shape[1])
+
+    @property
+    def ref_points(self) -> np.ndarray:
+        """(nbody, 3) body-frame reference points of the bounds (m)."""
+        return self._ref
+
+    def _poses(self, t: np.ndarray, loc: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+        i, s, at_end = self._seg.locate(t) if loc is None else loc
+        pos = K.lerp_values(self._pos, i, s, at_end)
+        quat = np.stack([tr.interp(i, s, at_end) for tr in self._tracks], axis=1)
+        return pos, quat
+
+    def body_poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World poses at ``times`` (T,): positions (T, nbody, 3) m, rotations (T, nbody, 3, 3)."""
+        t = K.check_times_in_window(times, self.window)
+        pos, quat = self._poses(t)
+        return pos, K.quat_to_mat(quat)
+
+    def motion_bounds(self, t0: np.ndarray, t1: np.ndarray) -> MotionBounds:
+        """Certified bounds for sub-intervals [t0[i], t1[i]] (see module docstring).
+
+        Args:
+            t0: (N,) sub-interval starts (s), inside the window.
+            t1: (N,) sub-interval ends (s), inside the window, t1 >= t0.
+
+        Returns:
+            MotionBounds with trans (N, nbody) m and angle (N, nbody) rad.
+        """
+        ta, tb = K.check_interval_arrays(t0, t1, self.window)
+        tol = self._tol
+        N = ta.shape[0]
+        trans = np.zeros((N, self.nbody))
+        angle = np.zeros((N, self.nbody))
+        if N and self._moving.any():
+            iv = K.IntervalVertices(self._seg, ta, tb)
+            xa, _ = self._poses(ta, iv.loc_a)
+            xb, _ = self._poses(tb, iv.loc_b)
+            xm, qm = self._poses(iv.tm, iv.loc_m)
+            for b in np.flatnonzero(self._moving):
+                dx = K.vector_deviation(self._pos[:, b], xa[:, b], xb[:, b], xm[:, b], iv)
+                dx = dx + tol.rel_pad * self._pos_mag
+                if self._rotating[b]:
+                    tr = self._tracks[b]
+                    qmb = qm[:, b] / np.linalg.norm(qm[:, b], axis=-1, keepdims=True)
+                    th = K.rotation_deviation(tr, qmb, iv) + tol.rel_pad * (tr.cum[-1] + 1.0)
+                    th = np.minimum(th * (1.0 + tol.rel_pad) + tol.abs_pad, np.pi)
+                else:
+                    th = np.zeros(N)
+                T = dx + chord(th) * np.linalg.norm(self._ref[b])
+                trans[:, b] = T * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * self._scale
+                angle[:, b] = th
+        return MotionBounds(t0=ta, t1=tb, trans=trans, angle=angle)
+
+    def moving_bodies(self) -> np.ndarray:
+        """(nbody,) bool: True where the body's waypoint poses are not all identical."""
+        return self._moving.copy()
+
+    def translation_segments(self, body: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """Breakpoints (k+1,) s and origins (k+1, 3) m if the body only translates, else None."""
+        b = int(body)
+        if not 0 <= b < self.nbody:
+            raise InvalidInputError(f"body index {body} out of range [0, {self.nbody})")
+        if not self._moving[b]:
+            p = self._pos[0, b]
+            return np.array([self.t0, self.t1]), np.stack([p, p])
+        if self._rotating[b]:
+            return None
+        return self._times.copy(), self._pos[:, b].copy()
+
+
+__all__ = ["BodyMotion"]
