@@ -289,6 +289,8 @@ class Gate:
         frame_skip: default number of substeps per window (``nstep``).
         reuse: reuse certified results of pairs whose bodies are fixed and unchanged.
         tolerances: numerical tolerances.
+        log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
+            ``log`` is a path (e.g. ``env_id``, ``model_source``).
 
     Raises:
         InvalidInputError: on an unknown option, negative margin or epsilon <= 0.
@@ -298,7 +300,8 @@ class Gate:
                  epsilon: float = 1e-3, predictor: str | Callable[..., Any] = "rollout",
                  on_violation: str = "block", unsafe: str = "uncertain",
                  fallback: Any = None, budget: Any = None, log: Any = None, frame_skip: int = 1,
-                 reuse: bool = True, tolerances: Tolerances = DEFAULT) -> None:
+                 reuse: bool = True, tolerances: Tolerances = DEFAULT,
+                 log_options: dict[str, Any] | None = None) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
         if on_violation not in ON_VIOLATION:
@@ -330,6 +333,7 @@ class Gate:
         self._scene = None
         self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._log_spec = log
+        self._log_options = dict(log_options or {})
         self._log = None
         self._log_owned = False
         self.last_report: StepReport | None = None
@@ -562,7 +566,7 @@ class Gate:
             meta = {"margin": self.margin, "epsilon": self.epsilon, "pairs": str(self.pairs),
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip}
-            self._log = MonitorLog(spec, model=self.model, metadata=meta)
+            self._log = MonitorLog(spec, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
         else:

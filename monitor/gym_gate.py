@@ -81,10 +81,21 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.timing = bool(timing)
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
-                         frame_skip=int(getattr(u, "frame_skip", 1)))
+                         frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env))
         self._obs: Any = None
 
     # ----------------------------------------------------------------- helpers
+    @staticmethod
+    def _log_options(env: gymnasium.Env) -> dict[str, Any]:
+        """Env id and MJCF source for the log, when the env exposes them."""
+        opts: dict[str, Any] = {}
+        if env.spec is not None:
+            opts["env_id"] = env.spec.id
+        src = getattr(env.unwrapped, "fullpath", None)
+        if isinstance(src, str):
+            opts["model_source"] = src
+        return opts
+
     def _as_action(self, a: Any) -> np.ndarray:
         space = self.env.action_space
         return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
