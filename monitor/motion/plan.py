@@ -69,7 +69,8 @@ delta_P(z) <= T_P + chord(Theta_P) ||z - ref_P||. Hence
 A free body: T_b = max_t ||x(t) - x(m)|| + chord(Theta) ||ref_b|| by (1) about the
 origin, Theta its slerp bound. Mocap and world-welded bodies: zero. A body whose
 chain has no changing coordinate has bit-identical poses (the lerp is
-``a + s (b - a)``) and gets exactly zero.
+``a + s (b - a)``) and gets exactly zero; likewise the angle of a body whose
+chain has no changing hinge, ball or free-quaternion coordinate.
 
 *Rounding.* Joint deviations are differences of numbers of size |q|, so dq_k is
 padded by rel_pad * max|q| (angles and lengths alike); the path lengths by
@@ -431,8 +432,11 @@ class Plan:
                 if P != 0 and self._moving[P]:
                     T += trans[:, P] + chord(angle[:, P]) * np.linalg.norm(z - ref[P], axis=-1)
                     Th += angle[:, P]
-            Th = np.minimum(Th, np.pi)
-            angle[:, b] = np.minimum(Th * (1.0 + tol.rel_pad) + tol.abs_pad, np.pi)
+            if self._rotating[b]:
+                Th = np.minimum(Th, np.pi)
+                angle[:, b] = np.minimum(Th * (1.0 + tol.rel_pad) + tol.abs_pad, np.pi)
+            # else: no rotational coordinate changes on the chain, so R_WB(t) is
+            # computed from bit-identical inputs and the angle is exactly 0.
             trans[:, b] = T * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * scale
         return trans, angle
 
