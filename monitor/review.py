@@ -153,6 +153,14 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     return Plan(times, qpos, model=model, **kw)
 
 
+def _engine() -> tuple[Any, Any]:
+    """(Scene class, certify function); ImportError while the engine is not installed."""
+    from monitor.certify.engine import certify
+    from monitor.scene import Scene
+
+    return Scene, certify
+
+
 def _tolerances(run: dict[str, Any]) -> Any:
     from monitor.tolerances import DEFAULT, Tolerances
 
@@ -165,7 +173,7 @@ def _tolerances(run: dict[str, Any]) -> Any:
 
 def _pair_policy(run: dict[str, Any], cert: dict[str, Any]) -> Any:
     pol = run.get("pairs", run.get("pair_policy"))
-    if isinstance(pol, str):
+    if pol in ("mujoco", "all"):
         return pol
     if isinstance(pol, list):
         return [tuple(p) for p in pol]
@@ -197,10 +205,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
     """
-    import monitor
     from monitor.errors import MonitorError
     from monitor.log.reader import load_model
 
+    scene_cls, certify = _engine()
     model, how = load_model(contents, model_source)
     run = contents.run
     tol = _tolerances(run)
@@ -230,7 +238,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                 kw = {"tolerances": tol}
                 if run.get("facets") is not None:
                     kw["facets"] = int(run["facets"])
-                scenes[key] = monitor.Scene.from_model(model, pairs=policy, **kw)
+                scenes[key] = scene_cls.from_model(model, pairs=policy, **kw)
             scene = scenes[key]
             plan = _rebuild_plan(model, plans[k])
             logged_pairs = [tuple(p["geoms"]) for p in c.get("pairs", [])]
@@ -238,7 +246,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if logged_pairs and set(logged_pairs) != set(map(tuple, scene.candidate_pairs)):
                 out["pairs_differ"] += 1
                 ckw["pairs"] = logged_pairs
-            new = monitor.certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
+            new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
                                   method=str(c.get("method", "auto")), **ckw)
         except (MonitorError, ValueError, KeyError, TypeError, IndexError) as exc:
             out["errors"].append({"index": k, "sim_time": c.get("sim_time"),

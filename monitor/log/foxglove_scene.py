@@ -54,14 +54,20 @@ _COLORS = {
 }
 
 
+def xyzw(q_wxyz: Any) -> np.ndarray:
+    """Reorder a MuJoCo (w, x, y, z) quaternion (4,) to Foxglove/scipy (x, y, z, w) (4,)."""
+    q = np.asarray(q_wxyz, np.float64).reshape(4)
+    return np.array([q[1], q[2], q[3], q[0]])
+
+
 def fox_quat(q_wxyz: Any) -> Quaternion:
     """MuJoCo (w, x, y, z) quaternion -> foxglove ``Quaternion(x, y, z, w)``."""
-    w, x, y, z = (float(v) for v in np.asarray(q_wxyz, np.float64).reshape(4))
+    x, y, z, w = (float(v) for v in xyzw(q_wxyz))
     return Quaternion(x=x, y=y, z=z, w=w)
 
 
 def mj_quat(q: Any) -> np.ndarray:
-    """Foxglove quaternion (object with x, y, z, w) -> MuJoCo (4,) (w, x, y, z)."""
+    """Decoded Foxglove quaternion (protobuf with x, y, z, w) -> MuJoCo (4,) (w, x, y, z)."""
     return np.array([q.w, q.x, q.y, q.z], dtype=np.float64)
 
 
@@ -236,4 +242,4 @@ class FoxgloveScene:
         return out
 
 
-__all__ = ["FoxgloveScene", "fox_quat", "mj_quat", "geom_primitives", "body_frame", "WORLD_FRAME"]
+__all__ = ["FoxgloveScene", "fox_quat", "xyzw", "mj_quat", "geom_primitives", "body_frame", "WORLD_FRAME"]

@@ -321,8 +321,8 @@ def load_model(contents: LogContents, source: str = "auto") -> tuple[Any, str]:
 def geometry_deviation(model_a: Any, model_b: Any, qpos: Any = None) -> float:
     """Max world-position difference (m) of geoms and mesh vertices between two models.
 
-    Both models must have the same structure (nq, nbody, ngeom, geom types, mesh
-    vertex counts); otherwise ``inf``. Evaluated at ``qpos`` (default ``qpos0``).
+    Both models must have the same structure (nq, nbody, ngeom, geom types, body,
+    geom and joint names, mesh vertex counts); otherwise ``inf``. Evaluated at ``qpos`` (default ``qpos0``).
     Mesh vertex sets are compared as sorted clouds (re-compiled meshes may reorder).
     """
     import mujoco
@@ -333,6 +333,10 @@ def geometry_deviation(model_a: Any, model_b: Any, qpos: Any = None) -> float:
         return math.inf
     if not np.array_equal(a.geom_type, b.geom_type) or not np.array_equal(a.geom_bodyid, b.geom_bodyid):
         return math.inf
+    for obj, n in ((mujoco.mjtObj.mjOBJ_GEOM, a.ngeom), (mujoco.mjtObj.mjOBJ_BODY, a.nbody),
+                   (mujoco.mjtObj.mjOBJ_JOINT, a.njnt)):
+        if any(mujoco.mj_id2name(a, obj, i) != mujoco.mj_id2name(b, obj, i) for i in range(n)):
+            return math.inf  # names are how certificates refer to geoms
     da, db = mujoco.MjData(a), mujoco.MjData(b)
     if qpos is not None:
         da.qpos[:] = qpos
