@@ -114,6 +114,19 @@ def _quat_to_mat(q: np.ndarray) -> np.ndarray:
     return R.reshape(3, 3)
 
 
+def _to_body(shape_G: ConvexShape, R_BG: np.ndarray, p_BG: np.ndarray) -> ConvexShape:
+    """Move a geom-frame shape into the body frame (x_B = R_BG x_G + p_BG).
+
+    For polytopes the offsets are then raised to the max of ``normal . v`` over the
+    moved vertices, so the H-rep contains the V-rep exactly in float64 (only enlarges).
+    """
+    s = shape_G.transformed(R_BG, p_BG)
+    if s.kind != "polytope":
+        return s
+    off = np.maximum(s.offsets, (s.normals @ s.points.T).max(axis=1))
+    return ConvexShape(s.kind, s.points, s.radius, s.edges, s.faces, s.normals, off, s.approx_error)
+
+
 def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape | None:
     """Shape of geom ``g`` in its geom frame (None for unsupported types)."""
     t = int(model.geom_type[g])
@@ -246,8 +259,8 @@ class Scene:
             shape_G = _geom_shape(model, g, nf, tolerances)
             shape_B = None
             if shape_G is not None:
-                shape_B = shape_G.transformed(_quat_to_mat(model.geom_quat[g]),
-                                              np.asarray(model.geom_pos[g], dtype=np.float64).copy())
+                shape_B = _to_body(shape_G, _quat_to_mat(model.geom_quat[g]),
+                                   np.asarray(model.geom_pos[g], dtype=np.float64).copy())
             geoms.append(GeomInfo(
                 name=names[g], id=g, body=body_names[b], body_id=b,
                 type=_GEOM_TYPES.get(int(types[g]), str(int(types[g]))), shape=shape_B,

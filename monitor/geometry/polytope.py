@@ -43,6 +43,12 @@ distinct faces of a float32 mesh (whose noise is ~1e-7 relative). Merging is
 not a soundness decision: every offset is recomputed as the max over all
 vertices, so the H-rep always contains the vertex set."""
 
+_FLAT_REL = 1e-9
+"""A point set whose width along a principal direction is at most this times its
+extent is degenerate (flat/collinear): qhull would return slivers whose normals
+are dominated by rounding. 1e-9 is far above rounding (1e-16) and far below any
+real part (a 1 m part thinner than 1 nm)."""
+
 _DEDUP_REL = 1e-12
 """Vertices of a half-space intersection closer than ``_DEDUP_REL * scale`` are
 one vertex (a vertex where more than three tangent planes meet is returned once
@@ -88,8 +94,35 @@ def _plane_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return u, w
 
 
+def _assemble(V: np.ndarray, faces: list[np.ndarray], normals: np.ndarray, contain: np.ndarray,
+              approx_error: float = 0.0) -> ConvexShape:
+    """Polytope from vertices, CCW face loops and unit outward normals.
+
+    Offsets are the max of ``normal . x`` over the vertices AND the points
+    ``contain`` (the original input), so the H-rep contains both exactly as
+    evaluated in float64. Checks the topology: every edge is used by exactly two
+    faces in opposite directions and V - E + F == 2.
+    """
+    offsets = (normals @ np.concatenate([V, contain]).T).max(axis=1)
+    directed: dict[tuple[int, int], int] = {}
+    for loop in faces:
+        for k in range(len(loop)):
+            e = (int(loop[k]), int(loop[(k + 1) % len(loop)]))
+            directed[e] = directed.get(e, 0) + 1
+    ok = all(c == 1 and directed.get((j, i)) == 1 for (i, j), c in directed.items())
+    E = np.array(sorted({(min(i, j), max(i, j)) for i, j in directed}), dtype=np.int64).reshape(-1, 2)
+    if not ok or len(V) - len(E) + len(faces) != 2:
+        raise _BadHull(f"inconsistent hull topology (V={len(V)}, E={len(E)}, F={len(faces)})")
+    return ConvexShape("polytope", V, 0.0, E, tuple(f.astype(np.int64) for f in faces),
+                       np.asarray(normals, dtype=np.float64), offsets, float(approx_error))
+
+
+class _BadHull(Exception):
+    """qhull's output could not be assembled into a valid polytope."""
+
+
 def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
-    """Polytope from a full-rank point set (raises QhullError if degenerate)."""
+    """Polytope from a full-rank point set (raises QhullError/_BadHull if degenerate)."""
     hull = ConvexHull(P)
     simp = hull.simplices
     eq = hull.equations  # (nf, 4): n . x + d <= 0 inside, n outward unit
@@ -130,25 +163,46 @@ def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
         # area-weighted normal of the group (qhull's normals are outward)
         a = P[simp[tri, 1]] - P[simp[tri, 0]]
         b = P[simp[tri, 2]] - P[simp[tri, 0]]
-        cr = np.cross(a, b)
-        area = np.linalg.norm(cr, axis=1)
+        area = np.linalg.norm(np.cross(a, b), axis=1)
         n = (nrm[tri] * area[:, None]).sum(axis=0) if area.sum() > 0 else nrm[tri].sum(axis=0)
         n /= np.linalg.norm(n)
         idx = remap[np.unique(simp[tri])]
         u, w = _plane_basis(n)
         q = V[idx] - V[idx].mean(axis=0)
         ang = np.arctan2(q @ w, q @ u)  # CCW about n, i.e. seen from outside
-        faces.append(idx[np.argsort(ang, kind="stable")].astype(np.int64))
+        faces.append(idx[np.argsort(ang, kind="stable")])
         normals.append(n)
-    N = np.array(normals)
-    offsets = (N @ V.T).max(axis=1)  # H-rep contains every vertex by construction
-    edges = set()
-    for loop in faces:
-        for k in range(len(loop)):
-            i, j = int(loop[k]), int(loop[(k + 1) % len(loop)])
-            edges.add((min(i, j), max(i, j)))
-    E = np.array(sorted(edges), dtype=np.int64).reshape(-1, 2)
-    return ConvexShape("polytope", V, 0.0, E, tuple(faces), N, offsets, 0.0)
+    return _assemble(V, faces, np.array(normals), P)
+
+
+def _prism(center: np.ndarray, u: np.ndarray, w: np.ndarray, n: np.ndarray, ring: np.ndarray,
+           lo: float, hi: float, contain: np.ndarray, approx_error: float) -> ConvexShape:
+    """Right prism over a convex polygon, built without qhull (robust when very thin).
+
+    Args:
+        center: (3,) origin of the (u, w, n) frame; (u, w, n) right-handed orthonormal.
+        ring: (k, 2) polygon vertices in (u, w) coordinates, counter-clockwise, k >= 3.
+        lo, hi: extent along n (lo < hi).
+        contain: (m, 3) points the H-rep must contain.
+        approx_error: reported excess (m).
+    """
+    base = center + ring[:, :1] * u + ring[:, 1:] * w
+    k = len(ring)
+    V = np.concatenate([base + lo * n, base + hi * n])
+    faces = [np.arange(k, 2 * k), np.arange(k)[::-1]]
+    normals = [n, -n]
+    for i in range(k):
+        j = (i + 1) % k
+        faces.append(np.array([i, j, k + j, k + i]))
+        e = ring[j] - ring[i]
+        side = (e[0] * u + e[1] * w)
+        out = np.cross(side, n)
+        normals.append(out / np.linalg.norm(out))
+    return _assemble(V, faces, np.array(normals), contain, approx_error)
+
+
+def _ccw_square(a: float) -> np.ndarray:
+    return np.array([[-a, -a], [a, -a], [a, a], [-a, a]])
 
 
 # --------------------------------------------------------------------------- public builders
@@ -160,22 +214,27 @@ def polytope_from_points(points: np.ndarray, *, thicken: float = 0.0) -> ConvexS
     Coplanar hull triangles are merged into convex face loops ordered
     counter-clockwise seen from outside; edges are unique vertex pairs; the
     H-representation has one row per merged face, with offsets equal to the
-    max of ``normal . v`` over all vertices (so it contains the vertex set).
-    Duplicate and interior points are dropped.
+    max of ``normal . x`` over all input points (so it contains the whole set).
+    Duplicate and interior points are dropped from the vertices.
+
+    A set is *degenerate* when its width along its least principal direction
+    (or the next one) is at most ``_FLAT_REL = 1e-9`` times its extent: then a
+    3-D hull would be numerically meaningless (slivers, merged faces).
 
     Args:
         points: (n, 3) points, metres, any frame.
-        thicken: metres. 0 (default): a degenerate set (coplanar, collinear,
-            single point) raises. > 0: such a set is thickened outwards by this
-            amount (see module docstring); full-rank sets are never thickened.
+        thicken: metres. 0 (default): a degenerate set raises. > 0: the set is
+            thickened outwards (module docstring); full-rank sets are never
+            thickened.
 
     Returns:
         A polytope shape; ``approx_error`` is 0 for a full-rank set, else an
-        upper bound on the outward excess of the thickened shape.
+        upper bound on the distance from any point of the shape to the hull of
+        the input.
 
     Raises:
-        InvalidInputError: bad shape / non-finite values, or a degenerate set
-            with ``thicken == 0``.
+        InvalidInputError: bad shape / non-finite values, a negative
+            ``thicken``, or a degenerate set with ``thicken == 0``.
     """
     P = _as_points(points)
     t = float(thicken)
@@ -183,51 +242,51 @@ def polytope_from_points(points: np.ndarray, *, thicken: float = 0.0) -> ConvexS
         raise InvalidInputError(f"thicken must be finite and >= 0, got {thicken!r}")
     P = np.unique(P, axis=0)
     c = P.mean(axis=0)
-    scale = float(np.ptp(P, axis=0).max()) if len(P) > 1 else 0.0
-    scale = max(scale, float(np.abs(P).max()) * 1e-3, t)
-    if len(P) >= 4:
-        try:
-            return _hull_polytope(P, scale)
-        except QhullError:
-            pass
-    # degenerate: find the rank with an SVD of the centred set
     Q = P - c
-    _, s, Vt = np.linalg.svd(Q, full_matrices=True) if len(P) > 1 else (None, np.zeros(3), np.eye(3))
-    s = np.concatenate([s, np.zeros(3 - len(s))])
-    rank = 2 if s[1] > 1e-9 * max(s[0], 1e-300) and len(P) >= 3 else (1 if s[0] > 0 else 0)
+    if len(P) > 1:
+        _, _, Vt = np.linalg.svd(Q, full_matrices=True)
+    else:
+        Vt = np.eye(3)
+    widths = np.ptp(Q @ Vt.T, axis=0)  # extent along each principal direction
+    extent = float(widths[0])
+    flat = widths <= _FLAT_REL * max(extent, np.finfo(float).tiny)
+    rank = 3 - int(flat.sum()) if extent > 0 else 0
+    if rank == 3:
+        try:
+            return _hull_polytope(P, float(np.ptp(P, axis=0).max()))
+        except (QhullError, _BadHull) as exc:
+            if t == 0.0:
+                raise InvalidInputError(f"points: no valid 3-D hull ({exc})") from None
+            rank = 2
     names = {2: "coplanar", 1: "collinear", 0: "a single point"}
     if t == 0.0:
         raise InvalidInputError(
-            f"points are {names[rank]} (singular values {s.tolist()}): no 3-D hull; "
-            "pass thicken > 0 to thicken the set outwards")
+            f"points are {names[rank]} (widths {widths.tolist()} m along the principal axes): no 3-D "
+            "hull; pass thicken > 0 to thicken the set outwards")
     if rank == 2:
         n = Vt[2]
         u, w = _plane_basis(n)
         r = Q @ n
         q2 = np.stack([Q @ u, Q @ w], axis=1)
         try:
-            h2 = ConvexHull(q2)
-            ring = q2[h2.vertices]
+            ring = q2[ConvexHull(q2).vertices]  # counter-clockwise for 2-D input
         except QhullError:
             rank = 1
         else:
-            lo, hi = r.min() - t, r.max() + t
-            base = c + ring[:, :1] * u + ring[:, 1:] * w
-            V = np.concatenate([base + hi * n, base + lo * n])
-            shape = _hull_polytope(V, scale)
             err = float(r.max() - r.min()) + t
-            return _with_error(shape, err)
+            return _prism(c, u, w, n, ring, float(r.min()) - t, float(r.max()) + t, P, err)
     if rank == 1:
         d = Vt[0]
         u, w = _plane_basis(d)
         sd = Q @ d
-        rho = float(np.sqrt((Q @ u) ** 2 + (Q @ w) ** 2).max()) + t
-        V = np.array([c + a * d + su * rho * u + sw * rho * w
-                      for a in (sd.min(), sd.max()) for su in (-1, 1) for sw in (-1, 1)])
-        return _with_error(_hull_polytope(V, scale), float(np.sqrt(2.0) * 2 * rho))
-    rho = float(np.linalg.norm(Q, axis=1).max()) + t
-    shape = box_polytope(np.array([rho, rho, rho]))
-    return _with_error(shape.transformed(np.eye(3), c), float(np.sqrt(3.0) * 2 * rho))
+        perp = float(np.sqrt((Q @ u) ** 2 + (Q @ w) ** 2).max())
+        rho = perp + t
+        err = float(np.sqrt(2.0)) * rho + perp
+        return _prism(c, u, w, d, _ccw_square(rho), float(sd.min()), float(sd.max()), P, err)
+    perp = float(np.linalg.norm(Q, axis=1).max())
+    rho = perp + t
+    err = float(np.sqrt(3.0)) * rho + perp
+    return _prism(c, np.eye(3)[0], np.eye(3)[1], np.eye(3)[2], _ccw_square(rho), -rho, rho, P, err)
 
 
 def _with_error(shape: ConvexShape, err: float) -> ConvexShape:
@@ -245,14 +304,20 @@ def _contain(shape: ConvexShape, support, tol: Tolerances) -> ConvexShape:
         tol: tolerances (``rel_pad`` pads the scale factor).
     """
     h = support(shape.normals)
-    ratio = float((h / shape.offsets).max())
-    k = max(ratio, 1.0) * (1.0 + tol.rel_pad)
-    return ConvexShape("polytope", shape.points * k, 0.0, shape.edges, shape.faces,
-                       shape.normals, shape.offsets * k, shape.approx_error)
+    k = 1.0
+    for _ in range(8):
+        V = shape.points * k
+        offsets = (shape.normals @ V.T).max(axis=1)  # recomputed: the H-rep contains V exactly
+        ratio = float((h / offsets).max())
+        if ratio <= 1.0 / (1.0 + tol.rel_pad):
+            return ConvexShape("polytope", V, 0.0, shape.edges, shape.faces, shape.normals, offsets,
+                               shape.approx_error)
+        k *= max(ratio, 1.0) * (1.0 + 2.0 * tol.rel_pad)
+    raise AssertionError("containment scaling did not converge")  # pragma: no cover
 
 
 def box_polytope(half_extents: np.ndarray) -> ConvexShape:
-    """Axis-aligned box centred at the origin (exact).
+    """Axis-aligned box centred at the origin (exact; built without qhull).
 
     Args:
         half_extents: (3,) half sizes, metres, each > 0.
@@ -262,8 +327,9 @@ def box_polytope(half_extents: np.ndarray) -> ConvexShape:
         raise InvalidInputError(f"half_extents: expected shape (3,), got {h.shape}")
     for i in range(3):
         _positive(h[i], f"half_extents[{i}]")
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
-    return _hull_polytope(signs * h, float(2 * h.max()))
+    ring = np.array([[-h[0], -h[1]], [h[0], -h[1]], [h[0], h[1]], [-h[0], h[1]]])
+    ex, ey, ez = np.eye(3)
+    return _prism(np.zeros(3), ex, ey, ez, ring, -h[2], h[2], np.zeros((0, 3)), 0.0)
 
 
 def cylinder_polytope(radius: float, half_length: float, facets: int = DEFAULT.facets,
