@@ -304,3 +304,27 @@ def test_interval_validation(model):
         plan.motion_bounds(np.array([plan.t0, plan.t0]), np.array([plan.t1]))
     with pytest.raises(InvalidInputError, match="outside the window"):
         plan.body_poses(np.array([plan.t0 - 1e-9]))
+
+
+def test_chunked_bounds_equal_unchunked(model, monkeypatch):
+    """Many waypoints and many long sub-intervals: chunking must not change any bound."""
+    import functools
+
+    from monitor.motion import _kinematics
+
+    rng = np.random.default_rng(11)
+    K = 60
+    times = np.cumsum(rng.uniform(0.01, 0.1, K))
+    plan = Plan(times, _random_qpos(model, K, rng), model=model)
+    ta = rng.uniform(times[0], times[-1], 300)
+    tb = np.minimum(ta + rng.uniform(0, 3, 300), times[-1])
+    ref = plan.motion_bounds(ta, tb)
+    small = functools.partial(_kinematics.interval_chunks, budget=500)
+    chunks = small(times, ta, tb, width=model.nq)
+    assert len(chunks) > 10
+    assert chunks[0].start == 0 and chunks[-1].stop == 300
+    assert all(a.stop == b.start for a, b in zip(chunks[:-1], chunks[1:]))
+    monkeypatch.setattr(_kinematics, "interval_chunks", small)
+    got = plan.motion_bounds(ta, tb)
+    np.testing.assert_array_equal(got.trans, ref.trans)
+    np.testing.assert_array_equal(got.angle, ref.angle)

@@ -321,3 +321,29 @@ def check_times_in_window(times: object, window: tuple[float, float]) -> np.ndar
         i = int(np.argmax(bad))
         raise InvalidInputError(f"query time {i} = {t[i]!r} is outside the window {window}")
     return t
+
+
+def interval_chunks(times: np.ndarray, ta: np.ndarray, tb: np.ndarray, width: int,
+                    budget: int = 4_000_000) -> list[slice]:
+    """Split N sub-intervals into consecutive chunks whose vertex gathers stay small.
+
+    The gathered arrays of :class:`IntervalVertices` have N * C * width entries
+    (C = most waypoints inside one sub-interval of the chunk); each chunk keeps
+    that under ``budget`` (about 32 MB of float64).
+    """
+    n = ta.shape[0]
+    count = np.maximum(np.searchsorted(times, tb, side="left") - np.searchsorted(times, ta, side="right"), 0)
+    per = (count + 1) * max(int(width), 1)
+    if n == 0 or int(per.max()) * n <= budget:
+        return [slice(0, n)]
+    out = []
+    start = 0
+    while start < n:
+        stop = start + 1
+        worst = int(per[start])
+        while stop < n and max(worst, int(per[stop])) * (stop + 1 - start) <= budget:
+            worst = max(worst, int(per[stop]))
+            stop += 1
+        out.append(slice(start, stop))
+        start = stop
+    return out

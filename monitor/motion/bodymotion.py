@@ -163,6 +163,13 @@ class BodyMotion:
             MotionBounds with trans (N, nbody) m and angle (N, nbody) rad.
         """
         ta, tb = K.check_interval_arrays(t0, t1, self.window)
+        trans = np.empty((ta.shape[0], self.nbody))
+        angle = np.empty((ta.shape[0], self.nbody))
+        for sl in K.interval_chunks(self._times, ta, tb, width=4):
+            trans[sl], angle[sl] = self._bounds(ta[sl], tb[sl])
+        return MotionBounds(t0=ta, t1=tb, trans=trans, angle=angle)
+
+    def _bounds(self, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         tol = self._tol
         N = ta.shape[0]
         trans = np.zeros((N, self.nbody))
@@ -185,7 +192,7 @@ class BodyMotion:
                 T = dx + chord(th) * np.linalg.norm(self._ref[b])
                 trans[:, b] = T * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * self._scale
                 angle[:, b] = th
-        return MotionBounds(t0=ta, t1=tb, trans=trans, angle=angle)
+        return trans, angle
 
     def moving_bodies(self) -> np.ndarray:
         """(nbody,) bool: True where the body's waypoint poses are not all identical."""

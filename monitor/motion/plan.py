@@ -356,7 +356,10 @@ class Plan:
             MotionBounds with trans (N, nbody) m and angle (N, nbody) rad.
         """
         a, b = K.check_interval_arrays(t0, t1, self.window)
-        trans, angle = self._bounds(a, b, scale=self._scale)
+        trans = np.empty((a.shape[0], self.nbody))
+        angle = np.empty((a.shape[0], self.nbody))
+        for sl in K.interval_chunks(self._times, a, b, width=max(self._model.nq, 4)):
+            trans[sl], angle[sl] = self._bounds(a[sl], b[sl], scale=self._scale)
         return MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
 
     def _bounds(self, ta: np.ndarray, tb: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
