@@ -377,6 +377,44 @@ def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
 
 
 @njit(cache=True)
+def _simplex_directions_bound(VA, VB, W, k):
+    """Best axis bound over directions from the sub-simplices of W[:k] (A-to-B sign).
+
+    Vertices w_i, perpendiculars from the origin to edge lines (re-orthogonalised)
+    and triangle normals: each is accurate when its own feature is well shaped.
+    """
+    best = -np.inf
+    n = np.empty(3)
+    e = np.empty(3)
+    f = np.empty(3)
+    for i in range(k):
+        for r in range(3):
+            n[r] = -W[i, r]
+        best = max(best, _axis_bound(VA, VB, n))
+        for j in range(i + 1, k):
+            for r in range(3):
+                e[r] = W[j, r] - W[i, r]
+            ee = _dot(e, e)
+            if ee > 0.0:
+                t = -_dot(W[i], e) / ee
+                for r in range(3):
+                    n[r] = W[i, r] + t * e[r]
+                s = _dot(n, e) / ee
+                for r in range(3):
+                    n[r] = -(n[r] - s * e[r])
+                best = max(best, _axis_bound(VA, VB, n))
+            for m in range(j + 1, k):
+                for r in range(3):
+                    f[r] = W[m, r] - W[i, r]
+                _cross(e, f, n)
+                if _dot(n, W[i]) > 0.0:
+                    for r in range(3):
+                        n[r] = -n[r]
+                best = max(best, _axis_bound(VA, VB, n))
+    return best
+
+
+@njit(cache=True)
 def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad, abs_pad,
                   eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
@@ -530,6 +568,17 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad,
         lb = _axis_bound(VA, VB, vn)
         if lb > best_lower:
             best_lower = lb
+        sv = np.sqrt(vv)
+        if sv - best_lower > 8.0 * rel_pad * S + 1e-13 * sv:
+            # loose (e.g. a sliver simplex face whose cross-product normal lost
+            # precision): try the sub-simplex directions, then the SAT candidates
+            lb = _simplex_directions_bound(VA, VB, W, k)
+            if lb > best_lower:
+                best_lower = lb
+        if sv - best_lower > 8.0 * rel_pad * S + 1e-13 * sv:
+            lb = _sat_lower(VA, VB, EA, EB, WNA, WNB, any_polytope, max_edge_pairs, vn)
+            if lb > best_lower:
+                best_lower = lb
         lower = best_lower - pad
         est = np.sqrt(vv)
         if est > upper:

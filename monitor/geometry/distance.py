@@ -146,92 +146,119 @@ def _core_arrays(shape: ConvexShape):
 # --------------------------------------------------------------------------- overlap depth (LP)
 
 
-def _depth_lp(shape_a: ConvexShape, Ra, pa, shape_b: ConvexShape, Rb, pb,
-              tol: Tolerances) -> tuple[float, np.ndarray] | None:
-    """Certified penetration depth lower bound of the cores by LP, in A's shifted frame.
+def _depth_lp(shape_a: ConvexShape, Ra, pa, shape_b: ConvexShape, Rb, pb, x0: np.ndarray,
+              scale: float, tol: Tolerances) -> tuple[float, np.ndarray] | None:
+    """Certified lower bound on the cores' penetration depth by LP (frame shifted by ``pa``).
 
-    Maximises d_A + d_B over points x with B(x, d_A) in core A and B(x, d_B) in
-    core B (a point / segment core contributes depth 0 and x must lie on it).
-    The LP optimum is then re-checked in float64 with rounding pads.
+    Maximises ``d_A + d_B`` (each polytope depth >= a small tau) over points x with
+    ``B(x, d_A)`` in core A and ``B(x, d_B)`` in core B; a point / segment core
+    has depth 0 and x must lie on it. The LP is posed in local, scaled
+    coordinates ``x = x0 + scale * y`` around a common point ``x0`` so that HiGHS'
+    absolute tolerances (~1e-9) are relative to the expected depth. The optimum is
+    then re-checked in float64 with rounding pads against the H-representation
+    (offsets recomputed as the max over the posed vertices).
+
+    Args:
+        x0: (3,) approximate common point (relative frame).
+        scale: metres, > 0, the expected depth (e.g. the SAT estimate).
 
     Returns:
-        (depth, x) with depth > 0 certified, x (3,) relative to ``pa``; or None.
+        (depth, x): depth > 0 certified, x (3,) the common point (relative frame);
+        or None when no positive depth could be certified.
     """
     from scipy.optimize import linprog
 
+    L = float(scale)
+    x0 = np.asarray(x0, dtype=np.float64)
     d = pb - pa
     cores = []
+    S = float(np.abs(x0).max())
     for shape, R, t in ((shape_a, Ra, np.zeros(3)), (shape_b, Rb, d)):
         V = shape.points @ R.T + t
+        S = max(S, float(np.abs(V).max()))
         if shape.kind == "polytope":
             N = np.asarray(shape.normals, dtype=np.float64) @ R.T
             nrm = np.linalg.norm(N, axis=1)
             b = (N @ V.T).max(axis=1)
             cores.append(("poly", V, N, nrm, b))
+        elif shape.kind == "capsule" and np.any(V[1] != V[0]):
+            cores.append(("seg", V, None, None, None))
         else:
-            cores.append(("hull", V, None, None, None))
-    S = max(float(np.abs(c[1]).max()) for c in cores)
+            cores.append(("pt", V[:1], None, None, None))
     pad = 2.0 * tol.rel_pad * S + tol.abs_pad
-    # variables: x (3), then per core: depth s (poly) or weights lam (hull)
-    nvar = 3
-    idx = []
+    # anchor x0 on a lower-dimensional core (the GJK point is on it only up to rounding)
+    seg_t0 = None
     for c in cores:
-        if c[0] == "poly":
-            idx.append(nvar)
+        if c[0] == "pt":
+            x0 = c[1][0].copy()
+        elif c[0] == "seg":
+            V = c[1]
+            e = V[1] - V[0]
+            seg_t0 = float(np.clip((x0 - V[0]) @ e / (e @ e), 0.0, 1.0))
+            x0 = V[0] + seg_t0 * e
+    # variables: y (3) [x = x0 + L y], then s (poly) / u (seg), then the balance m
+    nvar = 3
+    cols = []
+    for c in cores:
+        cols.append(nvar)
+        if c[0] in ("poly", "seg"):
             nvar += 1
-        else:
-            idx.append(nvar)
-            nvar += len(c[1])
     cost = np.zeros(nvar)
+    bounds: list[tuple[float | None, float | None]] = [(None, None)] * 3 + [(0.0, None)] * (nvar - 3)
     A_ub, b_ub, A_eq, b_eq = [], [], [], []
-    bounds = [(None, None)] * 3
-    for c, j in zip(cores, idx):
+    for c, j in zip(cores, cols):
         if c[0] == "poly":
             _, V, N, nrm, b = c
             rows = np.zeros((len(N), nvar))
             rows[:, :3] = N
             rows[:, j] = nrm
             A_ub.append(rows)
-            b_ub.append(b)
+            b_ub.append((b - N @ x0) / L)
             cost[j] = -1.0
-            bounds.append((0.0, None))
-        else:
+        elif c[0] == "seg":
             V = c[1]
+            e = V[1] - V[0]
+            le = float(np.linalg.norm(e))
             rows = np.zeros((3, nvar))
             rows[:, :3] = np.eye(3)
-            rows[:, j:j + len(V)] = -V.T
+            rows[:, j] = -e / le
             A_eq.append(rows)
             b_eq.append(np.zeros(3))
-            row = np.zeros((1, nvar))
-            row[0, j:j + len(V)] = 1.0
-            A_eq.append(row)
-            b_eq.append(np.ones(1))
-            bounds.extend([(0.0, None)] * len(V))
-    s_cols = [j for c, j in zip(cores, idx) if c[0] == "poly"]
-    if len(s_cols) == 2:
-        # balance variable m <= s_A, m <= s_B with a small reward: among (near-)optimal
-        # points prefer one strictly inside both (a depth of exactly 0 cannot be
-        # certified after padding). Optimum of sum + 0.1 min has sum >= opt / 1.1.
-        cost = np.append(cost, -0.1)
-        bounds.append((0.0, None))
-        nvar += 1
-        A_ub = [np.pad(a, ((0, 0), (0, 1))) for a in A_ub]
-        A_eq = [np.pad(a, ((0, 0), (0, 1))) for a in A_eq]
+            bounds[j] = (-seg_t0 * le / L, (1.0 - seg_t0) * le / L)
+        else:
+            rows = np.zeros((3, nvar))
+            rows[:, :3] = np.eye(3)
+            A_eq.append(rows)
+            b_eq.append(np.zeros(3))
+    # Each polytope depth must be >= tau: the plain optimum often puts all the depth
+    # on one body (a point on A's boundary deep in B), and a depth of exactly 0
+    # cannot be certified after padding. tau = 1 % of the expected depth costs at
+    # most that much of the bound; a smaller tau is tried if it is infeasible.
+    s_cols = [j for c, j in zip(cores, cols) if c[0] == "poly"]
+    res = None
+    for tau in (0.01, 100.0 * pad / L):
         for j in s_cols:
-            row = np.zeros((1, nvar))
-            row[0, -1] = 1.0
-            row[0, j] = -1.0
-            A_ub.append(row)
-            b_ub.append(np.zeros(1))
-    res = linprog(cost,
-                  A_ub=np.vstack(A_ub) if A_ub else None, b_ub=np.concatenate(b_ub) if b_ub else None,
-                  A_eq=np.vstack(A_eq) if A_eq else None, b_eq=np.concatenate(b_eq) if b_eq else None,
-                  bounds=bounds, method="highs")
-    if res.status != 0 or res.x is None:
+            bounds[j] = (tau, None)
+        res = linprog(cost,
+                      A_ub=np.vstack(A_ub) if A_ub else None, b_ub=np.concatenate(b_ub) if b_ub else None,
+                      A_eq=np.vstack(A_eq) if A_eq else None, b_eq=np.concatenate(b_eq) if b_eq else None,
+                      bounds=bounds, method="highs")
+        if res.status == 0 and res.x is not None:
+            break
+    if res is None or res.status != 0 or res.x is None:
         return None
-    x = np.array(res.x[:3])
+    y = np.asarray(res.x)
+    x = x0 + L * y[:3]
+    for c, j in zip(cores, cols):
+        if c[0] == "seg":
+            V = c[1]
+            e = V[1] - V[0]
+            t = float(np.clip(seg_t0 + L * y[j] / float(np.linalg.norm(e)), 0.0, 1.0))
+            x = V[0] + t * e
+        elif c[0] == "pt":
+            x = c[1][0].copy()
     depth = 0.0
-    for c, j in zip(cores, idx):
+    for c in cores:
         if c[0] == "poly":
             _, V, N, nrm, b = c
             dc = float(((b - N @ x) / nrm).min()) - pad
@@ -239,13 +266,8 @@ def _depth_lp(shape_a: ConvexShape, Ra, pa, shape_b: ConvexShape, Rb, pb,
                 return None
             depth += dc
         else:
-            V = c[1]
-            lam = np.clip(np.asarray(res.x[j:j + len(V)]), 0.0, None)
-            if lam.sum() <= 0.0:
-                return None
-            lam = lam / lam.sum()
-            # distance from x to the hull point lam @ V counts against the depth
-            depth -= float(np.linalg.norm(lam @ V - x)) + pad
+            # x lies on the point / segment up to the rounding of its construction
+            depth -= pad
     if depth <= 0.0:
         return None
     return depth, x
@@ -347,7 +369,7 @@ def _finish(shape_a, Ra, pa, shape_b, Rb, pb, out, tol, use_lp):
     if status != _gjk.SEPARATED:
         anyp = shape_a.kind == "polytope" or shape_b.kind == "polytope"
         if use_lp and anyp:
-            got = _depth_lp(shape_a, Ra, pa, shape_b, Rb, pb, tol)
+            got = _depth_lp(shape_a, Ra, pa, shape_b, Rb, pb, ca, max(-lower, 1e3 * float(out[10])), tol)
             if got is not None and -got[0] < upper:
                 upper = -got[0]
                 ca = got[1].copy()
@@ -429,7 +451,8 @@ def shape_distance_batch(shape_a: ConvexShape, Xs_a, shape_b: ConvexShape, Xs_b,
     if exact_overlap and anyp:
         redo = np.flatnonzero((out[:, 0] != _gjk.SEPARATED) & (out[:, 3] >= 0.0))
         for t in redo:
-            got = _depth_lp(shape_a, Ra[t], pa[t], shape_b, Rb[t], pb[t], tol)
+            got = _depth_lp(shape_a, Ra[t], pa[t], shape_b, Rb[t], pb[t], out[t, 4:7],
+                            max(-out[t, 2], 1e3 * out[t, 10]), tol)
             if got is not None:
                 up[t] = min(up[t], -got[0] - rsum)
     return lo, up
