@@ -83,7 +83,8 @@ class Rollout:
 
         Returns:
             times (nstep + 1,) seconds and qpos (nstep + 1, nq): the current state
-            followed by the state after each substep.
+            (quaternions normalised, as MuJoCo uses them) followed by the state
+            after each substep.
         """
         m, s = self.model, self.scratch
         mujoco.mj_getState(m, data, self._state, _INTEGRATION)
@@ -93,6 +94,9 @@ class Rollout:
         times = np.empty(nstep + 1)
         qpos = np.empty((nstep + 1, m.nq))
         times[0], qpos[0] = data.time, data.qpos
+        # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
+        # integration); a state set by hand (e.g. a noisy reset) may not be.
+        mujoco.mj_normalizeQuat(m, qpos[0])
         for k in range(nstep):
             mujoco.mj_step(m, s)
             times[k + 1], qpos[k + 1] = s.time, s.qpos
@@ -189,15 +193,16 @@ class StepReport:
 
         Absent values are ``inf`` (times, witness point) and ``""`` (geoms), not
         NaN, so that two identical runs compare equal (gymnasium's determinism
-        checks use ``==`` / ``allclose``, for which NaN != NaN).
+        checks use ``==`` / ``allclose``, for which NaN != NaN). String arrays are
+        object arrays (``allclose`` cannot compare numpy str arrays).
 
         Args:
             timing: include ``certify_us`` (wall time: differs between identical runs).
 
         Returns:
-            dict with verdict (str), applied_verdict (str), checker ((P,) str per
-            candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
-            witness_time (float s), witness_geoms ((2,) str), witness_point ((3,) m),
+            dict with verdict (str), applied_verdict (str), checker ((P,) object array
+            of str, one per candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
+            witness_time (float s), witness_geoms ((2,) object array of str), witness_point ((3,) m),
             earliest_time (float s), clearance (float m), replaced (bool),
             fallback_certified (bool), terminated (bool), time (float s)
             and, if ``timing``, certify_us (float µs).
@@ -217,11 +222,11 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
     """
     inf = math.inf
     if cert is None:
-        checker = np.full(int(npairs or 0), "", dtype="<U10")
+        checker = np.full(int(npairs or 0), "", dtype=object)
         mix, wit, earliest, clearance = "", None, inf, inf
     else:
-        checker = np.array([p.method for p in cert.pairs], dtype="<U10")
-        methods, counts = np.unique(checker, return_counts=True)
+        checker = np.array([p.method for p in cert.pairs], dtype=object)
+        methods, counts = np.unique(checker.astype(str), return_counts=True)
         mix = " ".join(f"{m}:{c}" for m, c in zip(methods, counts))
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
@@ -232,7 +237,7 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         "checker": checker,
         "checker_mix": mix,
         "witness_time": inf if wit is None else float(wit.time),
-        "witness_geoms": np.array(["", ""] if wit is None else list(wit.geoms)),
+        "witness_geoms": np.array(["", ""] if wit is None else list(wit.geoms), dtype=object),
         "witness_point": np.full(3, inf) if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
         "earliest_time": earliest,
         "clearance": clearance,
