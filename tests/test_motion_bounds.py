@@ -135,6 +135,8 @@ def _oracle_qpos(m, times, qpos, t):
             rot = Rotation.from_quat(wxyz[:, [1, 2, 3, 0]])
             r = Slerp(times, rot)(t).as_quat()
             out[:, a:a + 4] = r[:, [3, 0, 1, 2]]
+            if (wxyz == wxyz[0]).all():  # held joint: the exact value, not a rounded round trip
+                out[:, a:a + 4] = wxyz[0]
     for c in range(m.nq):
         if c not in quat_cols:
             out[:, c] = np.interp(t, times, qpos[:, c])
@@ -244,3 +246,92 @@ def test_deep_subdivision_bounds_hold(seed):
             dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
             bound = mb.trans[i, b] + chord(mb.angle[i, b]) * np.linalg.norm(pts - plan.ref_points[b], axis=-1)
             assert (dev <= bound).all()
+
+
+STRESS_XML = """
+<mujoco><worldbody>
+  <body name="far" pos="3000 -2000 1000">
+    <joint name="h" type="hinge" axis="0.3 0.4 0.866" pos="5 0 0"/>
+    <joint name="s" type="slide" axis="1 1 0"/>
+    <geom type="capsule" size=".05 20" pos="0 0 20"/>
+    <body name="tip" pos="0 0 40">
+      <joint name="b" type="ball" pos="0 0 1"/>
+      <geom type="box" size="1 2 3" pos="0 3 0"/>
+    </body>
+  </body>
+  <body name="free"><freejoint/><geom type="sphere" size="1" pos="2 0 0"/></body>
+</worldbody></mujoco>
+"""
+
+
+@pytest.mark.parametrize("step", [1e-11, 1e-8, 1e-4])
+def test_rounding_stress_large_coordinates_tiny_motions(step):
+    """Coordinates ~1e4 m, joint values ~1e3, motions down to 1e-11: pads must cover rounding."""
+    m = mujoco.MjModel.from_xml_string(STRESS_XML)
+    rng = np.random.default_rng(int(-np.log10(step)))
+    K = 3
+    q0 = np.array([1234.5, -876.0, *_rand_quat(rng), 9000.0, -7000.0, 5000.0, *_rand_quat(rng)])
+    qpos = np.tile(q0, (K, 1))
+    for k in range(1, K):
+        qpos[k, :2] += step * rng.normal(size=2) * 1e3
+        for a in (2, 9):
+            qq = qpos[0, a:a + 4] + step * rng.normal(size=4)
+            qpos[k, a:a + 4] = qq / np.linalg.norm(qq)
+        qpos[k, 6:9] += step * rng.normal(size=3) * 1e3
+    times = np.array([0.0, 0.5, 1.5]) + 1e4  # large times as well
+    plan = Plan(times, qpos, model=m)
+    edges = np.linspace(times[0], times[-1], 65)
+    mb = plan.motion_bounds(edges[:-1], edges[1:])
+    for i in range(0, 64, 3):
+        ts = np.linspace(edges[i], edges[i + 1], 40)
+        tm = 0.5 * (edges[i] + edges[i + 1])
+        samples = [plan.body_poses(np.concatenate([[tm], ts])),
+                   _oracle_poses(m, _oracle_qpos(m, times, plan.qpos, np.concatenate([[tm], ts])))]
+        for pos, mat in samples:
+            for b in range(1, m.nbody):
+                spread = np.array([1, 1, 1, 1, 1, 100, 100, 100, 1e3, 0])[:, None]
+                pts = plan.ref_points[b] + rng.normal(size=(10, 3)) * spread
+                world = pos[:, b, None, :] + np.einsum("tij,nj->tni", mat[:, b], pts)
+                dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
+                r = np.linalg.norm(pts - plan.ref_points[b], axis=-1)
+                bound = mb.trans[i, b] + chord(mb.angle[i, b]) * r
+                assert (dev <= bound).all(), (step, i, b, dev, bound)
+
+
+TIGHT_XML = """
+<mujoco><worldbody>
+  <body pos="3000 -2000 1000"><joint type="hinge" axis="0 0 1" pos="7 0 0"/>
+    <geom size=".5" pos="0 3 0"/></body>
+  <body pos="-4000 100 10"><joint type="slide" axis="0.6 0.8 0"/><geom size=".5"/></body>
+  <body pos="10 20 30"><joint type="ball" pos="0 0 0"/><geom size=".5" pos="0 0 9"/></body>
+  <body><freejoint/><geom size=".5"/></body>
+</worldbody></mujoco>
+"""
+
+
+def test_tight_cases_rounding():
+    """Single-joint bodies, where the bound is exact in real arithmetic: only the pads absorb rounding."""
+    m = mujoco.MjModel.from_xml_string(TIGHT_XML)
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for trial in range(40):
+        step = 10.0 ** rng.uniform(-12, -2)
+        q0 = np.array([rng.uniform(-1e3, 1e3), rng.uniform(-1e3, 1e3), *_rand_quat(rng),
+                       *rng.uniform(-1e4, 1e4, 3), 1, 0, 0, 0])
+        q1 = q0.copy()
+        q1[:2] += step * rng.normal(size=2)
+        q1[2:6] = q0[2:6] + step * rng.normal(size=4)
+        q1[2:6] /= np.linalg.norm(q1[2:6])
+        q1[6:9] += step * rng.normal(size=3)
+        times = np.array([0.0, 1.0]) + rng.uniform(0, 1e5)
+        plan = Plan(times, np.stack([q0, q1]), model=m)
+        mb = plan.motion_bounds(times[:1], times[1:])
+        pos, mat = plan.body_poses(np.array([0.5 * (times[0] + times[1]), times[0], times[1]]))
+        for b in range(1, m.nbody):
+            pts = np.concatenate([plan.ref_points[b][None], rng.normal(size=(5, 3)) * 1e3])
+            world = pos[:, b, None, :] + np.einsum("tij,nj->tni", mat[:, b], pts)
+            dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
+            bound = mb.trans[0, b] + chord(mb.angle[0, b]) * np.linalg.norm(pts - plan.ref_points[b], axis=-1)
+            assert (dev <= bound).all(), (trial, b, dev, bound)
+            worst = max(worst, float((dev / bound).max()))
+    assert worst > 0.3  # the cases are tight: a loose bound would not exercise the pads
