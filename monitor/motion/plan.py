@@ -214,6 +214,19 @@ class Plan:
             list(range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]))
             for b in range(nbody)
         ]
+        # Plain-numpy copies of the joint and body geometry (MjModel attribute access is slow).
+        axes = np.array(model.jnt_axis, dtype=np.float64).reshape(-1, 3)
+        self._jnt = {
+            "type": [int(x) for x in jtype],
+            "adr": [int(x) for x in jadr],
+            "pos": np.array(model.jnt_pos, dtype=np.float64).reshape(-1, 3),
+            "axis": axes,
+            "axis_norm": np.linalg.norm(axes, axis=-1),
+            "qpos0": np.array(model.qpos0, dtype=np.float64),
+        }
+        self._body_pos = np.array(model.body_pos, dtype=np.float64)
+        self._body_quat = np.array(model.body_quat, dtype=np.float64)
+        self._parent = [int(x) for x in parent]
         qwidth = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}
         own_moving = np.zeros(nbody, dtype=bool)
         own_rot = np.zeros(nbody, dtype=bool)
@@ -380,9 +393,10 @@ class Plan:
         dq[:, lin] = K.scalar_deviation(self._qpos[:, lin], Qa[:, lin], Qb[:, lin], Qm[:, lin], iv)
         dq += tol.rel_pad * self._magnitude["q"]
 
-        jtype = m.jnt_type
-        jadr = m.jnt_qposadr
-        parent = m.body_parentid
+        J = self._jnt
+        jtype = J["type"]
+        jadr = J["adr"]
+        qpos0 = J["qpos0"]
         ref = self._ref
         for b in range(1, nbody):
             if not self._moving[b]:
@@ -408,30 +422,28 @@ class Plan:
                     a = jadr[j]
                     typ = jtype[j]
                     if typ == _HINGE:
-                        ax = np.asarray(m.jnt_axis[j], dtype=np.float64)
-                        axn = ax / np.linalg.norm(ax)
-                        s = np.asarray(m.jnt_pos[j], dtype=np.float64)
-                        d = np.linalg.norm(np.cross(axn, y - s), axis=-1)
+                        axn = J["axis"][j] / J["axis_norm"][j]
+                        s = J["pos"][j]
+                        d = np.linalg.norm(K.cross(axn, y - s), axis=-1)
                         T += chord(dq[:, a]) * d
                         Th += dq[:, a]
-                        y = s + K.axis_rotate(axn, Qm[:, a] - m.qpos0[a], y - s)
+                        y = s + K.axis_rotate(axn, Qm[:, a] - qpos0[a], y - s)
                     elif typ == _SLIDE:
-                        ax = np.asarray(m.jnt_axis[j], dtype=np.float64)
-                        T += dq[:, a] * np.linalg.norm(ax)
-                        y = y + np.outer(Qm[:, a] - m.qpos0[a], ax)
+                        T += dq[:, a] * J["axis_norm"][j]
+                        y = y + (Qm[:, a] - qpos0[a])[:, None] * J["axis"][j]
                     elif typ == _BALL:
                         track = self._quat_tracks[j]
                         qm = Qm[:, a:a + 4]
                         qm = qm / np.linalg.norm(qm, axis=-1, keepdims=True)
                         th = K.rotation_deviation(track, qm, iv) + tol.rel_pad * (track.cum[-1] + 1.0)
-                        s = np.asarray(m.jnt_pos[j], dtype=np.float64)
+                        s = J["pos"][j]
                         T += chord(th) * np.linalg.norm(y - s, axis=-1)
                         Th += th
                         y = s + K.quat_rotate(qm, y - s)
                     else:  # pragma: no cover - MuJoCo rejects nested free joints
                         raise InvalidInputError(f"free joint {j} is not the only joint of its body")
-                z = np.asarray(m.body_pos[b]) + K.quat_rotate(np.asarray(m.body_quat[b], dtype=np.float64), y)
-                P = parent[b]
+                z = self._body_pos[b] + K.quat_rotate(self._body_quat[b], y)
+                P = self._parent[b]
                 if P != 0 and self._moving[P]:
                     T += trans[:, P] + chord(angle[:, P]) * np.linalg.norm(z - ref[P], axis=-1)
                     Th += angle[:, P]
