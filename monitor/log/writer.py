@@ -83,6 +83,8 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, (list, tuple)):
         return [_jsonable(v) for v in x]
     if isinstance(x, np.ndarray):
+        if x.dtype.kind == "f" and np.isfinite(x).all():
+            return x.tolist()
         return _jsonable(x.tolist())
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
@@ -94,8 +96,21 @@ def _jsonable(x: Any) -> Any:
     return x
 
 
+def _default(x: Any) -> Any:
+    """``json.dumps`` hook for numpy values (fast path; non-finite values raise ValueError)."""
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"not JSON-serialisable: {type(x).__name__}")
+
+
 def _dumps(obj: Any) -> bytes:
-    return json.dumps(_jsonable(obj), allow_nan=False, separators=(",", ":")).encode("utf-8")
+    """Strict JSON bytes; floats are written with repr, so they round-trip exactly."""
+    try:
+        return json.dumps(obj, allow_nan=False, separators=(",", ":"), default=_default).encode("utf-8")
+    except ValueError:  # NaN/inf somewhere: sanitise (-> null) and retry
+        return json.dumps(_jsonable(obj), allow_nan=False, separators=(",", ":")).encode("utf-8")
 
 
 def package_versions() -> dict[str, str]:
