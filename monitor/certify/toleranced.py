@@ -1,0 +1,960 @@
+"""Toleranced-ball collision checker (Schröcker & Weber), vectorised breadth-first.
+
+Setting. A moving convex core A (a polytope, a flat polygon, a segment or a point)
+and a fixed core B (same kinds, or a half-space), each inflated by its radius; the
+pair is clear when ``dist(core_A, core_B) > r`` with ``r = radius_A + radius_B + margin``.
+Everything is done in B's frame ("test frame"). A sub-interval of the motion is
+covered by a ball B_R(g) of affine maps in R^12 (metric of :mod:`monitor.motion.metric`,
+built on A's feature points): ``g`` maps A's body frame to the test frame (rigid for
+trajectories: the relative pose at the sub-interval midpoint; affine for Bézier
+motions: the curve point c(1/2)). For a point x of A, every pose of the sub-interval
+maps x into the ball of radius ``R rho(x)`` about ``g(x)``.
+
+Inflation by radius and margin (the paper's fat features stay quadrics). With
+``rho_max = max rho`` over A (rho is convex, so the max is at a vertex) we use
+
+    F(x)^2 = q(x) = R^2 rho(x)^2 + Delta,   Delta = r^2 + 2 r R rho_max   >=  (R rho(x) + r)^2 .
+
+A feature pair (f_A, f_B) can touch during the sub-interval only if
+``max_{x in f_A, z in f_B} q(x) - |g(x) - z|^2 >= 0``. This is the quantity every
+elementary test bounds; with ``x = g^-1(y)`` it is the paper's fat-feature test in
+world coordinates: ``q`` restricted to a line / plane is a convex quadratic whose
+canonical form is eq. 5 / eq. 7, so the fat edge is bounded by the hyperboloid (6)
+and the fat face by the two-sheet hyperboloid (8) over sigma(P) (Prop. 1). For an
+affine, non-rigid g (Bézier centre) the same holds because rho is evaluated in A's
+body frame (q(g(x)) = R^2 rho(x)^2 + Delta): only |g(x) - z| uses the mapped features,
+i.e. the metric frames are those of the features mapped by g's linear part.
+
+Elementary tests (rows). All are exact maxima of phi = q - |g(x) - z|^2 (up to the pad):
+
+* VF  vertex v of A vs the interior part of a polygon face G of B: the projection of
+  g(v) lies in G and h^2 <= q(v) (h = height over G's plane).
+* EE  edge e of A vs edge (or degenerate edge = vertex) g of B: max of the 2-variable
+  quadratic phi(s, tau) over [0, 1]^2 (sides: vertex balls vs segments; interior:
+  the hyperboloid part of eq. 6, present iff the Hessian is negative definite, which
+  is the paper's condition R < nu (beta < 1) tightened by the angle between the edges).
+* FE  face P of A vs edge g of B: for fixed z the maximiser over P's plane is
+  w*(z) (closed form when G - R^2 K is positive definite, i.e. all beta_i < 1); the
+  row fires if ``max_tau V(tau)`` over the tau-interval with w*(z(tau)) in P is >= 0.
+  This is the paper's "vertex in fat face" AND the case Listing 2 misses: g crossing
+  the fat face with both end points outside it. If some beta_i >= 1 the face part is
+  empty: for fixed z, phi is convex along a direction of P's plane, so its max over P
+  is on P's boundary (covered by EE). (This improves Remark 1's third bullet, which
+  subdivides instead.)
+* EF  edge e of A crossing polygon G of B statically at the centre pose g.
+* VH  vertex v of A vs half-space B: h(g(v)) <= F(v). (h - F is concave, so the min
+  over A is at a vertex; VH rows alone are complete for half-spaces.)
+
+Completeness for one (face P of A, face G of B) *unit*. The max of phi over P x G is
+attained on a pair of faces (f, f') with independent direction spaces: a common
+direction u gives the Hessian value 2 u^T (R^2 J^-1) u > 0 along (u, u). So (P-int,
+G-int) never occurs; (vertex, *) is VF or EE's sides; (edge-int, vertex/edge of G) is
+EE; (P-int, vertex/edge of G) is FE. The remaining case (edge-int e, G-int): along e,
+psi(s) = q - h^2 has an interior local max, so it is concave and e is not parallel to
+G; let s_z be where e's line meets G's plane. If s_z is in e and g(e(s_z)) lies in G,
+EF fires. Otherwise the projections of the points between the maximiser and s_z (or
+the end point of e between them, whose psi is >= min(psi(s_z) = q > 0, psi(s*)) by
+concavity) leave G, so some ball of the fat edge meets G's boundary: an EE row fires
+(or a VF row at that end point). Hence: the unit's rows fire iff the fat P meets G.
+
+Solids. If the cores are disjoint at the start (the engine checks this exactly) and
+they come within r later, at the first such time the closest points lie on the
+boundaries, i.e. on a (face of A, face of B) unit whose rows must fire on every
+sub-interval containing that time. Flat polygons / segments / points are tested as
+whole (their unit IS the set), so they need no start test.
+
+Remark 2 pruning. A unit excluded on a sub-interval I is clear for every pose of I,
+so it stays excluded on sub-intervals of I: children only test the units that
+fired on the parent (rows are recomputed with the child ball, and rows shared by
+several units are evaluated once per item).
+
+Rounding pad. Every row compares a quadratic value V with zero and fires when
+``V >= -pad``, ``pad = 8 rel_pad S + 2 sqrt(S) e + e^2``, where ``S`` (m^2) is the sum of
+the absolute values of the terms of V, and ``e = pad(L) + scale_pad L`` (m) is the
+coordinate pad for the magnitude ``L`` of the coordinates involved (pair extent +
+|translation of g|). Interior critical points scale the relative part by the 2x2
+condition number, and near-singular Hessians (|det| within 1e3 ulp of its terms)
+fire conservatively. Inclusion tests (point in polygon, tau in interval) are widened
+by ``e`` (widening only adds candidates, each of which upper-bounds the true max).
+R is padded upwards, J^-1 is inflated (see metric.py), and Delta uses the padded r.
+
+Termination (eq. 11): an item that is not excluded ends as an interval of possible
+violation once R * rho_max < epsilon, or at ``tolerances.max_depth``, or when the
+budget runs out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from monitor.certify.common import Budget, PairOutcome
+from monitor.geometry.shapes import ConvexShape
+from monitor.motion.base import Trajectory, chord
+from monitor.motion.metric import Metric, edge_coefficients, face_coefficients, shape_metric
+from monitor.tolerances import DEFAULT, Tolerances
+
+_U = 2.0**-53
+_ETA = 1e-9
+"""Relative widening of parameter ranges [0, 1] and tau-intervals (conservative)."""
+
+
+# ============================================================================ feature sets
+
+
+def _plane_frame(pts: np.ndarray, normal: np.ndarray | None = None):
+    """Origin, unit normal, (3, 2) orthonormal basis, 2D loop coordinates of a planar loop."""
+    o = pts.mean(axis=0)
+    if normal is None:
+        # Newell's method: robust normal of a planar polygon
+        nx = np.roll(pts, -1, axis=0)
+        n = np.array([((pts[:, 1] - nx[:, 1]) * (pts[:, 2] + nx[:, 2])).sum(),
+                      ((pts[:, 2] - nx[:, 2]) * (pts[:, 0] + nx[:, 0])).sum(),
+                      ((pts[:, 0] - nx[:, 0]) * (pts[:, 1] + nx[:, 1])).sum()])
+    else:
+        n = np.asarray(normal, float)
+    n = n / np.linalg.norm(n)
+    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    u1 = np.cross(n, a)
+    u1 /= np.linalg.norm(u1)
+    u2 = np.cross(n, u1)
+    U = np.stack([u1, u2], axis=1)
+    w = (pts - o) @ U
+    return o, n, U, w
+
+
+def _halfplanes(w: np.ndarray, kmax: int) -> tuple[np.ndarray, np.ndarray]:
+    """Outward half-planes hn . w <= hc of a convex 2D loop (any orientation), padded to kmax."""
+    k = len(w)
+    area = 0.5 * np.sum(w[:, 0] * np.roll(w[:, 1], -1) - np.roll(w[:, 0], -1) * w[:, 1])
+    if area < 0:
+        w = w[::-1]
+    dw = np.roll(w, -1, axis=0) - w
+    hn = np.stack([dw[:, 1], -dw[:, 0]], axis=1)
+    nrm = np.linalg.norm(hn, axis=1)
+    keep = nrm > 0
+    hn = hn[keep] / nrm[keep, None]
+    hc = np.einsum("ij,ij->i", hn, w[keep])
+    outn = np.zeros((kmax, 2))
+    outc = np.ones(kmax)
+    outn[: len(hn)] = hn
+    outc[: len(hc)] = hc
+    del k
+    return outn, outc
+
+
+@dataclass(eq=False)
+class MovingFeatures:
+    """Features of the moving core A in its body frame, with metric coefficients.
+
+    Units are the pieces whose pair with a fixed unit is tested as a whole (faces of a
+    polytope, the polygon itself, the segment, the point).
+    """
+
+    metric: Metric
+    verts: np.ndarray            # (nv, 3)
+    qv: np.ndarray               # (nv,) rho^2 at vertices
+    e_v0: np.ndarray             # (ne, 3)
+    e_d: np.ndarray              # (ne, 3)
+    e_k: np.ndarray              # (ne, 3) rho^2 = k0 + k1 s + k2 s^2
+    e_deg: np.ndarray            # (ne,) zero-length edge
+    f_o: np.ndarray              # (nf, 3)
+    f_U: np.ndarray              # (nf, 3, 2)
+    f_k0: np.ndarray             # (nf,)
+    f_kg: np.ndarray             # (nf, 2)
+    f_K: np.ndarray              # (nf, 2, 2)
+    f_hn: np.ndarray             # (nf, kmax, 2)
+    f_hc: np.ndarray             # (nf, kmax)
+    units: list[tuple[np.ndarray, np.ndarray, int]]  # (vertex ids, edge ids, face id or -1)
+    rho_max: float
+    extent: float                # max |coordinate| (m)
+    solid: bool                  # polytope core (needs the start-pose test)
+
+
+@dataclass(eq=False)
+class FixedFeatures:
+    """Features of the fixed core B in its own frame."""
+
+    kind: str                    # "polytope" | "polygon" | "segment" | "point" | "halfspace"
+    verts: np.ndarray
+    e_w0: np.ndarray             # (ne, 3)
+    e_e: np.ndarray              # (ne, 3)
+    f_o: np.ndarray              # (nf, 3)
+    f_n: np.ndarray              # (nf, 3)
+    f_U: np.ndarray              # (nf, 3, 2)
+    f_hn: np.ndarray             # (nf, kmax, 2)
+    f_hc: np.ndarray             # (nf, kmax)
+    units: list[tuple[np.ndarray, int]]  # (edge ids, face id or -1); half-space: one unit
+    h_n: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    h_off: float = 0.0
+    extent: float = 0.0
+    solid: bool = False
+
+
+def _loops_and_edges(shape_points: np.ndarray, edges: np.ndarray, loops: list[np.ndarray]):
+    """Edge list containing every loop edge; returns edges (m, 2) and per-loop edge ids."""
+    E = [tuple(sorted(map(int, e))) for e in np.asarray(edges).reshape(-1, 2)]
+    index = {e: i for i, e in enumerate(E)}
+    per_loop = []
+    for lp in loops:
+        ids = []
+        for i in range(len(lp)):
+            key = tuple(sorted((int(lp[i]), int(lp[(i + 1) % len(lp)]))))
+            if key not in index:
+                index[key] = len(E)
+                E.append(key)
+            ids.append(index[key])
+        per_loop.append(np.array(ids, dtype=np.int64))
+    return np.array(E, dtype=np.int64).reshape(-1, 2), per_loop
+
+
+def moving_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | None = None,
+                    metric: Metric | None = None) -> MovingFeatures:
+    """Moving feature set of a shape's core (body frame), or of a flat convex polygon.
+
+    Args:
+        shape: a sphere / capsule / polytope :class:`ConvexShape` (its radius is NOT part
+            of the features; the checker adds it to r).
+        polygon: alternatively (k, 3) vertices of a planar convex polygon (a surface, not a
+            solid), as in the paper's examples.
+        metric: mass distribution; default :func:`monitor.motion.metric.shape_metric`
+            (or the polygon's vertices plus off-plane points).
+    """
+    if polygon is not None:
+        V = np.asarray(polygon, float).reshape(-1, 3)
+        loops = [np.arange(len(V))]
+        edges, per_loop = _loops_and_edges(V, np.zeros((0, 2)), loops)
+        if metric is None:
+            from monitor.motion.metric import make_metric
+            metric = make_metric(V)
+        units = [(np.arange(len(V)), per_loop[0], 0)]
+        solid = False
+    else:
+        assert shape is not None
+        V = np.asarray(shape.points, float)
+        metric = metric or shape_metric(shape)
+        solid = shape.kind == "polytope"
+        if shape.kind == "sphere":
+            edges, loops, per_loop = np.array([[0, 0]]), [], []
+            units = [(np.array([0]), np.array([0]), -1)]
+        elif shape.kind == "capsule":
+            edges, loops, per_loop = np.array([[0, 1]]), [], []
+            units = [(np.array([0, 1]), np.array([0]), -1)]
+        elif shape.kind == "polytope":
+            loops = [np.asarray(f, np.int64) for f in shape.faces]
+            edges, per_loop = _loops_and_edges(V, shape.edges, loops)
+            units = [(loops[i], per_loop[i], i) for i in range(len(loops))]
+        else:
+            raise ValueError(f"a {shape.kind} core cannot be the moving side")
+    nf = len(loops)
+    kmax = max([len(lp) for lp in loops], default=1)
+    f_o = np.zeros((nf, 3))
+    f_U = np.zeros((nf, 3, 2))
+    f_hn = np.zeros((nf, kmax, 2))
+    f_hc = np.ones((nf, kmax))
+    for i, lp in enumerate(loops):
+        o, _n, U, w = _plane_frame(V[lp])
+        f_o[i], f_U[i] = o, U
+        f_hn[i], f_hc[i] = _halfplanes(w, kmax)
+    f_k0, f_kg, f_K = face_coefficients(metric, f_o, f_U)
+    v0 = V[edges[:, 0]]
+    d = V[edges[:, 1]] - v0
+    qv = metric.rho2(V)
+    return MovingFeatures(metric, V, qv, v0, d, edge_coefficients(metric, v0, d),
+                          ~(np.abs(d).max(axis=1) > 0), f_o, f_U, f_k0, f_kg, f_K, f_hn, f_hc,
+                          units, float(np.sqrt(qv.max())), float(np.abs(V).max()), solid)
+
+
+def fixed_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | None = None
+                   ) -> FixedFeatures:
+    """Fixed feature set of a shape's core (its own frame), or of a flat convex polygon."""
+    normals = None
+    if polygon is not None:
+        V = np.asarray(polygon, float).reshape(-1, 3)
+        loops = [np.arange(len(V))]
+        edges, per_loop = _loops_and_edges(V, np.zeros((0, 2)), loops)
+        kind, solid = "polygon", False
+    else:
+        assert shape is not None
+        V = np.asarray(shape.points, float)
+        kind, solid = shape.kind, shape.kind == "polytope"
+        if kind == "halfspace":
+            n = np.asarray(shape.normals[0], float)
+            return FixedFeatures("halfspace", V, np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                                 np.zeros((0, 3)), np.zeros((0, 3, 2)), np.zeros((0, 1, 2)),
+                                 np.zeros((0, 1)), [(np.zeros(0, np.int64), -1)], n,
+                                 float(shape.offsets[0]), float(np.abs(V).max()), True)
+        if kind == "sphere":
+            edges, loops, per_loop = np.array([[0, 0]]), [], []
+            kind = "point"
+        elif kind == "capsule":
+            edges, loops, per_loop = np.array([[0, 1]]), [], []
+            kind = "segment"
+        else:
+            loops = [np.asarray(f, np.int64) for f in shape.faces]
+            edges, per_loop = _loops_and_edges(V, shape.edges, loops)
+            normals = np.asarray(shape.normals, float) if len(shape.normals) == len(loops) else None
+    nf = len(loops)
+    kmax = max([len(lp) for lp in loops], default=1)
+    f_o, f_n = np.zeros((nf, 3)), np.zeros((nf, 3))
+    f_U = np.zeros((nf, 3, 2))
+    f_hn, f_hc = np.zeros((nf, kmax, 2)), np.ones((nf, kmax))
+    for i, lp in enumerate(loops):
+        o, n, U, w = _plane_frame(V[lp], None if normals is None else normals[i])
+        f_o[i], f_n[i], f_U[i] = o, n, U
+        f_hn[i], f_hc[i] = _halfplanes(w, kmax)
+    if nf:
+        units = [(per_loop[i], i) for i in range(nf)]
+    else:
+        units = [(np.arange(len(edges)), -1)]
+    w0 = V[edges[:, 0]]
+    return FixedFeatures(kind, V, w0, V[edges[:, 1]] - w0, f_o, f_n, f_U, f_hn, f_hc, units,
+                         extent=float(np.abs(V).max()), solid=solid)
+
+
+# ============================================================================ pair tables
+
+
+_TYPES = ("VF", "EE", "FE", "EF", "VH")
+
+
+@dataclass(eq=False)
+class _Tables:
+    """Concatenated row and unit tables of all pairs of one check."""
+
+    rows: dict[str, dict[str, np.ndarray]]   # per type: column arrays (global feature ids)
+    row_start: dict[str, int]                # global row id offset per type
+    n_rows: int
+    unit_ptr: np.ndarray                     # (n_units + 1,) CSR into unit_rows
+    unit_rows: np.ndarray                    # global row ids
+    unit_pair: np.ndarray                    # (n_units,) pair index
+    pair_units: list[np.ndarray]             # per pair: its global unit ids
+
+
+@dataclass(eq=False)
+class _PairData:
+    A: MovingFeatures
+    B: FixedFeatures
+    r: float
+    name: Any = None
+
+
+class _Concat:
+    """Concatenation of per-pair feature arrays with offsets."""
+
+    def __init__(self, pairs: list[_PairData]):
+        def cat(getter, empty_shape):
+            arrs = [getter(p) for p in pairs]
+            offs = np.cumsum([0] + [len(a) for a in arrs])
+            data = np.concatenate(arrs) if arrs else np.zeros(empty_shape)
+            return data, offs
+
+        A = lambda name: (lambda p: getattr(p.A, name))  # noqa: E731
+        B = lambda name: (lambda p: getattr(p.B, name))  # noqa: E731
+        self.av, self.av_off = cat(A("verts"), (0, 3))
+        self.aqv, _ = cat(A("qv"), (0,))
+        self.ae_v0, self.ae_off = cat(A("e_v0"), (0, 3))
+        self.ae_d, _ = cat(A("e_d"), (0, 3))
+        self.ae_k, _ = cat(A("e_k"), (0, 3))
+        self.af_o, self.af_off = cat(A("f_o"), (0, 3))
+        self.af_U, _ = cat(A("f_U"), (0, 3, 2))
+        self.af_k0, _ = cat(A("f_k0"), (0,))
+        self.af_kg, _ = cat(A("f_kg"), (0, 2))
+        self.af_K, _ = cat(A("f_K"), (0, 2, 2))
+        self.af_hn, self.af_hc = _pad_cat([p.A.f_hn for p in pairs], [p.A.f_hc for p in pairs])
+        self.be_w0, self.be_off = cat(B("e_w0"), (0, 3))
+        self.be_e, _ = cat(B("e_e"), (0, 3))
+        self.bf_o, self.bf_off = cat(B("f_o"), (0, 3))
+        self.bf_n, _ = cat(B("f_n"), (0, 3))
+        self.bf_U, _ = cat(B("f_U"), (0, 3, 2))
+        self.bf_hn, self.bf_hc = _pad_cat([p.B.f_hn for p in pairs], [p.B.f_hc for p in pairs])
+        self.h_n = np.array([p.B.h_n for p in pairs]).reshape(-1, 3)
+        self.h_off = np.array([p.B.h_off for p in pairs], float)
+
+
+def _pad_cat(hns: list[np.ndarray], hcs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    kmax = max([h.shape[1] for h in hns if h.ndim == 3 and len(h)], default=1)
+    n = sum(len(h) for h in hns)
+    out_n = np.zeros((n, kmax, 2))
+    out_c = np.ones((n, kmax))
+    i = 0
+    for hn, hc in zip(hns, hcs):
+        k = len(hn)
+        if k:
+            out_n[i:i + k, : hn.shape[1]] = hn
+            out_c[i:i + k, : hc.shape[1]] = hc
+        i += k
+    return out_n, out_c
+
+
+def _build_tables(pairs: list[_PairData], C: _Concat) -> _Tables:
+    cols: dict[str, list[tuple[int, ...]]] = {t: [] for t in _TYPES}
+    index: dict[tuple, int] = {}
+    unit_rows: list[list[tuple[str, int]]] = []
+    unit_pair: list[int] = []
+    pair_units: list[np.ndarray] = []
+
+    def row(t: str, key: tuple[int, ...], pi: int) -> tuple[str, int]:
+        k = (t, *key)
+        if k not in index:
+            index[k] = len(cols[t])
+            cols[t].append((*key, pi))
+        return (t, index[k])
+
+    for pi, pd in enumerate(pairs):
+        A, B = pd.A, pd.B
+        av, ae, af = int(C.av_off[pi]), int(C.ae_off[pi]), int(C.af_off[pi])
+        be, bf = int(C.be_off[pi]), int(C.bf_off[pi])
+        mine = []
+        if B.kind == "halfspace":
+            for v in range(len(A.verts)):
+                unit_rows.append([row("VH", (av + v,), pi)])
+                unit_pair.append(pi)
+                mine.append(len(unit_pair) - 1)
+        else:
+            for vs, es, fa in A.units:
+                for ges, fb in B.units:
+                    rs = []
+                    if fb >= 0:
+                        rs += [row("VF", (av + int(v), bf + fb), pi) for v in vs]
+                        rs += [row("EF", (ae + int(e), bf + fb), pi) for e in es if not A.e_deg[e]]
+                    rs += [row("EE", (ae + int(e), be + int(g)), pi) for e in es for g in ges]
+                    if fa >= 0:
+                        rs += [row("FE", (af + fa, be + int(g)), pi) for g in ges]
+                    unit_rows.append(rs)
+                    unit_pair.append(pi)
+                    mine.append(len(unit_pair) - 1)
+        pair_units.append(np.array(mine, dtype=np.int64))
+    start, s = {}, 0
+    for t in _TYPES:
+        start[t] = s
+        s += len(cols[t])
+    names = {"VF": ("a", "b"), "EE": ("a", "b"), "FE": ("a", "b"), "EF": ("a", "b"), "VH": ("a",)}
+    rows = {}
+    for t in _TYPES:
+        arr = np.array(cols[t], dtype=np.int64).reshape(-1, len(names[t]) + 1)
+        rows[t] = {nm: arr[:, j] for j, nm in enumerate(names[t])}
+        rows[t]["pair"] = arr[:, -1]
+    ptr = np.cumsum([0] + [len(u) for u in unit_rows]).astype(np.int64)
+    flat = np.array([start[t] + i for u in unit_rows for t, i in u], dtype=np.int64)
+    return _Tables(rows, start, s, ptr, flat, np.array(unit_pair, np.int64), pair_units)
+
+
+# ============================================================================ kernels
+
+
+def _pad2(S: np.ndarray, e: np.ndarray, rel: float) -> np.ndarray:
+    """Pad (m^2) for a quadratic value whose terms sum to S in absolute value (module doc)."""
+    S = np.abs(S)
+    return 8.0 * rel * S + 2.0 * np.sqrt(S) * e + e * e
+
+
+def _qmax01(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Max of a t^2 + b t + c over t in [0, 1] (the vertex is included if within [-eta, 1+eta])."""
+    best = np.maximum(c, a + b + c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = -b / (2.0 * a)
+        v = c - b * b / (4.0 * a)
+    ok = (a < 0) & (t >= -_ETA) & (t <= 1 + _ETA)
+    return np.where(ok, np.maximum(best, v), best)
+
+
+def _inside2(hn: np.ndarray, hc: np.ndarray, w: np.ndarray, pad: np.ndarray) -> np.ndarray:
+    """Point (n, 2) in padded convex polygon (n, k, 2) / (n, k)."""
+    return (np.einsum("nkj,nj->nk", hn, w) <= hc + pad[:, None]).all(axis=1)
+
+
+def _apply(L: np.ndarray, p: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.einsum("nij,nj->ni", L, x) + p
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ni,ni->n", a, b)
+
+
+class _Ball:
+    """Per-item ball data: g = (L, p) maps A's body frame to the test frame."""
+
+    def __init__(self, L, p, R, rho_max, r, eps_pos, tol: Tolerances):
+        self.L, self.p = L, p
+        R = np.asarray(R, float)
+        self.R2 = R * R
+        ru = r + tol.pad(r) if np.ndim(r) == 0 else r + tol.rel_pad * np.abs(r) + tol.abs_pad
+        self.Delta = ru * ru + 2.0 * ru * R * rho_max
+        self.eps = eps_pos
+
+
+def _kernel_VF(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
+    y = _apply(ball.L[it], ball.p[it], C.av[a])
+    rel = y - C.bf_o[b]
+    h = _dot(rel, C.bf_n[b])
+    w = np.einsum("ni,nik->nk", rel, C.bf_U[b])
+    e = ball.eps[it]
+    q = ball.R2[it] * C.aqv[a] + ball.Delta[it]
+    inside = _inside2(C.bf_hn[b], C.bf_hc[b], w, 4 * e)
+    return inside & (q - h * h >= -_pad2(q + h * h, e, tol.rel_pad))
+
+
+def _kernel_VH(C: _Concat, it, a, pair, ball: _Ball, tol) -> np.ndarray:
+    y = _apply(ball.L[it], ball.p[it], C.av[a])
+    h = _dot(y, C.h_n[pair]) - C.h_off[pair]
+    e = ball.eps[it] + tol.pad(0.0) + tol.rel_pad * np.abs(C.h_off[pair])
+    q = ball.R2[it] * C.aqv[a] + ball.Delta[it]
+    return (h <= 4 * e) | (q - h * h >= -_pad2(q + h * h, e, tol.rel_pad))
+
+
+def _kernel_EE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
+    L, p = ball.L[it], ball.p[it]
+    Y0 = _apply(L, p, C.ae_v0[a])
+    D = np.einsum("nij,nj->ni", L, C.ae_d[a])
+    E = C.be_e[b]
+    P = Y0 - C.be_w0[b]
+    k = C.ae_k[a]
+    R2, Dl, e = ball.R2[it], ball.Delta[it], ball.eps[it]
+    DD, EE, DE = _dot(D, D), _dot(E, E), _dot(D, E)
+    PD, PE, PP = _dot(P, D), _dot(P, E), _dot(P, P)
+    a_ss = R2 * k[:, 2] - DD
+    a_tt = -EE
+    a_st = 2.0 * DE
+    b_s = R2 * k[:, 1] - 2.0 * PD
+    b_t = 2.0 * PE
+    c = R2 * k[:, 0] + Dl - PP
+    S = (np.abs(R2 * k[:, 0]) + Dl + np.abs(R2 * k[:, 1]) + np.abs(R2 * k[:, 2])
+         + (np.sqrt(PP) + np.sqrt(DD) + np.sqrt(EE)) ** 2)
+    pad = _pad2(S, e, tol.rel_pad)
+    best = np.maximum.reduce([
+        _qmax01(a_tt, b_t, c),                       # s = 0
+        _qmax01(a_tt, b_t + a_st, c + a_ss + b_s),   # s = 1
+        _qmax01(a_ss, b_s, c),                       # tau = 0
+        _qmax01(a_ss, b_s + a_st, c + a_tt + b_t),   # tau = 1
+    ])
+    fire = best >= -pad
+    det = 4.0 * a_ss * a_tt - a_st * a_st
+    band = 1e3 * _U * (4.0 * np.abs(a_ss * a_tt) + a_st * a_st)
+    deg = (DD == 0) | (EE == 0)
+    amb = (~deg) & (np.abs(det) <= band)
+    nd = (~deg) & (a_ss < 0) & (det > band)
+    if nd.any():
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s_ = (-2.0 * a_tt * b_s + a_st * b_t) / det
+            t_ = (-2.0 * a_ss * b_t + a_st * b_s) / det
+            val = c + 0.5 * (b_s * s_ + b_t * t_)
+            cond = (2 * np.abs(a_ss) + np.abs(a_st) + 2 * np.abs(a_tt)) ** 2 / det
+        inbox = (s_ >= -_ETA) & (s_ <= 1 + _ETA) & (t_ >= -_ETA) & (t_ <= 1 + _ETA)
+        Sx = S + np.abs(b_s * s_) + np.abs(b_t * t_)
+        padi = _pad2(Sx, e, tol.rel_pad) * (1.0 + cond)
+        fire |= nd & inbox & (val >= -padi)
+    return fire | amb
+
+
+def _kernel_FE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
+    L, p = ball.L[it], ball.p[it]
+    O = _apply(L, p, C.af_o[a])
+    Up = np.einsum("nij,njk->nik", L, C.af_U[a])
+    E = C.be_e[b]
+    P0 = O - C.be_w0[b]
+    R2, Dl, e = ball.R2[it], ball.Delta[it], ball.eps[it]
+    G = np.einsum("nik,nil->nkl", Up, Up)
+    Am = G - R2[:, None, None] * C.af_K[a]
+    a11, a12, a22 = Am[:, 0, 0], Am[:, 0, 1], Am[:, 1, 1]
+    det = a11 * a22 - a12 * a12
+    band = 1e3 * _U * (np.abs(a11 * a22) + a12 * a12)
+    amb = np.abs(det) <= band
+    pd = (a11 > 0) & (det > band)
+    fire = amb.copy()
+    if not pd.any():
+        return fire
+    idx = np.nonzero(pd)[0]
+    a11, a12, a22, det = a11[idx], a12[idx], a22[idx], det[idx]
+    Up, E, P0 = Up[idx], E[idx], P0[idx]
+    R2, Dl, e = R2[idx], Dl[idx], e[idx]
+    ca = R2[:, None] * C.af_kg[a[idx]] - np.einsum("nik,ni->nk", Up, P0)
+    cb = np.einsum("nik,ni->nk", Up, E)
+
+    def solve(v):
+        return np.stack([(a22 * v[:, 0] - a12 * v[:, 1]) / det,
+                         (-a12 * v[:, 0] + a11 * v[:, 1]) / det], axis=1)
+
+    wa, wb = solve(ca), solve(cb)
+    EE_, PE, PP = _dot(E, E), _dot(P0, E), _dot(P0, P0)
+    cbwb, cawb, cawa = _dot(cb, wb), _dot(ca, wb), _dot(ca, wa)
+    k0 = C.af_k0[a[idx]]
+    v2 = -EE_ + cbwb
+    v1 = 2.0 * PE + 2.0 * cawb
+    v0 = R2 * k0 + Dl - PP + cawa
+    S = np.abs(R2 * k0) + Dl + PP + np.abs(cawa) + 2 * np.abs(PE) + 2 * np.abs(cawb) + EE_ + np.abs(cbwb)
+    cond = (np.abs(a11) + np.abs(a22) + 2 * np.abs(a12)) ** 2 / det
+    pad = _pad2(S, e, tol.rel_pad) * (1.0 + cond)
+    # tau-interval where w*(tau) = wa + tau wb lies in P (widened)
+    hn, hc = C.af_hn[a[idx]], C.af_hc[a[idx]]
+    gk = np.einsum("nkj,nj->nk", hn, wb)
+    wscale = 1.0 + np.linalg.norm(wa, axis=1) + np.linalg.norm(wb, axis=1)
+    hk = hc - np.einsum("nkj,nj->nk", hn, wa) + (_ETA * wscale * (1.0 + cond * 1e-6))[:, None] \
+        + 4 * e[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = hk / gk
+    upper = np.where(gk > 0, ratio, np.inf).min(axis=1)
+    lower = np.where(gk < 0, ratio, -np.inf).max(axis=1)
+    empty = ((gk == 0) & (hk < 0)).any(axis=1)
+    lo = np.maximum(lower, -_ETA)
+    hi = np.minimum(upper, 1.0 + _ETA)
+    ok = (~empty) & (lo <= hi)
+    lo_c, hi_c = np.where(ok, lo, 0.0), np.where(ok, hi, 0.0)
+
+    def V(t):
+        return v0 + v1 * t + v2 * t * t
+
+    best = np.maximum(V(lo_c), V(hi_c))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tv = -v1 / (2.0 * v2)
+    inv = (v2 < 0) & (tv >= lo_c) & (tv <= hi_c)
+    best = np.where(inv, np.maximum(best, V(np.where(inv, tv, 0.0))), best)
+    fire[idx] |= ok & (best >= -pad)
+    return fire
+
+
+def _clip_interval(g: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Intersect [lo, hi] with {s : g_k s <= h_k for all k} (rows (n, k)); returns lo, hi, empty."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = h / g
+    upper = np.where(g > 0, ratio, np.inf).min(axis=1)
+    lower = np.where(g < 0, ratio, -np.inf).max(axis=1)
+    empty = ((g == 0) & (h < 0)).any(axis=1)
+    lo = np.maximum(lo, lower)
+    hi = np.minimum(hi, upper)
+    return lo, hi, empty | (lo > hi)
+
+
+def _kernel_EF(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
+    """Edge of A (at the centre pose) meets polygon G: s-range in the slab |h| <= e, clipped by G."""
+    L, p = ball.L[it], ball.p[it]
+    Y0 = _apply(L, p, C.ae_v0[a])
+    D = np.einsum("nij,nj->ni", L, C.ae_d[a])
+    n, o = C.bf_n[b], C.bf_o[b]
+    h0 = _dot(Y0 - o, n)
+    dh = _dot(D, n)
+    e = 4 * ball.eps[it]
+    # slab: -e <= h0 + s dh <= e
+    g = np.stack([dh, -dh], axis=1)
+    h = np.stack([e - h0, e + h0], axis=1)
+    lo, hi, empty = _clip_interval(g, h, np.full(len(h0), -_ETA), np.full(len(h0), 1 + _ETA))
+    w0 = np.einsum("ni,nik->nk", Y0 - o, C.bf_U[b])
+    dw = np.einsum("ni,nik->nk", D, C.bf_U[b])
+    hn, hc = C.bf_hn[b], C.bf_hc[b]
+    gk = np.einsum("nkj,nj->nk", hn, dw)
+    hk = hc - np.einsum("nkj,nj->nk", hn, w0) + e[:, None]
+    lo2, hi2, empty2 = _clip_interval(gk, hk, lo, hi)
+    return ~empty & ~empty2
+
+
+def _evaluate(C: _Concat, T: _Tables, unit_item: np.ndarray, unit_id: np.ndarray, ball: _Ball,
+              tol: Tolerances) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Evaluate the rows of the active units (deduplicated per item); returns per-unit fired."""
+    ptr = T.unit_ptr
+    cnt = ptr[unit_id + 1] - ptr[unit_id]
+    rep_item = np.repeat(unit_item, cnt)
+    seg_start = np.repeat(ptr[unit_id] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
+    row_g = T.unit_rows[np.arange(cnt.sum()) + seg_start]
+    key = rep_item * np.int64(T.n_rows) + row_g
+    ukey, inv = np.unique(key, return_inverse=True)
+    u_item = ukey // T.n_rows
+    u_row = ukey % T.n_rows
+    fired = np.zeros(len(ukey), bool)
+    for t in _TYPES:
+        lo, hi = T.row_start[t], T.row_start[t] + len(T.rows[t]["pair"])
+        sel = np.nonzero((u_row >= lo) & (u_row < hi))[0]
+        if not len(sel):
+            continue
+        r = u_row[sel] - lo
+        it = u_item[sel]
+        cols = T.rows[t]
+        if t == "VF":
+            fired[sel] = _kernel_VF(C, it, cols["a"][r], cols["b"][r], ball, tol)
+        elif t == "EE":
+            fired[sel] = _kernel_EE(C, it, cols["a"][r], cols["b"][r], ball, tol)
+        elif t == "FE":
+            fired[sel] = _kernel_FE(C, it, cols["a"][r], cols["b"][r], ball, tol)
+        elif t == "EF":
+            fired[sel] = _kernel_EF(C, it, cols["a"][r], cols["b"][r], ball, tol)
+        else:
+            fired[sel] = _kernel_VH(C, it, cols["a"][r], cols["pair"][r], ball, tol)
+    fired_rows = fired[inv]
+    seg = np.concatenate([[0], np.cumsum(cnt)[:-1]]).astype(np.int64)
+    unit_fired = np.zeros(len(cnt), bool)
+    nz = cnt > 0
+    if nz.any():
+        unit_fired[nz] = np.logical_or.reduceat(fired_rows, seg[nz])
+    return unit_fired, cnt, u_item, len(ukey)
+
+
+def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
+                   tolerances: Tolerances = DEFAULT) -> np.ndarray:
+    """One ball test of one pair: which units' fat A-feature meets B (for tests and tools).
+
+    Args:
+        pd: pair data from :func:`prepare_pair` (or built from feature sets).
+        L: (3, 3) linear part of the centre g (A body frame -> B frame); p: (3,).
+        R: ball radius (metric of ``pd.A.metric``), used as given (no padding).
+
+    Returns:
+        (n_units,) bool, in the order of ``pd.A.units x pd.B.units`` (or A vertices for a half-space).
+    """
+    C = _Concat([pd])
+    T = _build_tables([pd], C)
+    tol = tolerances
+    eps = np.array([tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
+        pd.A.extent + pd.B.extent + float(np.linalg.norm(p)) + 1.0)])
+    ball = _Ball(np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)]),
+                 np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
+    uid = T.pair_units[0]
+    uf, *_ = _evaluate(C, T, np.zeros(len(uid), np.int64), uid, ball, tol)
+    return uf
+
+
+# ============================================================================ driver
+
+
+@dataclass
+class _Frontier:
+    pair: np.ndarray      # (N,)
+    t0: np.ndarray        # (N,)
+    t1: np.ndarray
+    depth: np.ndarray
+    unit_item: np.ndarray  # (K,) index into items
+    unit_id: np.ndarray    # (K,) global unit id
+    extra: Any = None      # ball-provider state per item (e.g. Bézier control points)
+
+
+class BallProvider:
+    """Interface: per-item g = (L (N,3,3), p (N,3)) and radius R (N,) for a frontier."""
+
+    def balls(self, fr: _Frontier) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    def split(self, fr: _Frontier, keep: np.ndarray) -> Any:
+        """Per-child extra state for items ``keep`` (children ordered [left..., right...])."""
+        return None
+
+
+@dataclass
+class SubdivisionResult:
+    """Per-pair result of :func:`subdivide`."""
+
+    intervals: list[list[tuple[float, float]]]
+    unit_tests: np.ndarray   # per pair: (unit, item) evaluations ("polygon vs fat polygon")
+    row_tests: np.ndarray    # per pair: elementary row evaluations
+    max_depth: np.ndarray
+    items: np.ndarray        # per pair: ball tests (items evaluated)
+    exhausted: bool
+
+
+def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: float, epsilon: float,
+              tolerances: Tolerances = DEFAULT, budget: Budget | None = None,
+              active: np.ndarray | None = None, extra0: Any = None) -> SubdivisionResult:
+    """Breadth-first subdivision over all pairs (Listings 1-2, Remark 2 pruning)."""
+    tol = tolerances
+    C = _Concat(pairs)
+    T = _build_tables(pairs, C)
+    npair = len(pairs)
+    idx_pairs = np.arange(npair) if active is None else np.nonzero(active)[0]
+    rho_max = np.array([pd.A.rho_max for pd in pairs]) * (1.0 + 1e-12)
+    r_pair = np.array([pd.r for pd in pairs], float)
+    extent = np.array([pd.A.extent + pd.B.extent for pd in pairs], float)
+    units_i = [T.pair_units[i] for i in idx_pairs]
+    fr = _Frontier(idx_pairs.astype(np.int64), np.full(len(idx_pairs), t0), np.full(len(idx_pairs), t1),
+                   np.zeros(len(idx_pairs), np.int64),
+                   np.repeat(np.arange(len(idx_pairs)), [len(u) for u in units_i]).astype(np.int64),
+                   np.concatenate(units_i) if units_i else np.zeros(0, np.int64), extra0)
+    intervals: list[list[tuple[float, float]]] = [[] for _ in range(npair)]
+    unit_tests = np.zeros(npair, np.int64)
+    row_tests = np.zeros(npair, np.int64)
+    items_n = np.zeros(npair, np.int64)
+    max_depth = np.zeros(npair, np.int64)
+    exhausted = False
+    while len(fr.pair):
+        if budget is not None and budget.exhausted:
+            exhausted = True
+            for i in range(len(fr.pair)):
+                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            break
+        N = len(fr.pair)
+        np.maximum.at(max_depth, fr.pair, fr.depth)
+        L, p, R = provider.balls(fr)
+        R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
+        eps_pos = tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
+            extent[fr.pair] + np.linalg.norm(p, axis=1) + 1.0)
+        ball = _Ball(L, p, R, rho_max[fr.pair], r_pair[fr.pair], eps_pos, tol)
+        unit_fired, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item, fr.unit_id, ball, tol)
+        np.add.at(row_tests, fr.pair[u_item], 1)
+        np.add.at(unit_tests, fr.pair[fr.unit_item], 1)
+        np.add.at(items_n, fr.pair, 1)
+        if budget is not None:
+            budget.charge(nrow)
+        item_fired = np.zeros(N, bool)
+        item_fired[fr.unit_item[unit_fired]] = True
+        # termination (eq. 11) or depth cap
+        small = R * rho_max[fr.pair] < epsilon
+        stop = item_fired & (small | (fr.depth >= tol.max_depth))
+        for i in np.nonzero(stop)[0]:
+            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+        go = item_fired & ~stop
+        if not go.any():
+            break
+        keep = np.nonzero(go)[0]
+        newpos = -np.ones(N, np.int64)
+        newpos[keep] = np.arange(len(keep))
+        k = len(keep)
+        uf = unit_fired & go[fr.unit_item]
+        ui, uid = newpos[fr.unit_item[uf]], fr.unit_id[uf]
+        mid = 0.5 * (fr.t0[keep] + fr.t1[keep])
+        extra = provider.split(fr, keep)
+        fr = _Frontier(np.concatenate([fr.pair[keep]] * 2), np.concatenate([fr.t0[keep], mid]),
+                       np.concatenate([mid, fr.t1[keep]]), np.concatenate([fr.depth[keep] + 1] * 2),
+                       np.concatenate([ui, ui + k]), np.concatenate([uid, uid]), extra)
+    for lst in intervals:
+        lst.sort()
+    return SubdivisionResult([_merge(x) for x in intervals], unit_tests, row_tests, max_depth, items_n,
+                             exhausted)
+
+
+def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    out: list[tuple[float, float]] = []
+    for a, b in sorted(iv):
+        if out and a <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
+
+
+# ============================================================================ trajectories
+
+
+class _TrajectoryBalls(BallProvider):
+    """Balls from the certified motion bounds of a Trajectory (relative motion of A in B)."""
+
+    def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric]):
+        self.traj = traj
+        self.ba, self.bb = body_a, body_b
+        self.ref = np.asarray(traj.ref_points, float)
+        self.mp = [m.points for m in metrics]
+        self.mw = [m.weights for m in metrics]
+        self.mp_off = np.cumsum([0] + [len(x) for x in self.mp])
+        self.mp_all = np.concatenate(self.mp)
+        self.mw_all = np.concatenate(self.mw)
+
+    def balls(self, fr: _Frontier):
+        mids = 0.5 * (fr.t0 + fr.t1)
+        pos, rot = self.traj.body_poses(mids)
+        mb = self.traj.motion_bounds(fr.t0, fr.t1)
+        n = np.arange(len(mids))
+        a, b = self.ba[fr.pair], self.bb[fr.pair]
+        Ra, pa = rot[n, a], pos[n, a]
+        Rb, pb = rot[n, b], pos[n, b]
+        L = np.einsum("nji,njk->nik", Rb, Ra)
+        p = np.einsum("nji,nj->ni", Rb, pa - pb)
+        # per feature point displacement bound of the relative motion (design doc)
+        cnt = self.mp_off[fr.pair + 1] - self.mp_off[fr.pair]
+        item = np.repeat(n, cnt)
+        start = np.repeat(self.mp_off[fr.pair] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
+        j = np.arange(cnt.sum()) + start
+        m = self.mp_all[j]
+        w = self.mw_all[j]
+        TA, AA = mb.trans[item, a[item]], mb.angle[item, a[item]]
+        TB, AB = mb.trans[item, b[item]], mb.angle[item, b[item]]
+        cA, cB = self.ref[a[item]], self.ref[b[item]]
+        mB = np.einsum("nij,nj->ni", L[item], m) + p[item]
+        d = (TA + chord(AA) * np.linalg.norm(m - cA, axis=1)
+             + TB + chord(AB) * np.linalg.norm(mB - cB, axis=1))
+        d = d * (1.0 + 8 * DEFAULT.rel_pad)
+        R2 = np.bincount(item, weights=w * d * d, minlength=len(mids))
+        return L, p, np.sqrt(R2)
+
+
+def _orient(shape_a: ConvexShape, body_a: int, shape_b: ConvexShape, body_b: int,
+            static: np.ndarray | None) -> bool:
+    """True if A and B must be swapped (B = half-space, or the static body, is the fixed side)."""
+    if shape_a.kind == "halfspace":
+        return True
+    if shape_b.kind == "halfspace":
+        return False
+    if static is not None and static[body_a] and not static[body_b]:
+        return True
+    return False
+
+
+def prepare_pair(shape_a: ConvexShape, shape_b: ConvexShape, margin: float,
+                 tolerances: Tolerances = DEFAULT) -> _PairData:
+    """Feature sets and inflation radius r of (moving A, fixed B)."""
+    r = float(shape_a.radius) + float(shape_b.radius) + float(margin)
+    return _PairData(moving_features(shape_a), fixed_features(shape_b), r + tolerances.pad(r))
+
+
+def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShape, int]],
+                window: tuple[float, float], margin: float, epsilon: float,
+                tolerances: Tolerances = DEFAULT, budget: Budget | None = None, *,
+                static: np.ndarray | None = None, check_start: bool = True) -> list[PairOutcome]:
+    """Toleranced-ball check of shape pairs under a trajectory.
+
+    Args:
+        traj: the motion (Trajectory protocol; only body_poses / motion_bounds are used).
+        items: (shape_a, body_a, shape_b, body_b) per pair, shapes in their body frames.
+        window: (t0, t1) seconds.
+        margin: clearance (m) that counts as safe.
+        epsilon: termination tolerance (m): stop when R * rho_max < epsilon.
+        tolerances: pads and max depth.
+        budget: optional work limit; when exhausted the unfinished pairs are unresolved.
+        static: optional (nbody,) bool; a static body is chosen as the fixed side.
+        check_start: run the exact static test at t0 for solid pairs (containment is
+            invisible to boundary tests). The engine does it itself and passes False.
+
+    Returns:
+        One :class:`PairOutcome` per item: ``"certified"`` or ``"unresolved"`` (the engine
+        turns unresolved intervals into witnesses). ``info`` holds ``unit_tests``,
+        ``row_tests``, ``items`` and ``swapped``.
+    """
+    t0, t1 = float(window[0]), float(window[1])
+    pds, ba, bb, swapped = [], [], [], []
+    for sa, a, sb, b in items:
+        sw = _orient(sa, a, sb, b, static)
+        if sw:
+            sa, a, sb, b = sb, b, sa, a
+        pds.append(prepare_pair(sa, sb, margin, tolerances))
+        ba.append(a)
+        bb.append(b)
+        swapped.append(sw)
+    outs: list[PairOutcome | None] = [None] * len(items)
+    active = np.ones(len(items), bool)
+    if check_start:
+        from monitor.geometry.distance import shape_distance
+        pos, rot = traj.body_poses(np.array([t0]))
+        for i, (sa, a, sb, b) in enumerate(items):
+            if sa.kind != "polytope" and sb.kind != "polytope":
+                continue
+            if "halfspace" in (sa.kind, sb.kind):
+                continue
+            res = shape_distance(sa, (rot[0, a], pos[0, a]), sb, (rot[0, b], pos[0, b]),
+                                 tolerances=tolerances)
+            if res.lower + sa.radius + sb.radius <= 0.0 and res.lower <= margin:
+                outs[i] = PairOutcome("unresolved", intervals=[(t0, t0)],
+                                      info={"start_overlap": True, "start_upper": res.upper})
+                active[i] = False
+    if active.any():
+        prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds])
+        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active)
+        for i in np.nonzero(active)[0]:
+            iv = res.intervals[i]
+            outs[i] = PairOutcome(
+                "certified" if not iv else "unresolved", tests=int(res.row_tests[i]),
+                max_depth=int(res.max_depth[i]), intervals=iv,
+                clearance=float(margin) if not iv else float("-inf"),
+                info={"unit_tests": int(res.unit_tests[i]), "row_tests": int(res.row_tests[i]),
+                      "items": int(res.items[i]), "swapped": bool(swapped[i]),
+                      "budget_exhausted": bool(res.exhausted)})
+    return outs  # type: ignore[return-value]
+
+
+__all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
+           "subdivide", "check_pairs", "BallProvider", "SubdivisionResult"]
