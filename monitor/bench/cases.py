@@ -1,0 +1,461 @@
+"""The fixed, seeded pair-window case set of the accuracy and peer suites.
+
+A case is two convex bodies ``A`` and ``B`` over one window ``[0, T]``. Each body
+moves along ONE segment: its origin is linearly interpolated and its orientation
+slerped (constant angular velocity about a fixed axis, angle < pi) between two
+poses. This is exactly :class:`monitor.BodyMotion` with two waypoints and exactly
+python-fcl's ``CCDM_LINEAR`` interpolated motion (rotation about the object
+origin), so every peer that takes start and end poses sees the true motion.
+
+Each geom sits at its body origin with identity orientation, so body-frame and
+geom-frame coordinates coincide for all consumers (MJCF, python-fcl, ipctk,
+``monitor.geometry``).
+
+Cases come in two groups, ``"translating"`` (no rotation; the extrusion checker
+and the exact LP oracle apply) and ``"rotating"``, and three intents:
+``"collide"`` (paths cross), ``"near"`` (designed minimum clearance ``c``, from
+1e-1 down to 1e-5 m) and ``"clear"`` (about 0.2 m). The intent is only how the
+case was built; the label used for scoring comes from :mod:`monitor.bench.oracle`.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.spatial import ConvexHull
+from scipy.spatial.transform import Rotation
+
+NEAR_CLEARANCES_FULL = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
+NEAR_CLEARANCES_QUICK = (1e-2, 1e-3, 1e-4)
+CLEAR_DISTANCE = 0.2
+"""Designed minimum clearance (m) of the ``"clear"`` cases."""
+
+
+@dataclass(frozen=True, eq=False)
+class ShapeSpec:
+    """One convex geom at its body origin.
+
+    Attributes:
+        kind: ``"box" | "hull" | "sphere" | "capsule" | "cylinder" | "ellipsoid"``.
+        vertices: (n, 3) body-frame vertices (m) for box/hull; (0, 3) otherwise.
+        half_extents: (3,) box / ellipsoid half sizes (m), or zeros.
+        radius: sphere/capsule/cylinder radius (m).
+        half_length: capsule/cylinder half length along body z (m).
+    """
+
+    kind: str
+    vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    half_extents: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    radius: float = 0.0
+    half_length: float = 0.0
+
+    @staticmethod
+    def box(half_extents: np.ndarray) -> ShapeSpec:
+        """A box with half sizes ``half_extents`` (3,) m."""
+        h = np.asarray(half_extents, float)
+        v = np.array(
+            [[sx * h[0], sy * h[1], sz * h[2]] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+        )
+        return ShapeSpec("box", v, h)
+
+    @staticmethod
+    def hull(points: np.ndarray) -> ShapeSpec:
+        """The convex hull of ``points`` (n, 3) m (only hull vertices are kept)."""
+        p = np.asarray(points, float)
+        return ShapeSpec("hull", p[ConvexHull(p).vertices])
+
+    @property
+    def is_polytope(self) -> bool:
+        """True for box and hull (triangle meshes exist)."""
+        return self.kind in ("box", "hull")
+
+    @functools.cached_property
+    def triangles(self) -> np.ndarray:
+        """(m, 3) int32 hull triangles (indices into ``vertices``); polytopes only."""
+        hull = ConvexHull(self.vertices)
+        tri = hull.simplices.astype(np.int32).copy()
+        # Orient counter-clockwise seen from outside (outward normals).
+        a, b, c = (self.vertices[tri[:, k]] for k in range(3))
+        out = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - self.vertices.mean(axis=0)) < 0
+        tri[out] = tri[out][:, ::-1]
+        return tri
+
+    @property
+    def max_radius(self) -> float:
+        """Largest distance (m) of a shape point from the body origin."""
+        if self.is_polytope:
+            return float(np.linalg.norm(self.vertices, axis=1).max())
+        if self.kind == "ellipsoid":
+            return float(self.half_extents.max())
+        if self.kind == "cylinder":
+            return float(np.hypot(self.radius, self.half_length))
+        return self.half_length + self.radius
+
+    @property
+    def size(self) -> float:
+        """A characteristic size (m): the smallest half extent / radius."""
+        if self.kind == "box":
+            return float(self.half_extents.min())
+        if self.kind == "hull":
+            return float(np.ptp(self.vertices, axis=0).min() / 2)
+        return self.radius
+
+    def mjcf(self, name: str) -> tuple[str, str]:
+        """(asset XML, geom XML) for a geom named ``name`` at its body origin."""
+        if self.kind == "box":
+            h = " ".join(f"{x:.17g}" for x in self.half_extents)
+            return "", f'<geom name="{name}" type="box" size="{h}"/>'
+        if self.kind == "sphere":
+            return "", f'<geom name="{name}" type="sphere" size="{self.radius:.17g}"/>'
+        if self.kind in ("capsule", "cylinder"):
+            return "", (
+                f'<geom name="{name}" type="{self.kind}" size="{self.radius:.17g} {self.half_length:.17g}"/>'
+            )
+        if self.kind == "ellipsoid":
+            h = " ".join(f"{x:.17g}" for x in self.half_extents)
+            return "", f'<geom name="{name}" type="ellipsoid" size="{h}"/>'
+        v = " ".join(f"{x:.17g}" for x in self.vertices.ravel())
+        return (
+            f'<mesh name="{name}_mesh" vertex="{v}"/>',
+            f'<geom name="{name}" type="mesh" mesh="{name}_mesh"/>',
+        )
+
+    def convex_shape(self, facets: int = 16):
+        """The :class:`monitor.geometry.shapes.ConvexShape` of this geom (body frame).
+
+        Cylinders and ellipsoids are circumscribed polytopes with ``facets``.
+        """
+        from monitor.geometry import polytope
+
+        if self.kind == "cylinder":
+            return polytope.cylinder_polytope(self.radius, self.half_length, facets)
+        if self.kind == "ellipsoid":
+            return polytope.ellipsoid_polytope(self.half_extents, facets)
+        if self.kind == "box":
+            return polytope.box_polytope(self.half_extents)
+        if self.kind == "hull":
+            return polytope.polytope_from_points(self.vertices)
+        if self.kind == "sphere":
+            return polytope.sphere_shape(self.radius)
+        return polytope.capsule_shape(self.radius, self.half_length)
+
+    def to_dict(self) -> dict:
+        """JSON form (for results.json)."""
+        return {
+            "kind": self.kind,
+            "vertices": self.vertices.tolist(),
+            "half_extents": self.half_extents.tolist(),
+            "radius": self.radius,
+            "half_length": self.half_length,
+        }
+
+
+def slerp_matrices(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Rotation matrices (N, 3, 3) of the slerp from q0 to q1 (w, x, y, z; q0.q1 >= 0) at s (N,)."""
+    q0 = q0 / np.linalg.norm(q0)
+    q1 = q1 / np.linalg.norm(q1)
+    c = float(np.clip(q0 @ q1, -1.0, 1.0))
+    th = np.arccos(c)
+    if th < 1e-9:
+        q = q0[None] + s[:, None] * (q1 - q0)[None]
+    else:
+        q = (np.sin((1 - s) * th)[:, None] * q0 + np.sin(s * th)[:, None] * q1) / np.sin(th)
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    return Rotation.from_quat(q, scalar_first=True).as_matrix().reshape(-1, 3, 3)
+
+
+@dataclass(eq=False)
+class PairCase:
+    """Two bodies, one lerp/slerp segment each, window ``[0, duration]`` s.
+
+    Attributes:
+        name: unique case name.
+        group: ``"translating" | "rotating"``.
+        intent: ``"collide" | "near" | "clear"`` (how it was built, not the label).
+        nominal: designed minimum distance (m), approximate; negative for collide.
+        shapes: (A, B) :class:`ShapeSpec`.
+        pos: (2, 2, 3) body origin positions [body, waypoint] (m, world).
+        quat: (2, 2, 4) body orientations (w, x, y, z) [body, waypoint].
+        moving: (2,) bool; a non-moving body is welded to the world in the MJCF.
+        duration: window length T (s).
+    """
+
+    name: str
+    group: str
+    intent: str
+    nominal: float
+    shapes: tuple[ShapeSpec, ShapeSpec]
+    pos: np.ndarray
+    quat: np.ndarray
+    moving: tuple[bool, bool]
+    duration: float = 1.0
+
+    # ----------------------------------------------------------------- motion
+    def poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Exact world poses at ``times`` (N,) s: positions (N, 2, 3), rotations (N, 2, 3, 3)."""
+        s = np.clip(np.asarray(times, float).reshape(-1) / self.duration, 0.0, 1.0)
+        P = self.pos[None, :, 0, :] + s[:, None, None] * (self.pos[None, :, 1, :] - self.pos[None, :, 0, :])
+        R = np.stack([slerp_matrices(self.quat[b, 0], self.quat[b, 1], s) for b in range(2)], axis=1)
+        return P, R
+
+    def angles(self) -> np.ndarray:
+        """(2,) rotation angle (rad) of each body over the window."""
+        out = np.zeros(2)
+        for b in range(2):
+            r = Rotation.from_quat(self.quat[b], scalar_first=True)
+            out[b] = (r[1] * r[0].inv()).magnitude()
+        return out
+
+    def speed_bounds(self) -> np.ndarray:
+        """(2,) bound (m/s) on the speed of any point of each body's shape.
+
+        A point p (body frame) moves with velocity v + omega x R p, so its speed is
+        at most |v| + |omega| max|p|, with v and omega constant over the segment.
+        Padded by 1e-12 relative for rounding.
+        """
+        v = np.linalg.norm(self.pos[:, 1] - self.pos[:, 0], axis=1) / self.duration
+        w = self.angles() / self.duration
+        r = np.array([s.max_radius for s in self.shapes])
+        return (v + w * r) * (1 + 1e-12) + 1e-15
+
+    def velocities(self) -> np.ndarray:
+        """(2, 3) constant origin velocities (m/s)."""
+        return (self.pos[:, 1] - self.pos[:, 0]) / self.duration
+
+    # ----------------------------------------------------------------- MuJoCo
+    def mjcf(self) -> str:
+        """An MJCF scene: bodies ``A`` and ``B`` (free joint if moving), geoms ``gA``, ``gB``."""
+        assets, bodies = [], []
+        for b, nm in enumerate("AB"):
+            asset, geom = self.shapes[b].mjcf(f"g{nm}")
+            if asset:
+                assets.append(asset)
+            p = " ".join(f"{x:.17g}" for x in self.pos[b, 0])
+            q = " ".join(f"{x:.17g}" for x in self.quat[b, 0])
+            joint = f'<freejoint name="j{nm}"/>' if self.moving[b] else ""
+            bodies.append(f'<body name="{nm}" pos="{p}" quat="{q}">{joint}{geom}</body>')
+        return (
+            '<mujoco model="bench_case"><option gravity="0 0 0"/>'
+            f"<asset>{''.join(assets)}</asset>"
+            f"<worldbody>{''.join(bodies)}</worldbody></mujoco>"
+        )
+
+    @functools.cached_property
+    def model(self):
+        """The compiled ``mujoco.MjModel`` of :meth:`mjcf` (cached)."""
+        import mujoco
+
+        return mujoco.MjModel.from_xml_string(self.mjcf())
+
+    def qpos(self, times: np.ndarray) -> np.ndarray:
+        """(N, nq) free-joint coordinates of the moving bodies at ``times``."""
+        P, R = self.poses(times)
+        Q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(scalar_first=True).reshape(len(P), 2, 4)
+        cols = [np.concatenate([P[:, b], Q[:, b]], axis=1) for b in range(2) if self.moving[b]]
+        return np.concatenate(cols, axis=1)
+
+    def body_motion(self):
+        """The exact motion as a :class:`monitor.BodyMotion` over (world, A, B)."""
+        from monitor import BodyMotion
+
+        pos = np.zeros((2, 3, 3))
+        quat = np.zeros((2, 3, 4))
+        quat[:, 0, 0] = 1.0
+        for b in range(2):
+            pos[:, b + 1] = self.pos[b]
+            quat[:, b + 1] = self.quat[b]
+        return BodyMotion(np.array([0.0, self.duration]), pos, quat)
+
+    def scene(self, facets: int = 16):
+        """``monitor.Scene`` of :attr:`model` with all pairs (one candidate pair)."""
+        return _scene(self, facets)
+
+    def to_dict(self) -> dict:
+        """JSON form (for results.json)."""
+        return {
+            "name": self.name,
+            "group": self.group,
+            "intent": self.intent,
+            "nominal": self.nominal,
+            "shapes": [s.kind for s in self.shapes],
+            "pos": self.pos.tolist(),
+            "quat": self.quat.tolist(),
+            "moving": list(self.moving),
+            "duration": self.duration,
+        }
+
+
+@functools.lru_cache(maxsize=512)
+def _scene(case: PairCase, facets: int):
+    from monitor import Scene
+
+    return Scene.from_model(case.model, pairs="all", facets=facets)
+
+
+# --------------------------------------------------------------------------- building
+def _random_shape(rng: np.random.Generator, kind: str) -> ShapeSpec:
+    if kind == "box":
+        return ShapeSpec.box(rng.uniform(0.05, 0.25, 3))
+    if kind == "hull":
+        d = rng.normal(size=(14, 3))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return ShapeSpec.hull(d * rng.uniform(0.08, 0.22, (14, 1)) * rng.uniform(0.6, 1.0, 3))
+    if kind == "sphere":
+        return ShapeSpec("sphere", radius=float(rng.uniform(0.05, 0.2)))
+    return ShapeSpec(
+        "capsule", radius=float(rng.uniform(0.04, 0.1)), half_length=float(rng.uniform(0.05, 0.2))
+    )
+
+
+def _unit(rng: np.random.Generator) -> np.ndarray:
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def _random_quat(rng: np.random.Generator) -> np.ndarray:
+    return Rotation.random(random_state=rng).as_quat(scalar_first=True)
+
+
+def min_distance(case: PairCase, dist: Callable[[PairCase, float], float], samples: int = 40) -> float:
+    """Approximate minimum over the window of ``dist(case, t)`` (m): sampling + local refinement."""
+    ts = np.linspace(0.0, case.duration, samples)
+    d = np.array([dist(case, t) for t in ts])
+    best = float(d.min())
+    h = ts[1] - ts[0]
+    for i in np.argsort(d)[:2]:
+        lo, hi = max(0.0, ts[i] - h), min(case.duration, ts[i] + h)
+        r = minimize_scalar(
+            lambda t: dist(case, t),
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-12 * case.duration},
+        )
+        best = min(best, float(r.fun))
+    return best
+
+
+def _shifted(case: PairCase, w: np.ndarray, s: float) -> PairCase:
+    pos = case.pos.copy()
+    pos[0] += s * w
+    out = PairCase(
+        case.name,
+        case.group,
+        case.intent,
+        case.nominal,
+        case.shapes,
+        pos,
+        case.quat,
+        case.moving,
+        case.duration,
+    )
+    if "model" in case.__dict__:  # A always moves (free joint), so the compiled model is shared
+        out.__dict__["model"] = case.__dict__["model"]
+    return out
+
+
+def _place(case: PairCase, w: np.ndarray, target: float, dist) -> PairCase:
+    """Shift A's path along ``w`` so that its minimum distance is ``target`` (bisection)."""
+    if target <= 0:
+        return case
+    case.model  # noqa: B018  compile once; shifted copies share it
+    lo, hi = 0.0, case.shapes[0].max_radius + case.shapes[1].max_radius + target + 0.05
+    f_lo = min_distance(_shifted(case, w, lo), dist) - target
+    f_hi = min_distance(_shifted(case, w, hi), dist) - target
+    side = 0
+    s = hi
+    for _ in range(60):  # regula falsi (Illinois) on the bracket [lo, hi]
+        s = hi - f_hi * (hi - lo) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo + hi)
+        if not lo < s < hi:
+            s = 0.5 * (lo + hi)
+        f = min_distance(_shifted(case, w, s), dist) - target
+        if abs(f) <= 0.02 * target:
+            break
+        if f < 0:
+            lo, f_lo = s, f
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        else:
+            hi, f_hi = s, f
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+    out = _shifted(case, w, s)
+    out.nominal = min_distance(out, dist)
+    return out
+
+
+def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
+    """Build the seeded case set.
+
+    Args:
+        seed: RNG seed (the case set is a pure function of seed and quick).
+        quick: fewer shape combinations and clearances.
+        dist: static distance ``dist(case, t) -> float`` used to place near-misses
+            (default: MuJoCo's ``mj_geomDistance``, fast; placement only needs to be
+            approximate, the oracle labels every case rigorously afterwards).
+
+    Returns:
+        list of :class:`PairCase`, names unique.
+    """
+    if dist is None:
+        from monitor.bench.oracle import mujoco_distance as dist
+    rng = np.random.default_rng(seed)
+    combos = [("box", "box"), ("hull", "box"), ("hull", "hull"), ("capsule", "box"), ("sphere", "hull")]
+    clearances = NEAR_CLEARANCES_QUICK if quick else NEAR_CLEARANCES_FULL
+    if quick:
+        combos = [("box", "box"), ("hull", "box"), ("capsule", "box")]
+    cases: list[PairCase] = []
+    for group in ("translating", "rotating"):
+        for ka, kb in combos:
+            intents = [("collide", -1.0)] + [("near", c) for c in clearances] + [("clear", CLEAR_DISTANCE)]
+            for k, (intent, c) in enumerate(intents):
+                both = bool(k % 2)
+                shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
+                u = _unit(rng)
+                w = np.cross(u, _unit(rng))
+                w /= np.linalg.norm(w)
+                travel = rng.uniform(0.5, 0.9)
+                pos = np.zeros((2, 2, 3))
+                pos[0, 0], pos[0, 1] = -travel * u, travel * u
+                quat = np.zeros((2, 2, 4))
+                qa, qb = _random_quat(rng), _random_quat(rng)
+                quat[0, :] = qa
+                quat[1, :] = qb
+                if group == "rotating":
+                    ang = rng.uniform(0.5, 2.5)
+                    ra = Rotation.from_rotvec(ang * _unit(rng)) * Rotation.from_quat(qa, scalar_first=True)
+                    quat[0, 1] = ra.as_quat(scalar_first=True)
+                if both:
+                    pos[1, 1] = 0.15 * _unit(rng)
+                    if group == "rotating":
+                        rb = Rotation.from_rotvec(0.6 * _unit(rng)) * Rotation.from_quat(
+                            qb, scalar_first=True
+                        )
+                        quat[1, 1] = rb.as_quat(scalar_first=True)
+                for b in range(2):  # shortest arc so that slerp angle < pi
+                    if quat[b, 0] @ quat[b, 1] < 0:
+                        quat[b, 1] *= -1
+                name = f"{group[:3]}-{ka}-{kb}-{intent}" + (f"-{c:.0e}" if intent == "near" else "")
+                case = PairCase(name, group, intent, c, shapes, pos, quat, (True, both))
+                if intent != "collide":
+                    case = _place(case, w, c, dist)
+                else:
+                    case.nominal = min_distance(case, dist)
+                cases.append(case)
+    return cases
+
+
+__all__ = [
+    "ShapeSpec",
+    "PairCase",
+    "make_cases",
+    "min_distance",
+    "NEAR_CLEARANCES_FULL",
+    "NEAR_CLEARANCES_QUICK",
+    "CLEAR_DISTANCE",
+]
