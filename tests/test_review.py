@@ -258,3 +258,22 @@ def test_verify_end_to_end_scripted_rollout(tmp_path, capsys):
     # the portable XML attachment gives the same verdicts as the exact MJB
     assert main(["review", "--verify", "--model-source", "xml", str(path)]) == 0
     assert "0 critical" in capsys.readouterr().out
+
+
+def test_gated_rollout_log_verifies(tmp_path, capsys):
+    _engine_or_skip()
+    from monitor.gate import Gate
+
+    model = mujoco.MjModel.from_xml_path(str(ARM))
+    data = mujoco.MjData(model)
+    path = tmp_path / "gate.mcap"
+    rng = np.random.default_rng(11)
+    with Gate(model, margin=0.002, epsilon=1e-3, log=path, frame_skip=5,
+              log_options={"model_source": str(ARM)}) as gate:
+        for _ in range(15):
+            gate.step(data, rng.uniform(model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]))
+    assert main(["review", str(path)]) == 0
+    assert "windows" in capsys.readouterr().out
+    assert main(["review", "--verify", "--json", str(path)]) == 0
+    ver = json.loads(capsys.readouterr().out)["logs"][0]["verify"]
+    assert ver["checked"] >= 15 and ver["mismatches"] == [] and ver["errors"] == []
