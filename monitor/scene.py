@@ -185,7 +185,6 @@ class Scene:
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
-        self.candidate_pairs = tuple((geoms[a].name, geoms[b].name) for a, b in pair_ids.tolist())
         self.body_names = body_names
         self.body_static = body_static
         self.facets = facets
@@ -254,9 +253,13 @@ class Scene:
                     "an explicit pair list without it")
 
         geoms = []
+        cache: dict[tuple, ConvexShape | None] = {}  # identical primitives / meshes share a geom-frame shape
         for g in range(ngeom):
             b = int(model.geom_bodyid[g])
-            shape_G = _geom_shape(model, g, nf, tolerances)
+            key = (int(types[g]), tuple(np.asarray(model.geom_size[g]).tolist()), int(model.geom_dataid[g]))
+            if key not in cache:
+                cache[key] = _geom_shape(model, g, nf, tolerances)
+            shape_G = cache[key]
             shape_B = None
             if shape_G is not None:
                 shape_B = _to_body(shape_G, _quat_to_mat(model.geom_quat[g]),
@@ -309,6 +312,12 @@ class Scene:
         return np.array(sorted(out), dtype=np.int64).reshape(-1, 2)
 
     # ------------------------------------------------------------------ queries
+
+    @cached_property
+    def candidate_pairs(self) -> tuple[tuple[str, str], ...]:
+        """(name_a, name_b) per row of :attr:`pair_ids` (built on first access)."""
+        names = np.array([g.name for g in self.geoms], dtype=object)
+        return tuple(zip(names[self.pair_ids[:, 0]].tolist(), names[self.pair_ids[:, 1]].tolist()))
 
     def geom(self, name_or_id: str | int) -> GeomInfo:
         """The :class:`GeomInfo` of a geom given by name or id.

@@ -27,7 +27,11 @@ so it is sound for certification; the excess is reported in ``approx_error``.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError, cKDTree
 
 from monitor.errors import InvalidInputError
@@ -103,18 +107,20 @@ def _assemble(V: np.ndarray, faces: list[np.ndarray], normals: np.ndarray, conta
     evaluated in float64. Checks the topology: every edge is used by exactly two
     faces in opposite directions and V - E + F == 2.
     """
+    normals = np.asarray(normals, dtype=np.float64)
     offsets = (normals @ np.concatenate([V, contain]).T).max(axis=1)
-    directed: dict[tuple[int, int], int] = {}
-    for loop in faces:
-        for k in range(len(loop)):
-            e = (int(loop[k]), int(loop[(k + 1) % len(loop)]))
-            directed[e] = directed.get(e, 0) + 1
-    ok = all(c == 1 and directed.get((j, i)) == 1 for (i, j), c in directed.items())
-    E = np.array(sorted({(min(i, j), max(i, j)) for i, j in directed}), dtype=np.int64).reshape(-1, 2)
-    if not ok or len(V) - len(E) + len(faces) != 2:
-        raise _BadHull(f"inconsistent hull topology (V={len(V)}, E={len(E)}, F={len(faces)})")
-    return ConvexShape("polytope", V, 0.0, E, tuple(f.astype(np.int64) for f in faces),
-                       np.asarray(normals, dtype=np.float64), offsets, float(approx_error))
+    tails = np.concatenate(faces).astype(np.int64)
+    heads = np.concatenate([np.concatenate([f[1:], f[:1]]) for f in faces]).astype(np.int64)
+    nv = len(V)
+    code = tails * nv + heads
+    uniq = np.unique(code)
+    ok = len(uniq) == len(code) and bool(np.isin(heads * nv + tails, uniq).all())
+    E = np.unique(np.stack([np.minimum(tails, heads), np.maximum(tails, heads)], axis=1), axis=0)
+    if not ok or nv - len(E) + len(faces) != 2:
+        raise _BadHull(f"inconsistent hull topology (V={nv}, E={len(E)}, F={len(faces)})")
+    return ConvexShape("polytope", V, 0.0, E.astype(np.int64).reshape(-1, 2),
+                       tuple(np.asarray(f, dtype=np.int64) for f in faces), normals, offsets,
+                       float(approx_error))
 
 
 class _BadHull(Exception):
@@ -122,57 +128,56 @@ class _BadHull(Exception):
 
 
 def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
-    """Polytope from a full-rank point set (raises QhullError/_BadHull if degenerate)."""
+    """Polytope from a full-rank point set (raises QhullError/_BadHull if degenerate).
+
+    Adjacent qhull triangles whose vertices lie within ``_COPLANAR_REL * scale``
+    of each other's planes form one face (connected components); the face normal
+    is the area-weighted mean of its triangles' outward normals and its loop is
+    its vertices sorted by angle about the face centroid (CCW seen from outside).
+    """
     hull = ConvexHull(P)
-    simp = hull.simplices
-    eq = hull.equations  # (nf, 4): n . x + d <= 0 inside, n outward unit
+    simp = hull.simplices.astype(np.int64)
+    eq = hull.equations  # (nt, 4): n . x + d <= 0 inside, n outward unit
     nrm, d = eq[:, :3], eq[:, 3]
-    tol = _COPLANAR_REL * scale
     nt = len(simp)
+    tol = _COPLANAR_REL * scale
 
-    # union-find over adjacent coplanar triangles
-    parent = np.arange(nt)
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for i in range(nt):
-        for j in hull.neighbors[i]:
-            if j <= i or nrm[i] @ nrm[j] <= 0.0:
-                continue
-            di = np.abs(P[simp[j]] @ nrm[i] + d[i]).max()
-            dj = np.abs(P[simp[i]] @ nrm[j] + d[j]).max()
-            if di <= tol and dj <= tol:
-                ri, rj = find(i), find(j)
-                if ri != rj:
-                    parent[rj] = ri
-    roots = np.array([find(i) for i in range(nt)])
+    ti = np.repeat(np.arange(nt), 3)
+    tj = hull.neighbors.reshape(-1).astype(np.int64)
+    m = (tj > ti) & (np.einsum("ij,ij->i", nrm[ti], nrm[tj]) > 0.0)
+    ti, tj = ti[m], tj[m]
+    dij = np.abs(np.einsum("kvj,kj->kv", P[simp[tj]], nrm[ti]) + d[ti, None]).max(axis=1)
+    dji = np.abs(np.einsum("kvj,kj->kv", P[simp[ti]], nrm[tj]) + d[tj, None]).max(axis=1)
+    m = (dij <= tol) & (dji <= tol)
+    graph = coo_matrix((np.ones(int(m.sum())), (ti[m], tj[m])), shape=(nt, nt))
+    nface, label = connected_components(graph, directed=False)
 
     used = np.unique(simp)
     remap = -np.ones(len(P), np.int64)
     remap[used] = np.arange(len(used))
     V = P[used]
+    T = remap[simp]  # triangles in the new vertex numbering
 
-    faces: list[np.ndarray] = []
-    normals: list[np.ndarray] = []
-    for r in np.unique(roots):
-        tri = np.flatnonzero(roots == r)
-        # area-weighted normal of the group (qhull's normals are outward)
-        a = P[simp[tri, 1]] - P[simp[tri, 0]]
-        b = P[simp[tri, 2]] - P[simp[tri, 0]]
-        area = np.linalg.norm(np.cross(a, b), axis=1)
-        n = (nrm[tri] * area[:, None]).sum(axis=0) if area.sum() > 0 else nrm[tri].sum(axis=0)
-        n /= np.linalg.norm(n)
-        idx = remap[np.unique(simp[tri])]
-        u, w = _plane_basis(n)
-        q = V[idx] - V[idx].mean(axis=0)
-        ang = np.arctan2(q @ w, q @ u)  # CCW about n, i.e. seen from outside
-        faces.append(idx[np.argsort(ang, kind="stable")])
-        normals.append(n)
-    return _assemble(V, faces, np.array(normals), P)
+    area = np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1)
+    N = np.zeros((nface, 3))
+    np.add.at(N, label, nrm * (area + np.finfo(float).tiny)[:, None])
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+
+    inc = np.unique(np.stack([np.repeat(label, 3), T.reshape(-1)], axis=1), axis=0)  # (face, vertex)
+    fl, fv = inc[:, 0], inc[:, 1]
+    cnt = np.bincount(fl, minlength=nface)
+    cen = np.zeros((nface, 3))
+    np.add.at(cen, fl, V[fv])
+    cen /= cnt[:, None]
+    a = np.where((np.abs(N[:, 0]) < 0.9)[:, None], np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    U = np.cross(N, a)
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    W = np.cross(N, U)
+    q = V[fv] - cen[fl]
+    ang = np.arctan2(np.einsum("ij,ij->i", q, W[fl]), np.einsum("ij,ij->i", q, U[fl]))
+    order = np.lexsort((ang, fl))
+    faces = np.split(fv[order], np.cumsum(cnt)[:-1])
+    return _assemble(V, faces, N, P)
 
 
 def _prism(center: np.ndarray, u: np.ndarray, w: np.ndarray, n: np.ndarray, ring: np.ndarray,
@@ -244,7 +249,7 @@ def polytope_from_points(points: np.ndarray, *, thicken: float = 0.0) -> ConvexS
     c = P.mean(axis=0)
     Q = P - c
     if len(P) > 1:
-        _, _, Vt = np.linalg.svd(Q, full_matrices=True)
+        _, _, Vt = np.linalg.svd(Q, full_matrices=len(P) < 3)  # Vt (3, 3) either way
     else:
         Vt = np.eye(3)
     widths = np.ptp(Q @ Vt.T, axis=0)  # extent along each principal direction
@@ -352,9 +357,9 @@ def cylinder_polytope(radius: float, half_length: float, facets: int = DEFAULT.f
     N = _facet_count(facets)
     R = r / np.cos(np.pi / N)
     th = 2.0 * np.pi * np.arange(N) / N
-    ring = np.stack([R * np.cos(th), R * np.sin(th)], axis=1)
-    V = np.concatenate([np.c_[ring, np.full(N, -hl)], np.c_[ring, np.full(N, hl)]])
-    shape = _hull_polytope(V, float(2 * max(R, hl)))
+    ring = np.stack([R * np.cos(th), R * np.sin(th)], axis=1)  # counter-clockwise
+    ex, ey, ez = np.eye(3)
+    shape = _prism(np.zeros(3), ex, ey, ez, ring, -hl, hl, np.zeros((0, 3)), 0.0)
 
     def support(n: np.ndarray) -> np.ndarray:
         return r * np.hypot(n[:, 0], n[:, 1]) + hl * np.abs(n[:, 2])
@@ -399,7 +404,9 @@ def ellipsoid_distance_upper(points: np.ndarray, radii: np.ndarray) -> np.ndarra
     lo = np.zeros(len(Y))
     hi = e.max() * np.linalg.norm(Y, axis=1) + e.max() ** 2
     e2 = e**2
-    for _ in range(200):
+    for _ in range(200):  # stop at relative width ~1e-15: x is projected onto the surface below,
+        if (hi - lo <= 8.0 * np.finfo(float).eps * hi).all():  # so t only needs to be near the root
+            break
         mid = 0.5 * (lo + hi)
         f = (((e * Y) / (mid[:, None] + e2)) ** 2).sum(axis=1) - 1.0
         big = f > 0
@@ -409,6 +416,25 @@ def ellipsoid_distance_upper(points: np.ndarray, radii: np.ndarray) -> np.ndarra
     X /= np.sqrt(((X / e) ** 2).sum(axis=1))[:, None]
     d = np.linalg.norm(Y - X, axis=1)
     return np.where(inside, 0.0, d)
+
+
+@functools.lru_cache(maxsize=32)
+def _unit_sphere_polytope(facets: int) -> ConvexShape:
+    """Tangent-plane polytope of the unit sphere (directions from :func:`_sphere_directions`)."""
+    U = _sphere_directions(facets)
+    hs = HalfspaceIntersection(np.c_[U, -np.ones(len(U))], np.zeros(3))
+    V = hs.intersections
+    # merge near-duplicate vertices (more than three planes through one vertex)
+    keep = np.ones(len(V), bool)
+    for i, j in sorted(cKDTree(V).query_pairs(_DEDUP_REL * 2.0)):
+        if keep[i]:
+            keep[j] = False
+    shape = _hull_polytope(V[keep], 2.0)
+    if len(shape.faces) != len(U):
+        raise AssertionError(f"{len(shape.faces)} faces for {len(U)} tangent planes")  # pragma: no cover
+    for a in (shape.points, shape.normals, shape.offsets, *shape.faces):
+        a.setflags(write=False)
+    return shape
 
 
 def ellipsoid_polytope(radii: np.ndarray, facets: int = DEFAULT.facets,
@@ -434,22 +460,13 @@ def ellipsoid_polytope(radii: np.ndarray, facets: int = DEFAULT.facets,
         raise InvalidInputError(f"radii: expected shape (3,), got {e.shape}")
     for i in range(3):
         _positive(e[i], f"radii[{i}]")
-    N = _facet_count(facets)
-    U = _sphere_directions(N)
-    # plane u . z <= 1 on the unit sphere, z = x / e  ->  (u / e) . x <= 1
-    A = U / e
-    nA = np.linalg.norm(A, axis=1)
-    halfspaces = np.c_[A / nA[:, None], -1.0 / nA]
-    hs = HalfspaceIntersection(halfspaces, np.zeros(3))
-    V = hs.intersections
-    scale = float(2 * e.max())
-    # merge near-duplicate vertices (more than three planes through one vertex)
-    tree = cKDTree(V)
-    keep = np.ones(len(V), bool)
-    for i, j in sorted(tree.query_pairs(_DEDUP_REL * scale)):
-        if keep[i]:
-            keep[j] = False
-    shape = _hull_polytope(V[keep], scale)
+    unit = _unit_sphere_polytope(_facet_count(facets))
+    # x = diag(e) z maps the unit-sphere polytope onto the ellipsoid's: same faces and
+    # orientation (positive diagonal), plane n . z <= o becomes (n / e) . x <= o
+    V = unit.points * e
+    Nrm = unit.normals / e
+    Nrm /= np.linalg.norm(Nrm, axis=1, keepdims=True)
+    shape = _assemble(V, list(unit.faces), Nrm, np.zeros((0, 3)))
 
     def support(n: np.ndarray) -> np.ndarray:
         return np.linalg.norm(n * e, axis=1)
