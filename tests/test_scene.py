@@ -25,7 +25,7 @@ def _reported(model: mujoco.MjModel, data: mujoco.MjData) -> set[tuple[int, int]
     return {tuple(sorted(int(g) for g in c.geom)) for c in data.contact[: data.ncon]}
 
 
-def contact_pairs(path: Path) -> set[tuple[int, int]]:
+def contact_pairs(path: Path | str) -> set[tuple[int, int]]:
     """Geom pairs for which mj_collision reports a contact in either of two overlap setups.
 
     (a) Every geom and <pair> gets a margin (50 m) far above the scene size, at qpos0.
@@ -36,12 +36,17 @@ def contact_pairs(path: Path) -> set[tuple[int, int]]:
     (b) alone could hit the capsule-box piercing defect (reference section 6). MuJoCo never
     reports a pair outside its candidate set, so the union is still a subset of it.
     """
-    a = mujoco.MjModel.from_xml_path(str(path))
+    def fresh():
+        if isinstance(path, Path):
+            return mujoco.MjModel.from_xml_path(str(path))
+        return mujoco.MjModel.from_xml_string(path)
+
+    a = fresh()
     a.geom_margin[:] = 50.0
     a.pair_margin[:] = 100.0
     da = mujoco.MjData(a)
     mujoco.mj_setConst(a, da)
-    b = mujoco.MjModel.from_xml_path(str(path))
+    b = fresh()
     b.geom_margin[:] = 0.05
     b.pair_margin[:] = 0.1
     b.body_pos[:] = 0.0
@@ -425,3 +430,70 @@ def test_maxhullvert_mesh_uses_mujoco_hull(load_asset):
     mj = trimesh.Trimesh(V, tri, process=False)
     assert mj.is_watertight
     assert _polytope_volume(shape) == pytest.approx(abs(mj.volume), rel=1e-10)
+
+
+def _brute_force_mujoco(model):
+    """MuJoCo's static filter rules written out pair by pair (reference section 1.8)."""
+    weld, parent, dof = model.body_weldid, model.body_parentid, model.body_dofnum
+    filterparent = not model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_FILTERPARENT
+    excluded = set(model.exclude_signature.tolist())
+    explicit = {tuple(sorted(p)) for p in zip(model.pair_geom1.tolist(), model.pair_geom2.tolist())}
+    planeish = (TYPES.mjGEOM_PLANE, TYPES.mjGEOM_HFIELD)
+    out = set()
+    for a in range(model.ngeom):
+        for b in range(a + 1, model.ngeom):
+            if model.geom_type[a] in planeish and model.geom_type[b] in planeish:
+                continue
+            if (a, b) in explicit:
+                out.add((a, b))
+                continue
+            ba, bb = model.geom_bodyid[a], model.geom_bodyid[b]
+            wa, wb = weld[ba], weld[bb]
+            if wa == wb or (dof[wa] == 0 and dof[wb] == 0):
+                continue
+            if filterparent and wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+                continue
+            if (min(ba, bb) << 16) + max(ba, bb) in excluded:
+                continue
+            ca, cb = model.geom_contype, model.geom_conaffinity
+            if ca[a] & cb[b] or ca[b] & cb[a]:
+                out.add((a, b))
+    return out
+
+
+@pytest.mark.parametrize("name", PAIR_SCENES)
+def test_vectorised_filter_blocks_match_brute_force(name, monkeypatch):
+    """Row-blocked vectorised filter (tiny blocks forced) equals the rule-by-rule loop."""
+    import monitor.scene as scene_mod
+
+    model = load(ASSETS / name)
+    want = _brute_force_mujoco(model)
+    for chunk in (1, 7, 1 << 20):
+        monkeypatch.setattr(scene_mod, "_CHUNK", chunk)
+        got = {tuple(p) for p in Scene.from_model(model).pair_ids.tolist()}
+        assert got == want, chunk
+
+
+def test_many_bodies_filter_matches_brute_force():
+    """A 120-body scene (random masks, a chain, excludes) against the rule-by-rule loop."""
+    rng = np.random.default_rng(11)
+    parts, excl = [], []
+    for i in range(60):
+        ct, ca = rng.integers(0, 4, 2)
+        parts.append(f'<body name="f{i}" pos="{i * 0.1} 0 0"><freejoint/>'
+                     f'<geom size="0.05" contype="{ct}" conaffinity="{ca}"/></body>')
+    chain = ""
+    for i in range(59, -1, -1):
+        ct, ca = rng.integers(0, 4, 2)
+        chain = (f'<body name="c{i}" pos="0 0 0.1"><joint type="hinge"/>'
+                 f'<geom type="capsule" size="0.02 0.05" contype="{ct}" conaffinity="{ca}"/>{chain}</body>')
+    for _ in range(20):
+        a, b = rng.integers(0, 60, 2)
+        excl.append(f'<exclude body1="f{a}" body2="c{b}"/>')
+    xml = (f'<mujoco><worldbody><geom type="plane" size="5 5 1"/>{"".join(parts)}{chain}</worldbody>'
+           f'<contact>{"".join(excl)}</contact></mujoco>')
+    model = mujoco.MjModel.from_xml_string(xml)
+    got = {tuple(p) for p in Scene.from_model(model).pair_ids.tolist()}
+    assert got == _brute_force_mujoco(model)
+    assert got == contact_pairs(xml)
+    assert len(got) > 500
