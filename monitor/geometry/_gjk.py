@@ -48,6 +48,10 @@ TOUCHING = 1
 OVERLAP = 2
 """A GJK tetrahedron encloses the origin: common point; maybe a negative upper bound."""
 
+KIND_POINT = 0
+KIND_SEGMENT = 1
+KIND_POLYTOPE = 2
+
 OUT_SIZE = 12
 """Layout of the output row: status, estimate, lower, upper, p_a (3), p_b (3), pad, iters."""
 
@@ -277,6 +281,79 @@ def _compact(mask, k, W, IA, IB, lam):
 
 
 @njit(cache=True)
+def _depth_at(V, N, x):
+    """min_i (h_V(N_i) - N_i . x) / |N_i|: the depth of x in the polytope conv(V).
+
+    Exact (up to rounding) when the face normals N are complete; negative outside.
+    """
+    best = np.inf
+    for i in range(N.shape[0]):
+        nn = np.sqrt(_dot(N[i], N[i]))
+        if not nn > 0.0:
+            continue
+        _, h = _support_max(V, N[i])
+        d = (h - _dot(N[i], x)) / nn
+        if d < best:
+            best = d
+    return best
+
+
+@njit(cache=True)
+def _low_dim_depth(V, N, C, x_out):
+    """Deepest point of a point / segment core C (1 or 2 rows) inside the polytope (V, N).
+
+    The depth along the segment, t -> depth(c0 + t (c1 - c0)), is concave and
+    piecewise linear: bisection on the sign of the active face's slope finds its
+    maximum. Returns the depth at the chosen point (written to ``x_out``); any
+    point of C gives a valid bound, so the search accuracy only affects tightness.
+    """
+    x = np.empty(3)
+    e = np.empty(3)
+    for r in range(3):
+        x[r] = C[0, r]
+        e[r] = C[C.shape[0] - 1, r] - C[0, r]
+    best = _depth_at(V, N, x)
+    for r in range(3):
+        x_out[r] = x[r]
+    if C.shape[0] == 1 or _dot(e, e) == 0.0:
+        return best
+    nf = N.shape[0]
+    h = np.empty(nf)
+    nrm = np.empty(nf)
+    for i in range(nf):
+        nrm[i] = np.sqrt(_dot(N[i], N[i]))
+        _, h[i] = _support_max(V, N[i])
+    lo = 0.0
+    hi = 1.0
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        for r in range(3):
+            x[r] = C[0, r] + mid * e[r]
+        dmin = np.inf
+        slope = 0.0
+        for i in range(nf):
+            if not nrm[i] > 0.0:
+                continue
+            d = (h[i] - _dot(N[i], x)) / nrm[i]
+            if d < dmin:
+                dmin = d
+                slope = -_dot(N[i], e) / nrm[i]
+        if slope > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    for t in (1.0, lo, hi):
+        for r in range(3):
+            x[r] = C[0, r] + t * e[r]
+        d = _depth_at(V, N, x)
+        if d > best:
+            best = d
+            for r in range(3):
+                x_out[r] = x[r]
+    return best
+
+
+@njit(cache=True)
 def _tetra_inradius(W, pad_coord, rel_pad):
     """Certified radius r of a ball B(0, r) inside the tetrahedron W (4, 3), or 0.
 
@@ -415,7 +492,7 @@ def _simplex_directions_bound(VA, VB, W, k):
 
 
 @njit(cache=True)
-def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad, abs_pad,
+def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, rel_pad, abs_pad,
                   eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
 
@@ -425,7 +502,7 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad,
         tA, tB: (3,) translations (body -> world).
         EA, EB: (m, 2) int64 edges (vertex index pairs).
         NA, NB: (f, 3) body-frame face normals (empty for point / segment).
-        any_polytope: True if either core is a polytope.
+        kind_a, kind_b: KIND_POINT / KIND_SEGMENT / KIND_POLYTOPE.
         rel_pad, abs_pad: rounding pads (``Tolerances``).
         eps_rel: GJK relative duality-gap tolerance.
         max_iter: GJK iteration cap.
@@ -434,6 +511,8 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad,
             signed distance, metres), p_a (3), p_b (3) in the frame shifted by
             tA (add tA for world), pad, iterations.
     """
+    any_polytope = kind_a == KIND_POLYTOPE or kind_b == KIND_POLYTOPE
+    xc = np.empty(3)
     na = PA.shape[0]
     nb = PB.shape[0]
     VA = np.empty((na, 3))
@@ -596,6 +675,18 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad,
             r_in = _tetra_inradius(W, pad_coord, rel_pad)
             if r_in > 0.0 and -r_in < upper:
                 upper = -r_in
+        if kind_a == KIND_POLYTOPE and kind_b != KIND_POLYTOPE:
+            dep = _low_dim_depth(VA, WNA, VB, xc) - 2.0 * pad
+        elif kind_b == KIND_POLYTOPE and kind_a != KIND_POLYTOPE:
+            dep = _low_dim_depth(VB, WNB, VA, xc) - 2.0 * pad
+        else:
+            dep = 0.0
+        if dep > 0.0 and -dep < upper:
+            # a ball of radius dep about a point of the point / segment core lies in the polytope
+            upper = -dep
+            for r in range(3):
+                pa[r] = xc[r]
+                pb[r] = xc[r]
         est = sat
         if est > upper:
             est = upper
@@ -613,11 +704,11 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, any_polytope, rel_pad,
 
 
 @njit(cache=True)
-def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, any_polytope, rel_pad, abs_pad,
+def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, kind_a, kind_b, rel_pad, abs_pad,
                         eps_rel, max_iter, max_edge_pairs, out):
     """:func:`core_distance` for T poses: RAs (T, 3, 3), tAs (T, 3), ...; out (T, OUT_SIZE)."""
     for t in range(RAs.shape[0]):
-        core_distance(PA, RAs[t], tAs[t], EA, NA, PB, RBs[t], tBs[t], EB, NB, any_polytope,
+        core_distance(PA, RAs[t], tAs[t], EA, NA, PB, RBs[t], tBs[t], EB, NB, kind_a, kind_b,
                       rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out[t])
 
 

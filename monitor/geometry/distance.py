@@ -42,6 +42,8 @@ other pair intersects with infinite depth (``-inf``).
 
 from __future__ import annotations
 
+import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,7 +98,26 @@ class DistanceResult:
 # --------------------------------------------------------------------------- input checks
 
 
-def _check_shape(shape: ConvexShape, name: str) -> None:
+class _Core:
+    """Validated kernel arrays of one shape (cached per shape object)."""
+
+    __slots__ = ("P", "E", "N", "code", "radius", "offset")
+
+    def __init__(self, P, E, N, code, radius, offset=0.0):
+        self.P, self.E, self.N, self.code, self.radius, self.offset = P, E, N, code, radius, offset
+
+
+_CORE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Shape -> _Core. ConvexShape is frozen (identity hashed); its arrays are
+treated as immutable, like everywhere else in monitor."""
+
+
+def _core(shape: ConvexShape, name: str) -> _Core:
+    """Validate ``shape`` once and return its contiguous kernel arrays."""
+    try:
+        return _CORE_CACHE[shape]
+    except (KeyError, TypeError):
+        pass
     if not isinstance(shape, ConvexShape):
         raise InvalidInputError(f"{name}: expected a ConvexShape, got {type(shape).__name__}")
     if shape.kind not in _KINDS:
@@ -109,38 +130,55 @@ def _check_shape(shape: ConvexShape, name: str) -> None:
     r = float(shape.radius)
     if not np.isfinite(r) or r < 0.0:
         raise InvalidInputError(f"{name}.radius must be finite and >= 0, got {shape.radius!r}")
-    if shape.kind == "halfspace" and (np.shape(shape.normals) != (1, 3) or np.shape(shape.offsets) != (1,)):
-        raise InvalidInputError(f"{name}: a half-space needs normals (1, 3) and offsets (1,)")
+    P = np.ascontiguousarray(P, dtype=np.float64)
+    E = np.zeros((0, 2), np.int64)
+    N = np.zeros((0, 3))
+    if shape.kind == "sphere":
+        code = _gjk.KIND_POINT
+        P = P[:1].copy()
+    elif shape.kind == "capsule":
+        if len(P) != 2:
+            raise InvalidInputError(f"{name}: a capsule core needs 2 points, got {len(P)}")
+        code = _gjk.KIND_SEGMENT
+        E = np.array([[0, 1]], dtype=np.int64)
+    elif shape.kind == "polytope":
+        code = _gjk.KIND_POLYTOPE
+        E = np.ascontiguousarray(np.asarray(shape.edges, dtype=np.int64).reshape(-1, 2))
+        N = np.ascontiguousarray(np.asarray(shape.normals, dtype=np.float64).reshape(-1, 3))
+        if len(E) and (E.min() < 0 or E.max() >= len(P)):
+            raise InvalidInputError(f"{name}.edges: vertex index out of range [0, {len(P)})")
+        if not np.isfinite(N).all():
+            raise InvalidInputError(f"{name}.normals: not finite")
+    else:
+        code = -1
+        N = np.ascontiguousarray(np.asarray(shape.normals, dtype=np.float64))
+        off = np.asarray(shape.offsets, dtype=np.float64)
+        if N.shape != (1, 3) or off.shape != (1,) or not (np.isfinite(N).all() and np.isfinite(off).all()):
+            raise InvalidInputError(f"{name}: a half-space needs finite normals (1, 3) and offsets (1,)")
+        if not np.linalg.norm(N[0]) > 0.0:
+            raise InvalidInputError(f"{name}: half-space normal is zero")
+    off0 = float(shape.offsets[0]) if code < 0 else 0.0
+    core = _Core(P, E, N, code, r, off0)
+    try:
+        _CORE_CACHE[shape] = core
+    except TypeError:
+        pass
+    return core
 
 
 def _check_pose(X, name: str) -> tuple[np.ndarray, np.ndarray]:
     try:
         R, p = X
-        R = np.asarray(R, dtype=np.float64)
-        p = np.asarray(p, dtype=np.float64)
+        R = np.ascontiguousarray(R, dtype=np.float64)
+        p = np.ascontiguousarray(p, dtype=np.float64)
     except (TypeError, ValueError):
         raise InvalidInputError(f"{name}: expected a pose (R (3, 3), p (3,))") from None
     if R.shape != (3, 3) or p.shape != (3,):
         raise InvalidInputError(f"{name}: expected R (3, 3) and p (3,), got {R.shape} and {p.shape}")
-    if not (np.isfinite(R).all() and np.isfinite(p).all()):
+    # any NaN / inf entry makes the sum non-finite
+    if not math.isfinite(R.sum() + p.sum()):
         raise InvalidInputError(f"{name}: pose is not finite")
-    return np.ascontiguousarray(R), np.ascontiguousarray(p)
-
-
-def _core_arrays(shape: ConvexShape):
-    """(points, edges, normals) as contiguous float64/int64 arrays for the kernels."""
-    P = np.ascontiguousarray(shape.points, dtype=np.float64)
-    if shape.kind == "capsule":
-        E = np.array([[0, 1]], dtype=np.int64)
-    elif shape.kind == "polytope":
-        E = np.ascontiguousarray(np.asarray(shape.edges, dtype=np.int64).reshape(-1, 2))
-    else:
-        E = np.zeros((0, 2), np.int64)
-    if shape.kind == "polytope":
-        N = np.ascontiguousarray(np.asarray(shape.normals, dtype=np.float64).reshape(-1, 3))
-    else:
-        N = np.zeros((0, 3))
-    return P, E, N
+    return R, p
 
 
 # --------------------------------------------------------------------------- overlap depth (LP)
@@ -318,78 +356,70 @@ def shape_distance(shape_a: ConvexShape, X_a, shape_b: ConvexShape, X_b, *,
     Raises:
         InvalidInputError: bad shape or pose (shape, NaN, unknown kind).
     """
-    _check_shape(shape_a, "shape_a")
-    _check_shape(shape_b, "shape_b")
+    ca_, cb_ = _core(shape_a, "shape_a"), _core(shape_b, "shape_b")
     Ra, pa = _check_pose(X_a, "X_a")
     Rb, pb = _check_pose(X_b, "X_b")
     tol = tolerances
     out = np.empty(_gjk.OUT_SIZE)
-    ha, hb = shape_a.kind == "halfspace", shape_b.kind == "halfspace"
+    ha, hb = ca_.code < 0, cb_.code < 0
     if ha and hb:
         return _halfspace_pair(shape_a, Ra, pa, shape_b, Rb, pb, tol)
-    if ha or hb:
-        if ha:
-            H, RH, pH, C, RC, pC = shape_a, Ra, pa, shape_b, Rb, pb
-        else:
-            H, RH, pH, C, RC, pC = shape_b, Rb, pb, shape_a, Ra, pa
-        _gjk.halfspace_distance(np.ascontiguousarray(H.normals[0], dtype=np.float64),
-                                float(H.offsets[0]), RH, pH,
-                                np.ascontiguousarray(C.points, dtype=np.float64), RC, pC,
-                                tol.rel_pad, tol.abs_pad, out)
-        r = float(C.radius)
-        # n (unit, world) from the half-space into the core side: recover from the two points
-        ph, pc = out[4:7] + pC, out[7:10] + pC
-        lower, upper, est = out[2] - r, out[3] - r, out[1] - r
-        if r > 0.0:
-            nH = RH @ H.normals[0]
-            nH = nH / np.linalg.norm(nH)
-            pc = pc - r * nH
-        p_h, p_c = (ph, pc)
-        if upper < 0.0:
-            # overlap: the deepest core point (or the sphere point towards the plane) is common
-            p_h = pc.copy()
-        if ha:
-            return DistanceResult(float(est), float(lower), float(upper), p_h, p_c)
-        return DistanceResult(float(est), float(lower), float(upper), p_c, p_h)
-
-    PA, EA, NA = _core_arrays(shape_a)
-    PB, EB, NB = _core_arrays(shape_b)
-    anyp = shape_a.kind == "polytope" or shape_b.kind == "polytope"
-    _gjk.core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, anyp, tol.rel_pad, tol.abs_pad,
-                       _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
-    return _finish(shape_a, Ra, pa, shape_b, Rb, pb, out, tol, use_lp=True)
-
-
-def _finish(shape_a, Ra, pa, shape_b, Rb, pb, out, tol, use_lp):
-    """Turn a kernel output row into a DistanceResult (radii, LP depth, world points)."""
+    if ha:
+        return _halfspace_core(ca_, Ra, pa, cb_, Rb, pb, tol, out, True)
+    if hb:
+        return _halfspace_core(cb_, Rb, pb, ca_, Ra, pa, tol, out, False)
+    _gjk.core_distance(ca_.P, Ra, pa, ca_.E, ca_.N, cb_.P, Rb, pb, cb_.E, cb_.N, ca_.code, cb_.code,
+                       tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
     status = int(out[0])
     est, lower, upper = float(out[1]), float(out[2]), float(out[3])
-    ca, cb = out[4:7].copy(), out[7:10].copy()
-    ra, rb = float(shape_a.radius), float(shape_b.radius)
+    ra, rb = ca_.radius, cb_.radius
+    rs = ra + rb
     if status != _gjk.SEPARATED:
-        anyp = shape_a.kind == "polytope" or shape_b.kind == "polytope"
-        if use_lp and anyp:
-            got = _depth_lp(shape_a, Ra, pa, shape_b, Rb, pb, ca, max(-lower, 1e3 * float(out[10])), tol)
+        p = out[4:7]
+        if ca_.code == _gjk.KIND_POLYTOPE and cb_.code == _gjk.KIND_POLYTOPE:
+            got = _depth_lp(shape_a, Ra, pa, shape_b, Rb, pb, p, max(-lower, 1e3 * float(out[10])), tol)
             if got is not None and -got[0] < upper:
                 upper = -got[0]
-                ca = got[1].copy()
-                cb = got[1].copy()
+                p = got[1]
         est = min(max(est, lower), upper)
-        p = ca
-        return DistanceResult(est - ra - rb, lower - ra - rb, upper - ra - rb, p + pa, p + pa)
-    n = cb - ca
-    nn = float(np.linalg.norm(n))
-    if nn > 0.0:
-        n = n / nn
-        ca = ca + ra * n
-        cb = cb - rb * n
-    return DistanceResult(est - ra - rb, lower - ra - rb, upper - ra - rb, ca + pa, cb + pa)
+        q = p + pa
+        return DistanceResult(est - rs, lower - rs, upper - rs, q, q.copy())
+    c_a, c_b = out[4:7] + pa, out[7:10] + pa
+    if rs > 0.0:
+        n = out[7:10] - out[4:7]
+        nn = math.sqrt(n @ n)
+        if nn > 0.0:
+            n /= nn
+            c_a += ra * n
+            c_b -= rb * n
+    return DistanceResult(est - rs, lower - rs, upper - rs, c_a, c_b)
 
 
-def _batch_poses(Xs, T_hint, name):
-    R, p = Xs
-    R = np.asarray(R, dtype=np.float64)
-    p = np.asarray(p, dtype=np.float64)
+def _halfspace_core(H: _Core, RH, pH, C: _Core, RC, pC, tol: Tolerances, out, h_first: bool
+                    ) -> DistanceResult:
+    """A half-space H and a core shape C (closed form); ``h_first``: H is shape A."""
+    _gjk.halfspace_distance(H.N[0], H.offset, RH, pH, C.P, RC, pC, tol.rel_pad, tol.abs_pad, out)
+    r = C.radius
+    lower, upper, est = float(out[2]) - r, float(out[3]) - r, float(out[1]) - r
+    p_h, p_c = out[4:7] + pC, out[7:10] + pC
+    if r > 0.0:
+        nH = RH @ H.N[0]
+        p_c -= (r / math.sqrt(nH @ nH)) * nH
+    if upper < 0.0:
+        # overlap: the deepest core point (moved by the radius towards the plane) is common
+        p_h = p_c.copy()
+    if h_first:
+        return DistanceResult(est, lower, upper, p_h, p_c)
+    return DistanceResult(est, lower, upper, p_c, p_h)
+
+
+def _batch_poses(Xs, name):
+    try:
+        R, p = Xs
+        R = np.asarray(R, dtype=np.float64)
+        p = np.asarray(p, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name}: expected poses (R (T, 3, 3), p (T, 3))") from None
     if R.shape == (3, 3):
         R = R[None]
     if p.shape == (3,):
@@ -412,17 +442,17 @@ def shape_distance_batch(shape_a: ConvexShape, Xs_a, shape_b: ConvexShape, Xs_b,
             broadcasts against the other side.
         Xs_b: same for B.
         tolerances: rounding pads.
-        exact_overlap: if True, poses where the cores touch and the kernel could
-            not prove a negative upper bound are re-done with the LP depth
-            (polytope cores only), as in :func:`shape_distance`.
+        exact_overlap: if True, poses where two polytope cores touch and the
+            kernel could not prove a negative upper bound are re-done with the LP
+            depth, as in :func:`shape_distance` (point / segment cores get their
+            depth in the kernel).
 
     Returns:
         (lower (T,), upper (T,)) metres, each with lower <= true signed distance <= upper.
     """
-    _check_shape(shape_a, "shape_a")
-    _check_shape(shape_b, "shape_b")
-    Ra, pa = _batch_poses(Xs_a, None, "Xs_a")
-    Rb, pb = _batch_poses(Xs_b, None, "Xs_b")
+    ca_, cb_ = _core(shape_a, "shape_a"), _core(shape_b, "shape_b")
+    Ra, pa = _batch_poses(Xs_a, "Xs_a")
+    Rb, pb = _batch_poses(Xs_b, "Xs_b")
     T = max(len(Ra), len(Rb), len(pa), len(pb))
     for arr, nm in ((Ra, "Xs_a R"), (pa, "Xs_a p"), (Rb, "Xs_b R"), (pb, "Xs_b p")):
         if len(arr) not in (1, T):
@@ -432,23 +462,20 @@ def shape_distance_batch(shape_a: ConvexShape, Xs_a, shape_b: ConvexShape, Xs_b,
     pa = np.ascontiguousarray(np.broadcast_to(pa, (T, 3)))
     pb = np.ascontiguousarray(np.broadcast_to(pb, (T, 3)))
     tol = tolerances
-    if shape_a.kind == "halfspace" or shape_b.kind == "halfspace":
+    if ca_.code < 0 or cb_.code < 0:
         lo = np.empty(T)
         up = np.empty(T)
         for t in range(T):
             res = shape_distance(shape_a, (Ra[t], pa[t]), shape_b, (Rb[t], pb[t]), tolerances=tol)
             lo[t], up[t] = res.lower, res.upper
         return lo, up
-    PA, EA, NA = _core_arrays(shape_a)
-    PB, EB, NB = _core_arrays(shape_b)
-    anyp = shape_a.kind == "polytope" or shape_b.kind == "polytope"
     out = np.empty((T, _gjk.OUT_SIZE))
-    _gjk.core_distance_batch(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, anyp, tol.rel_pad, tol.abs_pad,
-                             _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
-    rsum = float(shape_a.radius) + float(shape_b.radius)
+    _gjk.core_distance_batch(ca_.P, Ra, pa, ca_.E, ca_.N, cb_.P, Rb, pb, cb_.E, cb_.N, ca_.code, cb_.code,
+                             tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+    rsum = ca_.radius + cb_.radius
     lo = out[:, 2] - rsum
     up = out[:, 3] - rsum
-    if exact_overlap and anyp:
+    if exact_overlap and ca_.code == _gjk.KIND_POLYTOPE and cb_.code == _gjk.KIND_POLYTOPE:
         redo = np.flatnonzero((out[:, 0] != _gjk.SEPARATED) & (out[:, 3] >= 0.0))
         for t in redo:
             got = _depth_lp(shape_a, Ra[t], pa[t], shape_b, Rb[t], pb[t], out[t, 4:7],
