@@ -76,7 +76,11 @@ def load(path: Path) -> mujoco.MjModel:
 # --------------------------------------------------------------------------- candidate pairs
 
 
-@pytest.mark.parametrize("path", ALL_SCENES, ids=lambda p: p.name if p.parent == ASSETS else str(p))
+def _scene_id(p: Path) -> str:
+    return p.name if p.parent == ASSETS else str(p.relative_to(REPO))
+
+
+@pytest.mark.parametrize("path", ALL_SCENES, ids=_scene_id)
 def test_mujoco_pairs_equal_mj_collision(path):
     scene = Scene.from_model(load(path), pairs="mujoco")
     got = {tuple(p) for p in scene.pair_ids.tolist()}
@@ -355,11 +359,11 @@ def inside_excess(shape, p):
     return np.linalg.norm(p - (a + t[:, None] * ab), axis=1) - shape.radius
 
 
-@pytest.mark.parametrize("name", PAIR_SCENES)
-def test_shapes_contain_true_geoms_in_body_frame(name):
+@pytest.mark.parametrize("path", ALL_SCENES, ids=_scene_id)
+def test_shapes_contain_true_geoms_in_body_frame(path):
     """At random joint poses, MuJoCo's world geom pose composed with the body pose places the true
     geom inside the scene's body-frame shape; exact shapes have the true support function."""
-    model = load(ASSETS / name)
+    model = load(path)
     scene = Scene.from_model(model)
     data = mujoco.MjData(model)
     rng = np.random.default_rng(7)
