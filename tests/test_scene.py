@@ -501,3 +501,19 @@ def test_many_bodies_filter_matches_brute_force():
     assert got == _brute_force_mujoco(model)
     assert got == contact_pairs(xml)
     assert len(got) > 500
+
+
+@pytest.mark.parametrize("path", ALL_SCENES, ids=_scene_id)
+def test_every_mesh_hull_volume(path):
+    """Each mesh geom's polytope has the volume of MuJoCo's stored hull, and of trimesh's hull of
+    all vertices unless maxhullvert reduced MuJoCo's hull."""
+    model = load(path)
+    scene = Scene.from_model(model)
+    meshes = [g for g in scene.geoms if g.type == "mesh"]
+    for info in meshes:
+        V, tri = _mesh_hull(model, info.id)
+        mj_hull = trimesh.Trimesh(V, tri, process=False)
+        assert _polytope_volume(info.shape) == pytest.approx(abs(mj_hull.volume), rel=1e-9)
+        full = trimesh.Trimesh(V, process=False).convex_hull
+        if len(full.vertices) == len(np.unique(tri)):
+            assert _polytope_volume(info.shape) == pytest.approx(full.volume, rel=1e-9)
