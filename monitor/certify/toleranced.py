@@ -551,10 +551,10 @@ def _kernel_EE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
 
 def _kernel_FE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
     L, p = ball.L[it], ball.p[it]
-    O = _apply(L, p, C.af_o[a])
+    Oa = _apply(L, p, C.af_o[a])
     Up = np.einsum("nij,njk->nik", L, C.af_U[a])
     E = C.be_e[b]
-    P0 = O - C.be_w0[b]
+    P0 = Oa - C.be_w0[b]
     R2, Dl, e = ball.R2[it], ball.Delta[it], ball.eps[it]
     G = np.einsum("nik,nil->nkl", Up, Up)
     Am = G - R2[:, None, None] * C.af_K[a]
@@ -731,6 +731,7 @@ class BallProvider:
     """Interface: per-item g = (L (N,3,3), p (N,3)) and radius R (N,) for a frontier."""
 
     def balls(self, fr: _Frontier) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Centre (L, p) and radius R of every frontier item's ball."""
         raise NotImplementedError
 
     def split(self, fr: _Frontier, keep: np.ndarray) -> Any:

@@ -96,7 +96,7 @@ class Metric:
         return self.inv_mass + np.einsum("...i,ij,...j->...", y, self.Jinv, y)
 
     def rho(self, x: np.ndarray) -> np.ndarray:
-        """Distortion rate rho(x) (eq. 4), (...,) for x (..., 3)."""
+        """Distortion rate (eq. 4) at points x (..., 3); returns (...)."""
         return np.sqrt(self.rho2(x))
 
     def norm(self, L: np.ndarray, p: np.ndarray) -> np.ndarray:
