@@ -163,7 +163,7 @@ def test_foxglove_messages_decode_and_quaternions(tmp_path):
     markers = 0
     with open(path, "rb") as f:
         r = make_reader(f, decoder_factories=[DecoderFactory()])
-        for _, ch, msg, dec in r.iter_decoded_messages(topics=[topics.SCENE, topics.TRANSFORMS]):
+        for _, ch, msg, dec in r.iter_decoded_messages(topics=list(topics.FOXGLOVE_TOPICS)):
             k = int(round(msg.log_time / 1e7))
             if ch.topic == topics.TRANSFORMS:
                 data.qpos[:] = plans[k].qpos[0]
@@ -181,10 +181,11 @@ def test_foxglove_messages_decode_and_quaternions(tmp_path):
                 seen_tf += 1
             else:
                 for e in dec.entities:
-                    entities.add(e.id)
-                    if e.id == "witness":
+                    if ch.topic == topics.MARKERS:
+                        assert e.id == "witness" and e.frame_id == "world"
                         markers += 1
-                        assert e.frame_id == "world"
+                    else:
+                        entities.add(e.id)
     assert seen_tf == 6
     assert {f"geom/{model.geom(g).name}" for g in range(model.ngeom)} <= entities
     assert markers == sum(c.verdict != "certified" for c in certs)

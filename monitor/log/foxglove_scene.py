@@ -4,9 +4,10 @@ Encoding: ``foxglove.messages`` classes, written by the plain ``mcap`` Writer wi
 their protobuf schemas (one file, one flush policy). Layout:
 
 * ``/monitor/scene`` (``foxglove.SceneUpdate``): at the first window, one entity per
-  geom in its **body frame** (``frame_id`` = body name; geometry is static in it);
-  at every violation/uncertain window, a red witness marker (sphere + label) in
-  ``world`` with a lifetime of the window length.
+  geom in its **body frame** (``frame_id`` = body name; geometry is static in it).
+* ``/monitor/markers`` (``foxglove.SceneUpdate``): at every violation/uncertain
+  window, a red witness marker (sphere + label) in ``world`` with a lifetime of the
+  window length.
 * ``/monitor/tf`` (``foxglove.FrameTransforms``): at every window, world -> body
   transforms of every body at the plan's first waypoint.
 
@@ -151,7 +152,8 @@ class FoxgloveScene:
     def schemas() -> dict[str, tuple[str, str, bytes]]:
         """Topic -> (schema name, encoding, FileDescriptorSet bytes)."""
         out = {}
-        for topic, cls in ((topics.SCENE, SceneUpdate), (topics.TRANSFORMS, FrameTransforms)):
+        for topic, cls in ((topics.SCENE, SceneUpdate), (topics.MARKERS, SceneUpdate),
+                           (topics.TRANSFORMS, FrameTransforms)):
             s = cls.get_schema()
             out[topic] = (s.name, s.encoding, bytes(s.data))
         return out
@@ -238,7 +240,7 @@ class FoxgloveScene:
         out.append((topics.TRANSFORMS, tf.encode()))
         marks = self.witness_markers(t_ns, cert)
         if marks is not None:
-            out.append((topics.SCENE, marks.encode()))
+            out.append((topics.MARKERS, marks.encode()))
         return out
 
 

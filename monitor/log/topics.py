@@ -25,7 +25,10 @@ PLAN = "/monitor/plan"
 ACTION = "/monitor/action"
 """Proposed action, applied action and whether the gate replaced it."""
 SCENE = "/monitor/scene"
-"""foxglove.SceneUpdate: geoms (once, in body frames) and witness markers."""
+"""foxglove.SceneUpdate: the geoms, once, in their body frames (a topic of its own so that
+Foxglove's seek back-fill, which replays the last message per topic, always finds it)."""
+MARKERS = "/monitor/markers"
+"""foxglove.SceneUpdate: witness markers of violation / uncertain windows."""
 TRANSFORMS = "/monitor/tf"
 """foxglove.FrameTransforms: world -> body poses at each window start."""
 
@@ -37,7 +40,7 @@ JSON_TOPICS: dict[str, tuple[str, str]] = {
 }
 """topic -> (schema name, schema file in ``monitor/log/schemas``)."""
 
-FOXGLOVE_TOPICS: tuple[str, ...] = (SCENE, TRANSFORMS)
+FOXGLOVE_TOPICS: tuple[str, ...] = (SCENE, MARKERS, TRANSFORMS)
 
 METADATA_RUN = "monitor.run"
 """Metadata record: versions, margin, epsilon, pair policy, predictor, ... (JSON values)."""
@@ -66,7 +69,7 @@ def schema(topic: str) -> dict[str, Any]:
 
 
 __all__ = [
-    "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "TRANSFORMS", "JSON_TOPICS",
+    "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "JSON_TOPICS",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",
 ]

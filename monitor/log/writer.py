@@ -387,8 +387,11 @@ class MonitorLog:
             except ImportError as exc:
                 self.foxglove_error = f"foxglove-sdk not installed ({exc}); pip install 'monitor[foxglove]'"
                 return
+            sids: dict[str, int] = {}
             for topic, (name, enc, data) in self._scene.schemas().items():
-                sid = self._w.register_schema(name=name, encoding=enc, data=data)
+                if name not in sids:  # each schema once
+                    sids[name] = self._w.register_schema(name=name, encoding=enc, data=data)
+                sid = sids[name]
                 self._channels[topic] = self._w.register_channel(topic=topic, message_encoding="protobuf",
                                                                  schema_id=sid)
             self.foxglove_enabled = True
