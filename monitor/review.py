@@ -95,6 +95,9 @@ def analyze(contents: LogContents) -> dict[str, Any]:
             rows.append(_violation_row(c))
     actions = contents.topic(topics.ACTION)
     run = {k: v for k, v in contents.run.items() if not k.startswith("version.")}
+    for key in ("margin", "epsilon", "method"):  # not in the metadata: from the first certificate
+        if run.get(key) is None and certs and key in certs[0]:
+            run[key] = certs[0][key]
     return {
         "file": {"path": contents.path, "size": contents.size, "complete": contents.complete,
                  "unreadable_bytes": contents.unreadable_bytes, "stop_reason": contents.stop_reason,
