@@ -110,6 +110,35 @@ class Rollout:
         return Plan(times, qpos, model=self.model, mocap_pos=np.array(data.mocap_pos),
                     mocap_quat=np.array(data.mocap_quat))
 
+    def brake_tail(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
+                   brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
+                   vel_tol: float) -> tuple[Any, np.ndarray]:
+        """Plan of the braking motion that would follow the window of ``ctrl``.
+
+        Integrates the window (``nstep`` substeps under ``ctrl``), then holds the
+        brake control ``brake_fn(state at the window's end)`` until every
+        ``|qvel| <= vel_tol`` or ``max_steps`` substeps.
+
+        Returns:
+            (plan of the tail from the window's end, brake control (nu,)).
+        """
+        from monitor.motion.plan import Plan
+
+        self.states(data, ctrl, nstep)
+        m, s = self.model, self.scratch
+        brake = np.asarray(brake_fn(s), dtype=np.float64)
+        s.ctrl[:] = brake
+        times, qpos = [s.time], [s.qpos.copy()]
+        for _ in range(max(int(max_steps), 1)):
+            mujoco.mj_step(m, s)
+            times.append(s.time)
+            qpos.append(s.qpos.copy())
+            if m.nv == 0 or float(np.max(np.abs(s.qvel))) <= vel_tol:
+                break
+        plan = Plan(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
+                    mocap_quat=np.array(data.mocap_quat))
+        return plan, brake
+
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     """A control that holds the current position where the actuators allow it.
@@ -162,8 +191,10 @@ class StepReport:
         fallback_certificate: certificate of the fallback window, or None.
         fallback_certified: False only when a fallback was applied whose window
             did not certify.
-        certify_us: wall time (µs) spent certifying (proposal + fallback).
+        certify_us: wall time (µs) spent certifying (proposal, brake tail, fallback).
         time: window start (s).
+        brake_verdict: verdict of the braking tail after the proposed window
+            (``""`` when not checked: brake check off, ``"warn"``, or proposal unsafe).
         plan: the proposed window's plan.
         stepped: True when :meth:`Gate.step` advanced the caller's data.
     """
@@ -182,6 +213,7 @@ class StepReport:
     time: float
     plan: Any = None
     stepped: bool = False
+    brake_verdict: str = ""
 
     @property
     def cost(self) -> float:
@@ -200,7 +232,7 @@ class StepReport:
             timing: include ``certify_us`` (wall time: differs between identical runs).
 
         Returns:
-            dict with verdict (str), applied_verdict (str), checker ((P,) object array
+            dict with verdict (str), applied_verdict (str), brake_verdict (str), checker ((P,) object array
             of str, one per candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
             witness_time (float s), witness_geoms ((2,) object array of str), witness_point ((3,) m),
             earliest_time (float s), clearance (float m), replaced (bool),
@@ -209,12 +241,12 @@ class StepReport:
         """
         return safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
                            replaced=self.replaced, fallback_certified=self.fallback_certified,
-                           terminated=self.terminated, time=self.time,
+                           terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
                            certify_us=self.certify_us if timing else None)
 
 
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
-                fallback_certified: bool, terminated: bool, time: float,
+                fallback_certified: bool, terminated: bool, time: float, brake_verdict: str = "",
                 certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
     """Build the fixed-shape ``info["safety"]`` dict (see :meth:`StepReport.info`).
 
@@ -234,6 +266,7 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
     out = {
         "verdict": verdict,
         "applied_verdict": applied_verdict,
+        "brake_verdict": brake_verdict,
         "checker": checker,
         "checker_mix": mix,
         "witness_time": inf if wit is None else float(wit.time),
@@ -293,6 +326,18 @@ class Gate:
             window is written.
         frame_skip: default number of substeps per window (``nstep``).
         reuse: reuse certified results of pairs whose bodies are fixed and unchanged.
+        brake: recoverability check (``"block"``/``"terminate"`` with the default or
+            an array fallback): a proposal is accepted only if, in addition to its
+            own window, the braking tail after it (the fallback control held from
+            the window's end state, see :meth:`Rollout.brake_tail`) is safe. That
+            brake control is then *committed*: when a later proposal is rejected the
+            gate applies the committed brake, whose motion was certified as that
+            tail, instead of a fresh hold computed too late to stop in time. Without
+            it a one-window gate can accept a proposal from which nothing can stop
+            before the obstacle. Not available with a callable fallback (it cannot
+            be evaluated at a predicted state).
+        brake_horizon: longest braking tail (s of simulation time).
+        brake_vel_tol: the tail ends once every ``|qvel|`` is at most this (rad/s, m/s).
         tolerances: numerical tolerances.
         log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
             ``log`` is a path (e.g. ``env_id``, ``model_source``).
@@ -305,7 +350,8 @@ class Gate:
                  epsilon: float = 1e-3, predictor: str | Callable[..., Any] = "rollout",
                  on_violation: str = "block", unsafe: str = "uncertain",
                  fallback: Any = None, budget: Any = None, log: Any = None, frame_skip: int = 1,
-                 reuse: bool = True, tolerances: Tolerances = DEFAULT,
+                 reuse: bool = True, brake: bool = True, brake_horizon: float = 0.25,
+                 brake_vel_tol: float = 1e-3, tolerances: Tolerances = DEFAULT,
                  log_options: dict[str, Any] | None = None) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
@@ -333,6 +379,10 @@ class Gate:
         self.budget = budget
         self.frame_skip = int(frame_skip)
         self.reuse = bool(reuse)
+        self.brake = bool(brake)
+        self.brake_steps = max(1, int(math.ceil(float(brake_horizon) / model.opt.timestep)))
+        self.brake_vel_tol = float(brake_vel_tol)
+        self._committed: np.ndarray | None = None
         self.tolerances = tolerances
         self._rollout = Rollout(model)
         self._scene = None
@@ -343,7 +393,9 @@ class Gate:
         self._log_owned = False
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
-                      "fallback_uncertified": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0}
+                      "fallback_uncertified": 0, "brake_rejected": 0, "certify_us": 0.0,
+                      "reused_pairs": 0, "pairs": 0}
+        self._warned = False
 
     # ----------------------------------------------------------------- scene / certify
     @property
@@ -466,9 +518,21 @@ class Gate:
             return np.asarray(fb(data), dtype=np.float64)
         return np.asarray(fb, dtype=np.float64)
 
+    def reset(self) -> None:
+        """Forget the committed brake (call when the caller's state is reset)."""
+        self._committed = None
+
+    def _brake_active(self, fallback: Callable[[], Any] | None) -> bool:
+        return (self.brake and self.on_violation != "warn" and fallback is None
+                and not callable(self.fallback))
+
+    def _brake_ctrl(self, d: mujoco.MjData) -> np.ndarray:
+        return hold_ctrl(self.model, d) if self.fallback is None else np.asarray(self.fallback, float)
+
     def decide(self, data: mujoco.MjData, ctrl: Any, *, nstep: int | None = None,
                predict: Callable[[Any], Any] | None = None,
-               fallback: Callable[[], Any] | None = None) -> StepReport:
+               fallback: Callable[[], Any] | None = None,
+               cast: Callable[[Any], np.ndarray] | None = None) -> StepReport:
         """Certify the proposed window and pick the control to apply; does NOT step.
 
         This is the whole gating logic; :meth:`step` and :class:`monitor.SafetyGate`
@@ -481,7 +545,9 @@ class Gate:
             predict: optional ``predict(action) -> Plan`` replacing the gate's predictor
                 (used by adapters whose action is not ``data.ctrl``).
             fallback: optional zero-argument callable giving the fallback action
-                (default :meth:`fallback_ctrl`).
+                (default: the committed brake, else :meth:`fallback_ctrl`).
+            cast: optional map applied to gate-made controls (fallback, brake) before
+                they are predicted and applied, e.g. to the env's action dtype.
 
         Returns:
             the :class:`StepReport` (``stepped=False``).
@@ -490,6 +556,9 @@ class Gate:
         if n < 1:
             raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
         ctrl = np.asarray(ctrl)
+        if cast is None:
+            def cast(c: Any) -> np.ndarray:
+                return np.asarray(c, dtype=np.float64)
         if predict is None:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
@@ -497,11 +566,26 @@ class Gate:
         plan = predict(ctrl)
         cert, us = self._certify(plan)
         unsafe = self.is_unsafe(cert.verdict)
+        brake_verdict, brake_next = "", None
+        if not unsafe and self._brake_active(fallback):
+            tail, brake_next = self._rollout.brake_tail(
+                data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
+            tail_cert, tail_us = self._certify(tail)
+            us += tail_us
+            brake_verdict = tail_cert.verdict
+            if self.is_unsafe(brake_verdict):
+                unsafe = True
+                self.stats["brake_rejected"] += 1
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
         if unsafe and self.on_violation != "warn":
-            applied = np.asarray(fallback() if fallback is not None else self.fallback_ctrl(data))
+            if fallback is not None:
+                applied = np.asarray(fallback())
+            elif self._brake_active(None) and self._committed is not None:
+                applied = self._committed
+            else:
+                applied = cast(self.fallback_ctrl(data))
             replaced, terminated = True, self.on_violation == "terminate"
             applied_plan = predict(applied)
             fb_cert, fb_us = self._certify(applied_plan)
@@ -510,10 +594,14 @@ class Gate:
             fb_ok = fb_cert.verdict == "certified"
             if not fb_ok:
                 self.stats["fallback_uncertified"] += 1
-                _LOG.warning("t=%.6f s: fallback window is %s (proposal was %s)", t_win,
-                             fb_cert.verdict, cert.verdict)
+                (_LOG.debug if self._warned else _LOG.warning)(
+                    "t=%.6f s: fallback window is %s (proposal was %s)%s", t_win, fb_cert.verdict,
+                    cert.verdict, "" if self._warned else "; further cases are logged at DEBUG level")
+                self._warned = True
+        elif not unsafe:
+            self._committed = brake_next
         report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
-                            applied_verdict, fb_cert, fb_ok, us, t_win, plan)
+                            applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
         self._account(report)
         self._write_log(report, applied_plan)
         self.last_report = report

@@ -48,6 +48,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             because a wall time differs between identical runs, which fails
             gymnasium's step-determinism check in ``check_env``; the time is always
             in ``gate.last_report.certify_us`` and ``gate.summary()``.
+        brake: recoverability check with a committed brake (see :class:`monitor.Gate`).
 
     Raises:
         InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data or an option is invalid.
@@ -56,11 +57,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     def __init__(self, env: gymnasium.Env, *, predictor: str | Callable[..., Any] = "rollout",
                  pairs: Any = "mujoco", margin: float = 0.0, epsilon: float = 1e-3,
                  on_violation: str = "block", fallback: Any = None, budget: Any = None, log: Any = None,
-                 unsafe: str = "uncertain", timing: bool = False) -> None:
+                 unsafe: str = "uncertain", timing: bool = False, brake: bool = True) -> None:
         gymnasium.utils.RecordConstructorArgs.__init__(
             self, predictor=predictor, pairs=pairs, margin=margin, epsilon=epsilon,
             on_violation=on_violation, fallback=fallback, budget=budget, log=log, unsafe=unsafe,
-            timing=timing)
+            timing=timing, brake=brake)
         gymnasium.Wrapper.__init__(self, env)
         u = env.unwrapped
         model, data = getattr(u, "model", None), getattr(u, "data", None)
@@ -79,8 +80,10 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.predictor_mode = predictor
         self.user_fallback = fallback
         self.timing = bool(timing)
+        gate_fallback = None if fallback is None or callable(fallback) else np.asarray(fallback, float)
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
+                         fallback=gate_fallback, brake=brake,
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env))
         self._obs: Any = None
 
@@ -108,19 +111,19 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             return u.planned_trajectory
         return lambda a: mode(self.env, self._obs, a)
 
-    def _fallback_fn(self) -> Callable[[], np.ndarray]:
-        fb, u = self.user_fallback, self.env.unwrapped
+    def _fallback_fn(self) -> Callable[[], np.ndarray] | None:
+        fb = self.user_fallback
         if fb is None:
-            return lambda: self._as_action(self.gate.fallback_ctrl(u.data))
+            return None  # the gate's default: committed brake, else hold position
         if callable(fb):
             return lambda: self._as_action(fb(self.env, self._obs))
-        return lambda: self._as_action(fb)
+        return None  # an array fallback is the gate's own (cast on use)
 
     # ----------------------------------------------------------------- gymnasium API
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Certify the window of ``action``, gate it, then step the wrapped env."""
         report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
-                                              fallback=self._fallback_fn())
+                                              fallback=self._fallback_fn(), cast=self._as_action)
         obs, reward, terminated, truncated, info = self.env.step(report.applied_ctrl)
         self._obs = obs
         info = dict(info)
@@ -132,6 +135,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
               ) -> tuple[Any, dict[str, Any]]:
         """Reset the wrapped env; ``info["safety"]`` has the same keys with verdict ``""``."""
         obs, info = self.env.reset(seed=seed, options=options)
+        self.gate.reset()
         self._obs = obs
         info = dict(info)
         info["safety"] = safety_info(None, verdict="", applied_verdict="", replaced=False,
