@@ -517,3 +517,17 @@ def test_every_mesh_hull_volume(path):
         full = trimesh.Trimesh(V, process=False).convex_hull
         if len(full.vertices) == len(np.unique(tri)):
             assert _polytope_volume(info.shape) == pytest.approx(full.volume, rel=1e-9)
+
+
+def test_scene_pickles(load_asset):
+    """Scenes cross process boundaries (ray extra, multiprocessing): pickle round trip."""
+    import pickle
+
+    scene = Scene.from_model(load_asset("meshes.xml"))
+    back = pickle.loads(pickle.dumps(scene))
+    assert back.candidate_pairs == scene.candidate_pairs
+    assert back.model_hash == scene.model_hash
+    for a, b in zip(scene.geoms, back.geoms):
+        assert a.name == b.name and a.type == b.type
+        if a.shape is not None:
+            np.testing.assert_array_equal(a.shape.points, b.shape.points)
