@@ -287,6 +287,8 @@ def _depth_at(V, N, x):
     Exact (up to rounding) when the face normals N are complete; negative outside.
     """
     best = np.inf
+    if N.shape[0] == 0:
+        return -np.inf
     for i in range(N.shape[0]):
         nn = np.sqrt(_dot(N[i], N[i]))
         if not nn > 0.0:
@@ -492,8 +494,8 @@ def _simplex_directions_bound(VA, VB, W, k):
 
 
 @njit(cache=True)
-def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, rel_pad, abs_pad,
-                  eps_rel, max_iter, max_edge_pairs, out):
+def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a, dpad_b, rel_pad,
+                  abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
 
     Args:
@@ -503,6 +505,9 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, rel_pa
         EA, EB: (m, 2) int64 edges (vertex index pairs).
         NA, NB: (f, 3) body-frame face normals (empty for point / segment).
         kind_a, kind_b: KIND_POINT / KIND_SEGMENT / KIND_POLYTOPE.
+        dpad_a, dpad_b: metres by which a depth measured with the face normals
+            may exceed the true depth in the vertex hull (normals' completeness
+            defect, see ``distance._core``); inf disables depth certificates.
         rel_pad, abs_pad: rounding pads (``Tolerances``).
         eps_rel: GJK relative duality-gap tolerance.
         max_iter: GJK iteration cap.
@@ -676,9 +681,9 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, rel_pa
             if r_in > 0.0 and -r_in < upper:
                 upper = -r_in
         if kind_a == KIND_POLYTOPE and kind_b != KIND_POLYTOPE:
-            dep = _low_dim_depth(VA, WNA, VB, xc) - 2.0 * pad
+            dep = _low_dim_depth(VA, WNA, VB, xc) - 2.0 * pad - dpad_a
         elif kind_b == KIND_POLYTOPE and kind_a != KIND_POLYTOPE:
-            dep = _low_dim_depth(VB, WNB, VA, xc) - 2.0 * pad
+            dep = _low_dim_depth(VB, WNB, VA, xc) - 2.0 * pad - dpad_b
         else:
             dep = 0.0
         if dep > 0.0 and -dep < upper:
@@ -704,11 +709,11 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, rel_pa
 
 
 @njit(cache=True)
-def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, kind_a, kind_b, rel_pad, abs_pad,
-                        eps_rel, max_iter, max_edge_pairs, out):
+def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, kind_a, kind_b, dpad_a, dpad_b,
+                        rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """:func:`core_distance` for T poses: RAs (T, 3, 3), tAs (T, 3), ...; out (T, OUT_SIZE)."""
     for t in range(RAs.shape[0]):
-        core_distance(PA, RAs[t], tAs[t], EA, NA, PB, RBs[t], tBs[t], EB, NB, kind_a, kind_b,
+        core_distance(PA, RAs[t], tAs[t], EA, NA, PB, RBs[t], tBs[t], EB, NB, kind_a, kind_b, dpad_a, dpad_b,
                       rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out[t])
 
 

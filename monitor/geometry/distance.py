@@ -29,11 +29,12 @@ the core swept by the radius, so ``dist = core_dist - radius_a - radius_b``):
   axis candidates (face normals, edge x edge), which give the exact penetration
   depth for polytope pairs.
 
-Assumption (documented, not checked per call): a polytope's face normals are
-complete, i.e. ``{x : normals @ x <= max_v normals @ v}`` equals the hull of
-its points (true for :func:`monitor.geometry.polytope.polytope_from_points`).
-It is only used to certify *depth* (negative ``upper``); the separated-case
-bounds and ``lower`` never rely on it.
+Depth certificates measure depth with a polytope's face normals. Once per
+shape (cached), the normals are checked against the facets of the vertex hull
+(scipy qhull); their angular defect becomes a depth pad (``_depth_pad``), and a
+flat or normal-less polytope gets no depth certificate at all (its ``upper``
+stays at the common-point bound, ~ +1e-12). The separated-case bounds and
+``lower`` never use the normals' completeness.
 
 Half-spaces: closed form (min over core vertices of the plane's signed
 distance). Two half-spaces: antiparallel normals give ``-(b_1 + b_2)``; any
@@ -101,10 +102,11 @@ class DistanceResult:
 class _Core:
     """Validated kernel arrays of one shape (cached per shape object)."""
 
-    __slots__ = ("P", "E", "N", "code", "radius", "offset")
+    __slots__ = ("P", "E", "N", "code", "radius", "offset", "dpad")
 
-    def __init__(self, P, E, N, code, radius, offset=0.0):
+    def __init__(self, P, E, N, code, radius, offset=0.0, dpad=0.0):
         self.P, self.E, self.N, self.code, self.radius, self.offset = P, E, N, code, radius, offset
+        self.dpad = dpad
 
 
 _CORE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -158,12 +160,43 @@ def _core(shape: ConvexShape, name: str) -> _Core:
         if not np.linalg.norm(N[0]) > 0.0:
             raise InvalidInputError(f"{name}: half-space normal is zero")
     off0 = float(shape.offsets[0]) if code < 0 else 0.0
-    core = _Core(P, E, N, code, r, off0)
+    dpad = _depth_pad(P, N) if code == _gjk.KIND_POLYTOPE else 0.0
+    core = _Core(P, E, N, code, r, off0, dpad)
     try:
         _CORE_CACHE[shape] = core
     except TypeError:
         pass
     return core
+
+
+def _depth_pad(P: np.ndarray, N: np.ndarray) -> float:
+    """Completeness defect (m) of a polytope's face normals, or inf.
+
+    Depth certificates (negative ``upper``) measure depth with the face normals:
+    ``depth_N(x) = min_i (h_V(n_i) - n_i . x) / |n_i|``. If every facet normal m
+    of the vertex hull (qhull) has a given normal n within angle theta, then
+    ``{x : n_i . x <= h_V(n_i)}`` violates each hull facet by at most
+    ``2 theta R`` (R = max vertex distance from the centroid, coordinates centred),
+    so ``depth_hull >= depth_N - 2 theta R``. Returns that defect (plus a rounding
+    pad), or inf when the hull is flat / the normals are missing: then no depth is
+    certified (upper stays at the common-point bound).
+    """
+    from scipy.spatial import ConvexHull, QhullError
+
+    if len(N) == 0 or len(P) < 4:
+        return math.inf
+    c = P.mean(axis=0)
+    Q = P - c
+    try:
+        M = ConvexHull(Q).equations[:, :3]
+    except (QhullError, ValueError):
+        return math.inf
+    Nn = N / np.linalg.norm(N, axis=1)[:, None]
+    sin = np.linalg.norm(np.cross(M[:, None, :], Nn[None, :, :]), axis=2)
+    sin = np.where(M @ Nn.T > 0.0, sin, np.inf)
+    theta = float(sin.min(axis=1).max())
+    R = float(np.sqrt((Q**2).sum(axis=1).max()))
+    return 2.0 * theta * R * (1.0 + 1e-6) + 64 * 2.0**-52 * R
 
 
 def _check_pose(X, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -296,10 +329,10 @@ def _depth_lp(shape_a: ConvexShape, Ra, pa, shape_b: ConvexShape, Rb, pb, x0: np
         elif c[0] == "pt":
             x = c[1][0].copy()
     depth = 0.0
-    for c in cores:
+    for c, shape in zip(cores, (shape_a, shape_b)):
         if c[0] == "poly":
             _, V, N, nrm, b = c
-            dc = float(((b - N @ x) / nrm).min()) - pad
+            dc = float(((b - N @ x) / nrm).min()) - pad - _core(shape, "shape").dpad
             if dc < 0.0:
                 return None
             depth += dc
@@ -369,7 +402,8 @@ def shape_distance(shape_a: ConvexShape, X_a, shape_b: ConvexShape, X_b, *,
     if hb:
         return _halfspace_core(cb_, Rb, pb, ca_, Ra, pa, tol, out, False)
     _gjk.core_distance(ca_.P, Ra, pa, ca_.E, ca_.N, cb_.P, Rb, pb, cb_.E, cb_.N, ca_.code, cb_.code,
-                       tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+                       ca_.dpad, cb_.dpad, tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER,
+                       _MAX_EDGE_PAIRS, out)
     status = int(out[0])
     est, lower, upper = float(out[1]), float(out[2]), float(out[3])
     ra, rb = ca_.radius, cb_.radius
@@ -471,7 +505,8 @@ def shape_distance_batch(shape_a: ConvexShape, Xs_a, shape_b: ConvexShape, Xs_b,
         return lo, up
     out = np.empty((T, _gjk.OUT_SIZE))
     _gjk.core_distance_batch(ca_.P, Ra, pa, ca_.E, ca_.N, cb_.P, Rb, pb, cb_.E, cb_.N, ca_.code, cb_.code,
-                             tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+                             ca_.dpad, cb_.dpad, tol.rel_pad, tol.abs_pad, _EPS_REL, _MAX_ITER,
+                       _MAX_EDGE_PAIRS, out)
     rsum = ca_.radius + cb_.radius
     lo = out[:, 2] - rsum
     up = out[:, 3] - rsum
