@@ -182,6 +182,8 @@ class Scene:
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
                  tolerances: Tolerances):
+        pair_ids.setflags(write=False)
+        body_static.setflags(write=False)
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
