@@ -1,0 +1,314 @@
+"""The public entry point :func:`certify`: cull, check, confirm, combine.
+
+Pipeline for one window [t0, t1] and the scene's candidate geom pairs:
+
+1. **Validation** (typed errors): margin finite and >= 0, epsilon finite and > 0, a
+   non-empty finite window inside the plan, a known method, a plan of the scene's model
+   (``plan.model is scene.model`` or equal model hashes; otherwise the body count must
+   match), known pair names.
+2. **Cull.** Pairs of two scene-static bodies (welded to the world) are ``"culled"``
+   (MuJoCo never collides them either). Pairs whose swept bounding spheres
+   (:mod:`monitor.certify.broadphase`, 8 sub-intervals) stay further apart than the
+   margin are ``"culled"`` and certified, with the sphere gap as clearance bound.
+3. **Start pose.** Every remaining pair gets the exact static distance at t0
+   (:func:`monitor.geometry.distance.shape_distance`): ``upper < margin`` is a violation
+   at t0 (method ``"static"``). If neither that nor clear cores can be proven, the pair can
+   at best be "uncertain" (boundary tests cannot see containment). Pairs whose bodies do
+   not move relative to the world in the window are decided by this test alone.
+4. **Checkers.** ``method="auto"``: pairs whose two bodies both translate with
+   piecewise-constant velocity (``Trajectory.translation_segments``) go to the exact
+   extrusion checker, the rest to the toleranced checker; ``"toleranced"`` / ``"extrusion"``
+   force one (extrusion raises InvalidInputError on a non-translating pair).
+5. **Witnesses.** For every interval a checker could not exclude, exact static tests at
+   ``Tolerances.witness_candidates`` times (in time order, stopping at the first hit):
+   ``upper < margin`` confirms a violation with a :class:`Witness`; otherwise the pair is
+   "uncertain". An extrusion "violation" is re-confirmed the same way at its witness time.
+6. **Combine.** Any violation wins (earliest witness), else any uncertain, else certified.
+   ``clearance`` is the minimum of the per-pair certified lower bounds (toleranced
+   certified pairs contribute ``margin``: the checker proves ``distance > margin``; -inf for
+   uncertain / violating pairs; culled static-static pairs do not contribute).
+
+MuJoCo's per-geom ``margin`` is not added: ``margin`` here is the caller's clearance.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from monitor.certify.broadphase import swept_sphere_gaps
+from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
+from monitor.certify.common import Budget, PairOutcome
+from monitor.errors import InvalidInputError, ModelMismatchError
+from monitor.tolerances import DEFAULT, Tolerances
+
+_METHODS = ("auto", "toleranced", "extrusion")
+_MAX_WITNESS_INTERVALS = 64
+"""Intervals per pair searched for a witness (in time order); the rest stay uncertain."""
+
+
+def _finite(name: str, x: Any) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"{name} must be a real number, got {x!r}") from exc
+    if math.isnan(v) or math.isinf(v):
+        raise InvalidInputError(f"{name} must be finite, got {v}")
+    return v
+
+
+def _check_model(scene: Any, plan: Any) -> None:
+    pm = getattr(plan, "model", None)
+    if pm is not None and pm is not scene.model:
+        try:
+            from monitor.scene import model_hash
+            same = model_hash(pm) == scene.model_hash
+        except Exception:  # noqa: BLE001 - any failure to hash means we cannot prove equality
+            same = False
+        if not same:
+            raise ModelMismatchError("the plan was built for a different MjModel than the scene "
+                                     "(model objects differ and their hashes differ)")
+    if int(plan.nbody) != len(scene.body_names):
+        raise ModelMismatchError(f"plan has {plan.nbody} bodies, scene has {len(scene.body_names)}")
+
+
+def _select(scene: Any, pairs: Any) -> list[int]:
+    if pairs is None:
+        return list(range(len(scene.candidate_pairs)))
+    index = {}
+    for i, (a, b) in enumerate(scene.candidate_pairs):
+        index[(a, b)] = i
+        index[(b, a)] = i
+    out = []
+    for k, pr in enumerate(pairs):
+        try:
+            a, b = pr
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(f"pairs[{k}] must be a (geom_a, geom_b) name pair, got {pr!r}") from exc
+        if (a, b) not in index:
+            raise InvalidInputError(f"pairs[{k}] = ({a!r}, {b!r}) is not a candidate pair of the scene")
+        out.append(index[(a, b)])
+    return sorted(set(out))
+
+
+def _make_budget(budget: Any) -> Budget | None:
+    if budget is None or isinstance(budget, Budget):
+        return budget
+    if isinstance(budget, dict):
+        return Budget(seconds=budget.get("seconds"), tests=budget.get("tests"))
+    raise InvalidInputError(f"budget must be None, a Budget or a dict, got {type(budget).__name__}")
+
+
+def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, method: str = "auto", *,
+            window: tuple[float, float] | None = None, budget: Budget | dict | None = None,
+            tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None) -> Certificate:
+    """Certify that the planned motion keeps every candidate pair at least ``margin`` apart.
+
+    Args:
+        scene: :class:`monitor.Scene`.
+        plan: a Trajectory (:class:`monitor.Plan` or :class:`monitor.BodyMotion`) of the scene's model.
+        margin: clearance (m) that counts as safe; distance below it is a violation.
+        epsilon: termination tolerance (m of body motion), R * max rho < epsilon.
+        method: "auto" | "toleranced" | "extrusion".
+        window: (t0, t1) sub-window (s); default the plan's span.
+        budget: None, a :class:`Budget`, or {"seconds": .., "tests": ..}.
+        tolerances: numerical tolerances.
+        pairs: optional subset of candidate pairs (geom-name pairs) to certify.
+
+    Returns:
+        The :class:`Certificate`.
+
+    Raises:
+        InvalidInputError: bad margin / epsilon / window / method / pairs (NaN, ranges).
+        ModelMismatchError: the plan belongs to a different model.
+    """
+    wall0 = time.perf_counter()
+    tol = tolerances
+    margin = _finite("margin", margin)
+    if margin < 0:
+        raise InvalidInputError(f"margin must be >= 0, got {margin}")
+    epsilon = _finite("epsilon", epsilon)
+    if epsilon <= 0:
+        raise InvalidInputError(f"epsilon must be > 0, got {epsilon}")
+    if method not in _METHODS:
+        raise InvalidInputError(f"method must be one of {_METHODS}, got {method!r}")
+    _check_model(scene, plan)
+    pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
+    if window is None:
+        t0, t1 = pt0, pt1
+    else:
+        try:
+            t0, t1 = (_finite("window[0]", window[0]), _finite("window[1]", window[1]))
+        except (TypeError, IndexError) as exc:
+            raise InvalidInputError(f"window must be (t0, t1), got {window!r}") from exc
+        if t0 < pt0 or t1 > pt1:
+            raise InvalidInputError(f"window ({t0}, {t1}) is not inside the plan span ({pt0}, {pt1})")
+    if not t1 > t0:
+        raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
+    bud = _make_budget(budget)
+    sel = _select(scene, pairs)
+
+    moving = np.asarray(plan.moving_bodies(), bool)
+    static = np.asarray(scene.body_static, bool)
+    results: dict[int, PairResult] = {}
+    gi = [(scene.geoms[int(scene.pair_ids[i][0])], scene.geoms[int(scene.pair_ids[i][1])]) for i in sel]
+    mix: dict[str, int] = {}
+    tests_total, depth_max = 0, 0
+
+    def done(i: int, r: PairResult) -> None:
+        results[i] = r
+        mix[r.method] = mix.get(r.method, 0) + 1
+
+    # -- 1. cull static-static ---------------------------------------------------------
+    todo = []
+    for i, (ga, gb) in zip(sel, gi):
+        if static[ga.body_id] and static[gb.body_id]:
+            done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "culled",
+                               clearance=float("inf")))
+        else:
+            todo.append((i, ga, gb))
+    # -- 2. swept spheres -------------------------------------------------------------
+    if todo:
+        gaps = swept_sphere_gaps(plan, [t[1].shape for t in todo], np.array([t[1].body_id for t in todo]),
+                                 [t[2].shape for t in todo], np.array([t[2].body_id for t in todo]),
+                                 (t0, t1), tolerances=tol)
+        rest = []
+        for (i, ga, gb), gap in zip(todo, gaps):
+            if gap > margin:
+                done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "culled",
+                                   clearance=float(gap)))
+            else:
+                rest.append((i, ga, gb))
+        todo = rest
+    # -- 3. start pose -----------------------------------------------------------------
+    from monitor.geometry.distance import shape_distance
+
+    witness_of: dict[int, Witness] = {}
+    start_unproven: set[int] = set()
+    checked = []
+    if todo:
+        pos0, rot0 = plan.body_poses(np.array([t0]))
+        for i, ga, gb in todo:
+            d = shape_distance(ga.shape, (rot0[0, ga.body_id], pos0[0, ga.body_id]),
+                               gb.shape, (rot0[0, gb.body_id], pos0[0, gb.body_id]), tolerances=tol)
+            if d.upper < margin:
+                w = Witness(t0, (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper))
+                done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "violation", "static",
+                                   intervals=((t0, t0),), witness=w))
+                continue
+            cores_apart = d.lower + ga.shape.radius + gb.shape.radius > 0
+            if not (d.lower > margin or cores_apart):
+                start_unproven.add(i)
+            if not moving[ga.body_id] and not moving[gb.body_id]:
+                if d.lower > margin:
+                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "static",
+                                       clearance=float(d.lower)))
+                else:
+                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "uncertain", "static",
+                                       intervals=((t0, t1),)))
+                continue
+            checked.append((i, ga, gb))
+    # -- 4. dispatch ---------------------------------------------------------------------
+    ext_items, tol_items = [], []
+    for i, ga, gb in checked:
+        trans = None
+        if method in ("auto", "extrusion"):
+            sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
+            if sa is not None and sb is not None:
+                trans = (sa, sb)
+            elif method == "extrusion":
+                raise InvalidInputError(f"method='extrusion' but pair ({ga.name!r}, {gb.name!r}) does not "
+                                        "translate with piecewise-constant velocity")
+        if trans is not None:
+            ext_items.append((i, ga, gb, trans))
+        else:
+            tol_items.append((i, ga, gb))
+    outcomes: dict[int, tuple[str, PairOutcome]] = {}
+    if ext_items:
+        from monitor.certify import extrusion
+        posr, rotr = plan.body_poses(np.array([t0]))
+        eps_pairs = []
+        for _i, ga, gb, ((ta, oa), (tb, ob)) in ext_items:
+            eps_pairs.append(extrusion.TranslatingPair(
+                ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
+                gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
+                name=(ga.name, gb.name)))
+        outs = extrusion.check_pairs(eps_pairs, (t0, t1), margin, tol, bud)
+        for (i, _ga, _gb, _), o in zip(ext_items, outs):
+            outcomes[i] = ("extrusion", o)
+    if tol_items:
+        from monitor.certify import toleranced
+        items = [(ga.shape, ga.body_id, gb.shape, gb.body_id) for _i, ga, gb in tol_items]
+        outs = toleranced.check_pairs(plan, items, (t0, t1), margin, epsilon, tol, bud,
+                                      static=static & ~moving, check_start=False)
+        for (i, _ga, _gb), o in zip(tol_items, outs):
+            outcomes[i] = ("toleranced", o)
+    # -- 5. witnesses ---------------------------------------------------------------------
+    by_i = {i: (ga, gb) for i, ga, gb in checked}
+    for i, (meth, o) in outcomes.items():
+        ga, gb = by_i[i]
+        tests_total += int(o.tests)
+        depth_max = max(depth_max, int(o.max_depth))
+        names, bodies = (ga.name, gb.name), (ga.body, gb.body)
+        if o.verdict == "certified" and i not in start_unproven:
+            clear = o.clearance if np.isfinite(o.clearance) else margin
+            done(i, PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (),
+                               float(max(clear, margin) if meth == "toleranced" else clear)))
+            continue
+        intervals = list(o.intervals)
+        if o.verdict == "certified":  # start pose not proven clear
+            intervals = [(t0, t0)]
+        cands: list[float] = []
+        if o.verdict == "violation" and o.witness_time is not None:
+            cands.append(float(o.witness_time))
+            if not intervals:
+                intervals = [(float(o.witness_time), float(o.witness_time))]
+        for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
+            k = 1 if b <= a else max(2, tol.witness_candidates)
+            cands += list(np.linspace(a, b, k))
+        w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol) if cands else None
+        if w is not None:
+            witness_of[i] = w
+            done(i, PairResult(names, bodies, "violation", meth, o.tests, o.max_depth,
+                               tuple(intervals), float("-inf"), w))
+        else:
+            done(i, PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
+                               tuple(intervals) if intervals else ((t0, t1),), float("-inf")))
+    # -- 6. combine -------------------------------------------------------------------------
+    ordered = tuple(results[i] for i in sel)
+    verdict = combine_verdicts([r.verdict for r in ordered])
+    witnesses = [r.witness for r in ordered if r.verdict == "violation" and r.witness is not None]
+    witness = min(witnesses, key=lambda w: w.time) if witnesses else None
+    earliest = None
+    if verdict != "certified":
+        starts = [r.intervals[0][0] for r in ordered if r.verdict != "certified" and r.intervals]
+        starts += [w.time for w in witnesses]
+        earliest = float(min(starts)) if starts else t0
+    clears = [r.clearance for r in ordered if not (r.method == "culled" and math.isinf(r.clearance))]
+    clearance = float(min(clears)) if clears else float("inf")
+    stats = {"pairs": len(ordered), "pairs_culled": sum(r.method == "culled" for r in ordered),
+             "tests": tests_total, "max_depth": depth_max,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
+             "budget_exhausted": bool(bud is not None and bud.exhausted)}
+    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
+                       ordered, stats)
+
+
+def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
+                  tol: Tolerances) -> Witness | None:
+    """Earliest candidate time whose exact static distance upper bound is below margin."""
+    from monitor.geometry.distance import shape_distance
+
+    pos, rot = plan.body_poses(times)
+    for k, t in enumerate(times):
+        d = shape_distance(ga.shape, (rot[k, ga.body_id], pos[k, ga.body_id]),
+                           gb.shape, (rot[k, gb.body_id], pos[k, gb.body_id]), tolerances=tol)
+        if d.upper < margin:
+            return Witness(float(t), (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper))
+    return None
+
+
+__all__ = ["certify"]
