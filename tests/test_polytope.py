@@ -285,3 +285,14 @@ def test_transformed_polytope_keeps_hrep():
     inside = (X @ shape.normals.T - shape.offsets).max(axis=1)
     inside_moved = ((X @ R.T + p) @ moved.normals.T - moved.offsets).max(axis=1)
     np.testing.assert_allclose(inside, inside_moved, atol=1e-14)
+
+
+def test_merge_chain_fallback_keeps_faces_planar():
+    """If merging chains near-coplanar triangles into a non-planar face, the hull falls back to
+    one face per triangle (forced here with a huge merge tolerance)."""
+    from monitor.geometry.polytope import _COPLANAR_REL, _hull_polytope
+
+    P = unit(np.random.default_rng(8), 300)
+    shape = _hull_polytope(P, scale=0.01 / _COPLANAR_REL)  # merge tolerance 1 cm on a unit sphere
+    check_valid(shape)
+    assert len(shape.faces) == len(ConvexHull(P).simplices)

@@ -127,13 +127,17 @@ class _BadHull(Exception):
     """qhull's output could not be assembled into a valid polytope."""
 
 
-def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
+def _hull_polytope(P: np.ndarray, scale: float, merge: bool = True) -> ConvexShape:
     """Polytope from a full-rank point set (raises QhullError/_BadHull if degenerate).
 
     Adjacent qhull triangles whose vertices lie within ``_COPLANAR_REL * scale``
     of each other's planes form one face (connected components); the face normal
     is the area-weighted mean of its triangles' outward normals and its loop is
     its vertices sorted by angle about the face centroid (CCW seen from outside).
+    If a merged face ends up non-planar by more than ``_COPLANAR_REL * scale``
+    (possible only through long chains of near-coplanar triangles), the hull is
+    rebuilt with one face per qhull triangle (``merge=False``), which is always
+    planar.
     """
     hull = ConvexHull(P)
     simp = hull.simplices.astype(np.int64)
@@ -148,7 +152,7 @@ def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
     ti, tj = ti[m], tj[m]
     dij = np.abs(np.einsum("kvj,kj->kv", P[simp[tj]], nrm[ti]) + d[ti, None]).max(axis=1)
     dji = np.abs(np.einsum("kvj,kj->kv", P[simp[ti]], nrm[tj]) + d[tj, None]).max(axis=1)
-    m = (dij <= tol) & (dji <= tol)
+    m = (dij <= tol) & (dji <= tol) & merge
     graph = coo_matrix((np.ones(int(m.sum())), (ti[m], tj[m])), shape=(nt, nt))
     nface, label = connected_components(graph, directed=False)
 
@@ -177,7 +181,11 @@ def _hull_polytope(P: np.ndarray, scale: float) -> ConvexShape:
     ang = np.arctan2(np.einsum("ij,ij->i", q, W[fl]), np.einsum("ij,ij->i", q, U[fl]))
     order = np.lexsort((ang, fl))
     faces = np.split(fv[order], np.cumsum(cnt)[:-1])
-    return _assemble(V, faces, N, P)
+    shape = _assemble(V, faces, N, P)
+    spread = shape.offsets[fl] - np.einsum("ij,ij->i", N[fl], V[fv])  # >= 0: depth of loop vertices
+    if merge and spread.max() > tol:
+        return _hull_polytope(P, scale, merge=False)
+    return shape
 
 
 def _prism(center: np.ndarray, u: np.ndarray, w: np.ndarray, n: np.ndarray, ring: np.ndarray,
