@@ -16,10 +16,17 @@ from scipy.optimize import linprog, minimize
 from scipy.spatial.transform import Rotation
 
 from monitor.errors import InvalidInputError
-from monitor.geometry.distance import DistanceResult, point_in_shape, shape_distance, shape_distance_batch
+from monitor.geometry.distance import (
+    DistanceResult,
+    point_in_shape,
+    sample_surface,
+    shape_distance,
+    shape_distance_batch,
+)
 from monitor.geometry.polytope import (
     box_polytope,
     capsule_shape,
+    cylinder_polytope,
     halfspace_shape,
     polytope_from_points,
     sphere_shape,
@@ -344,6 +351,71 @@ def test_capsule_piercing_box_mujoco_regression():
     # exact penetration depth: lift the capsule by 0.15 + 0.01 + 0.022
     check_bounds(res, -0.182, est_tol=1e-9)
     assert res.upper <= -0.032 + 1e-9  # the segment point at the plate's mid plane is 0.01 deep
+
+
+def _qp_segment_hull(S, N, b):
+    """Segment (2, 3) to H-polytope distance by SLSQP (approximate oracle)."""
+    e = S[1] - S[0]
+    cons = [{"type": "ineq", "fun": lambda z: b - N @ z[1:], "jac": lambda z: np.c_[0 * b, -N]}]
+    qp = minimize(lambda z: ((S[0] + z[0] * e - z[1:]) ** 2).sum(), np.r_[0.5, S.mean(axis=0)],
+                  method="SLSQP", bounds=[(0, 1)] + [(None, None)] * 3, constraints=cons,
+                  options={"ftol": 1e-16, "maxiter": 500})
+    return float(np.sqrt(max(qp.fun, 0.0)))
+
+
+def test_capsule_vs_random_hull_lp_depth_and_qp_distance():
+    """Segment core vs hull: LP oracle max_t depth (overlap), SLSQP distance (apart)."""
+    rng = np.random.default_rng(13)
+    n_over = n_sep = 0
+    for i in range(200):
+        H = rand_hull(rng)
+        cap = capsule_shape(rng.uniform(0.01, 0.2), rng.uniform(0.0, 1.5))
+        Rh, Rc = rand_rot(rng), rand_rot(rng)
+        ph = rand_offset(rng)
+        pc = ph + rng.normal(size=3) * 1.2
+        N = H.normals @ Rh.T
+        b = (N @ (H.points @ Rh.T).T).max(axis=1)  # frame shifted by ph
+        S = cap.points @ Rc.T + (pc - ph)
+        e = S[1] - S[0]
+        # LP: max s  s.t.  N (s0 + t e) + s <= b,  t in [0, 1]
+        A = np.c_[N @ e, np.ones(len(N))]
+        lp = linprog([0, -1.0], A_ub=A, b_ub=b - N @ S[0], bounds=[(0, 1), (-10, None)], method="highs")
+        depth = -lp.fun
+        res = shape_distance(cap, (Rc, pc), H, (Rh, ph))
+        res2 = shape_distance(H, (Rh, ph), cap, (Rc, pc))
+        # argument order only changes the relative frame (and so the rounding pads)
+        assert abs(res.lower - res2.lower) < 1e-10 and abs(res.upper - res2.upper) < 1e-10
+        r = cap.radius
+        if depth > 1e-7:
+            n_over += 1
+            assert res.upper <= -depth - r + 1e-9, (i, depth, res)
+            assert res.lower <= -depth - r + 1e-9
+        elif depth < -1e-7:
+            n_sep += 1
+            assert res.lower > -r
+            assert res.upper - res.lower < 1e-11
+            if i % 2 == 0:
+                qp = _qp_segment_hull(S, N, b)
+                assert abs(qp - r - res.distance) < 1e-6, (i, qp, res)
+    assert n_over > 30 and n_sep > 30
+
+
+@pytest.mark.parametrize("make", [lambda: sphere_shape(0.3, np.array([0.1, -0.2, 0.05])),
+                                  lambda: capsule_shape(0.1, 0.4), lambda: box_polytope([0.2, 0.3, 0.1]),
+                                  lambda: cylinder_polytope(0.1, 0.2, 8)])
+def test_sample_surface_points_are_on_the_boundary(make):
+    rng = np.random.default_rng(14)
+    shape = make()
+    pts = sample_surface(shape, 200, rng)
+    assert pts.shape == (200, 3)
+    R, p = rand_rot(rng), rand_offset(rng)
+    pt = ConvexShape("sphere", np.zeros((1, 3)), 0.0)
+    for q in pts:
+        res = shape_distance(pt, (I3, R @ q + p), shape, (R, p))
+        assert res.lower <= 1e-9 and res.upper >= -1e-9
+        assert abs(res.distance) < 1e-9
+    with pytest.raises(InvalidInputError):
+        sample_surface(halfspace_shape(), 3, rng)
 
 
 # ---------------------------------------------------------------------------- half-spaces, degenerate

@@ -540,4 +540,70 @@ def point_in_shape(shape: ConvexShape, X, point: np.ndarray, pad: float = 0.0, *
     return bool(res.upper <= pad)
 
 
-__all__ = ["DistanceResult", "shape_distance", "shape_distance_batch", "point_in_shape"]
+def sample_surface(shape: ConvexShape, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Random points on the boundary of a bounded shape, in its body frame (for oracles).
+
+    Spheres and capsules are sampled uniformly by area (cylinder + two
+    hemispheres); polytopes (radius 0) uniformly by area over fan-triangulated
+    faces. Not for half-spaces (unbounded).
+
+    Args:
+        shape: sphere, capsule, or polytope with radius 0.
+        n: number of points (>= 0).
+        rng: numpy Generator.
+
+    Returns:
+        (n, 3) body-frame points, metres.
+
+    Raises:
+        InvalidInputError: half-space, polytope with a radius, or a polytope without faces.
+    """
+    core = _core(shape, "shape")
+    n = int(n)
+    if n < 0:
+        raise InvalidInputError(f"n must be >= 0, got {n}")
+
+    def unit(k):
+        d = rng.normal(size=(k, 3))
+        return d / np.linalg.norm(d, axis=1)[:, None]
+
+    r = core.radius
+    if core.code == _gjk.KIND_POINT:
+        return core.P[0] + r * unit(n)
+    if core.code == _gjk.KIND_SEGMENT:
+        p0, p1 = core.P
+        e = p1 - p0
+        L = float(np.linalg.norm(e))
+        if L == 0.0:
+            return p0 + r * unit(n)
+        a = e / L
+        u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        w = np.cross(a, u)
+        cyl = rng.random(n) < (2 * np.pi * r * L) / (2 * np.pi * r * L + 4 * np.pi * r * r)
+        out = np.empty((n, 3))
+        k = int(cyl.sum())
+        t = rng.random(k)
+        phi = rng.uniform(0, 2 * np.pi, k)
+        out[cyl] = p0 + t[:, None] * e + r * (np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * w)
+        d = unit(n - k)
+        ends = np.where((d @ a >= 0)[:, None], p1, p0)
+        out[~cyl] = ends + r * d
+        return out
+    if core.code == _gjk.KIND_POLYTOPE:
+        if r > 0.0:
+            raise InvalidInputError("sample_surface: polytopes with a radius are not supported")
+        if not shape.faces:
+            raise InvalidInputError("sample_surface: the polytope has no faces")
+        tris = np.array([(f[0], f[i], f[i + 1]) for f in shape.faces for i in range(1, len(f) - 1)],
+                        dtype=np.int64)
+        A, B, C = core.P[tris[:, 0]], core.P[tris[:, 1]], core.P[tris[:, 2]]
+        area = 0.5 * np.linalg.norm(np.cross(B - A, C - A), axis=1)
+        idx = rng.choice(len(tris), size=n, p=area / area.sum())
+        s1 = np.sqrt(rng.random(n))[:, None]
+        s2 = rng.random(n)[:, None]
+        return (1 - s1) * A[idx] + s1 * (1 - s2) * B[idx] + s1 * s2 * C[idx]
+    raise InvalidInputError("sample_surface: a half-space is unbounded")
+
+
+__all__ = ["DistanceResult", "shape_distance", "shape_distance_batch", "point_in_shape", "sample_surface"]
