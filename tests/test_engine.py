@@ -6,9 +6,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from monitor.certify.engine import certify
 from monitor.certify.certificate import Certificate
 from monitor.certify.common import Budget
+from monitor.certify.engine import certify
 from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.geometry.distance import shape_distance
 from monitor.motion.plan import Plan
