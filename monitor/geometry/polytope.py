@@ -134,10 +134,10 @@ def _hull_polytope(P: np.ndarray, scale: float, merge: bool = True) -> ConvexSha
     of each other's planes form one face (connected components); the face normal
     is the area-weighted mean of its triangles' outward normals and its loop is
     its vertices sorted by angle about the face centroid (CCW seen from outside).
-    If a merged face ends up non-planar by more than ``_COPLANAR_REL * scale``
-    (possible only through long chains of near-coplanar triangles), the hull is
-    rebuilt with one face per qhull triangle (``merge=False``), which is always
-    planar.
+    If a merged face ends up non-planar by more than ``_COPLANAR_REL * scale`` or
+    the merged faces do not form a closed manifold (possible only through long
+    chains of near-coplanar triangles), the hull is rebuilt with one face per
+    qhull triangle (``merge=False``), which is always planar.
     """
     hull = ConvexHull(P)
     simp = hull.simplices.astype(np.int64)
@@ -181,7 +181,12 @@ def _hull_polytope(P: np.ndarray, scale: float, merge: bool = True) -> ConvexSha
     ang = np.arctan2(np.einsum("ij,ij->i", q, W[fl]), np.einsum("ij,ij->i", q, U[fl]))
     order = np.lexsort((ang, fl))
     faces = np.split(fv[order], np.cumsum(cnt)[:-1])
-    shape = _assemble(V, faces, N, P)
+    try:
+        shape = _assemble(V, faces, N, P)
+    except _BadHull:
+        if merge:  # a merged group that is not one convex planar face
+            return _hull_polytope(P, scale, merge=False)
+        raise
     spread = shape.offsets[fl] - np.einsum("ij,ij->i", N[fl], V[fv])  # >= 0: depth of loop vertices
     if merge and spread.max() > tol:
         return _hull_polytope(P, scale, merge=False)
