@@ -459,6 +459,34 @@ def test_flat_polytope_bounds():
     check_bounds(res, 0.0)
 
 
+def test_degenerate_polytope_cores_vs_sphere_closed_form():
+    """Flat rectangles / segments / single points given as 'polytope' cores with duplicate
+    vertices and no H-rep: the vertex-hull distance must still be bounded correctly."""
+    rng = np.random.default_rng(15)
+    for i in range(150):
+        a, b = rng.uniform(0.01, 1.0, 2) * [1.0, [1.0, 0.0, 0.0][i % 3]]
+        rect = np.array([[-a, -b, 0], [a, -b, 0], [a, b, 0], [-a, b, 0]], float)
+        pts = np.r_[rect, rect[rng.integers(0, 4, 3)]]  # duplicates
+        if i % 3 == 2:
+            pts = np.zeros((3, 3))  # a point, three times
+        flat = ConvexShape("polytope", pts)
+        R, p = rand_rot(rng), rand_offset(rng)
+        r = rng.uniform(0.0, 0.3)
+        q_body = rng.normal(size=3) * 0.7
+        if i % 5 == 0:
+            q_body[2] = rng.uniform(-1, 1) * 1e-9  # (nearly) in the plane
+        sph = ConvexShape("sphere", np.zeros((1, 3)), r)
+        c = R @ q_body + p
+        q = (np.asarray(c, LD) - np.asarray(p, LD)) @ np.asarray(R, LD)
+        hx, hy = (LD(a), LD(b)) if i % 3 != 2 else (LD(0), LD(0))
+        d = np.array([max(abs(q[0]) - hx, 0), max(abs(q[1]) - hy, 0), abs(q[2])], LD)
+        truth = float(np.sqrt((d**2).sum()) - LD(r))
+        res = shape_distance(sph, (I3, c), flat, (R, p))
+        check_bounds(res, truth)
+        res2 = shape_distance(flat, (R, p), sph, (I3, c))
+        check_bounds(res2, truth)
+
+
 def test_tiny_scales():
     rng = np.random.default_rng(10)
     for _ in range(50):
