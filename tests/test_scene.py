@@ -436,6 +436,25 @@ def test_maxhullvert_mesh_uses_mujoco_hull(load_asset):
     assert _polytope_volume(shape) == pytest.approx(abs(mj.volume), rel=1e-10)
 
 
+def _gymnasium_assets() -> list[Path]:
+    import importlib.util
+
+    spec = importlib.util.find_spec("gymnasium")
+    if spec is None or not spec.submodule_search_locations:
+        return []
+    root = Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets"
+    return sorted(root.glob("*.xml"))
+
+
+@pytest.mark.parametrize("path", _gymnasium_assets(), ids=lambda p: p.name)
+def test_gymnasium_models_pairs_equal_mj_collision(path):
+    """Real-world MJCF (gymnasium's bundled MuJoCo envs): the filter equals mj_collision."""
+    model = load(path)
+    scene = Scene.from_model(model)
+    assert {tuple(p) for p in scene.pair_ids.tolist()} == contact_pairs(path)
+    Scene.from_model(model, pairs="all")  # every geom type in these files is supported
+
+
 def _brute_force_mujoco(model):
     """MuJoCo's static filter rules written out pair by pair (reference section 1.8)."""
     weld, parent, dof = model.body_weldid, model.body_parentid, model.body_dofnum
