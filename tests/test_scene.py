@@ -17,6 +17,20 @@ REPO = Path(__file__).resolve().parents[1]
 PAIR_SCENES = sorted(p.name for p in ASSETS.glob("*.xml") if p.name != "hfield.xml")
 MODEL_SCENES = sorted(str(p.relative_to(REPO)) for p in (REPO / "models").glob("*/scene*.xml"))
 ALL_SCENES = [ASSETS / n for n in PAIR_SCENES] + [REPO / p for p in MODEL_SCENES]
+
+
+def _gymnasium_assets() -> list[Path]:
+    """gymnasium's bundled MuJoCo env XMLs (real-world MJCF), or [] if not found."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("gymnasium")
+    if spec is None or not spec.submodule_search_locations:
+        return []
+    root = Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets"
+    return sorted(root.glob("*.xml"))
+
+
+GYM_SCENES = _gymnasium_assets()
 TYPES = mujoco.mjtGeom
 
 
@@ -77,7 +91,9 @@ def load(path: Path) -> mujoco.MjModel:
 
 
 def _scene_id(p: Path) -> str:
-    return p.name if p.parent == ASSETS else str(p.relative_to(REPO))
+    if p.is_relative_to(REPO / "models"):
+        return str(p.relative_to(REPO))
+    return p.name if p.parent == ASSETS else f"gymnasium/{p.name}"
 
 
 @pytest.mark.parametrize("path", ALL_SCENES, ids=_scene_id)
@@ -359,7 +375,7 @@ def inside_excess(shape, p):
     return np.linalg.norm(p - (a + t[:, None] * ab), axis=1) - shape.radius
 
 
-@pytest.mark.parametrize("path", ALL_SCENES, ids=_scene_id)
+@pytest.mark.parametrize("path", ALL_SCENES + GYM_SCENES, ids=_scene_id)
 def test_shapes_contain_true_geoms_in_body_frame(path):
     """At random joint poses, MuJoCo's world geom pose composed with the body pose places the true
     geom inside the scene's body-frame shape; exact shapes have the true support function."""
@@ -436,17 +452,7 @@ def test_maxhullvert_mesh_uses_mujoco_hull(load_asset):
     assert _polytope_volume(shape) == pytest.approx(abs(mj.volume), rel=1e-10)
 
 
-def _gymnasium_assets() -> list[Path]:
-    import importlib.util
-
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        return []
-    root = Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets"
-    return sorted(root.glob("*.xml"))
-
-
-@pytest.mark.parametrize("path", _gymnasium_assets(), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", GYM_SCENES, ids=lambda p: p.name)
 def test_gymnasium_models_pairs_equal_mj_collision(path):
     """Real-world MJCF (gymnasium's bundled MuJoCo envs): the filter equals mj_collision."""
     model = load(path)
