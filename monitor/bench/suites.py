@@ -47,6 +47,7 @@ class BenchConfig:
         reps: timing repetitions per measurement (median reported).
         log: progress printer.
         shared: data passed between suites (case set, labels, our timings).
+        smoke: tiny sizes for the test suite (not a benchmark).
     """
 
     quick: bool
@@ -55,6 +56,7 @@ class BenchConfig:
     reps: int = 3
     log: Callable[[str], None] = field(default=lambda s: print(s, file=sys.stderr, flush=True))
     shared: dict[str, Any] = field(default_factory=dict)
+    smoke: bool = False
 
 
 def _missing(*modules: str) -> str | None:
@@ -79,6 +81,8 @@ def case_set(cfg: BenchConfig) -> tuple[list[PairCase], list[oracle.OracleLabel]
     if "cases" not in cfg.shared:
         t = time.perf_counter()
         cases = make_cases(cfg.seed, cfg.quick)
+        if cfg.smoke:
+            cases = cases[:: max(1, len(cases) // 4)][:4]
         t1 = time.perf_counter()
         labels = [oracle.label(c) for c in cases]
         cfg.log(
@@ -91,7 +95,8 @@ def case_set(cfg: BenchConfig) -> tuple[list[PairCase], list[oracle.OracleLabel]
 
 def run_ours(case: PairCase, method: str, epsilon: float, reps: int, facets: int = 16) -> dict[str, Any]:
     """Certify ``case`` ``reps`` times with ``monitor.certify``; verdict, tests, depth, median µs."""
-    import monitor
+    import monitor  # noqa: F401
+    from monitor.certify.engine import certify
     from monitor.errors import MonitorError
 
     scene, motion = case.scene(facets), case.body_motion()
@@ -99,7 +104,7 @@ def run_ours(case: PairCase, method: str, epsilon: float, reps: int, facets: int
     try:
         for _ in range(max(1, reps)):
             t = time.perf_counter()
-            cert = monitor.certify(scene, motion, margin=0.0, epsilon=epsilon, method=method)
+            cert = certify(scene, motion, margin=0.0, epsilon=epsilon, method=method)
             ts.append(time.perf_counter() - t)
     except MonitorError as exc:
         return {"verdict": "error", "error": f"{type(exc).__name__}: {exc}", "us": None}
@@ -153,7 +158,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     if miss:
         return {"skipped": miss}
     cases, labels = case_set(cfg)
-    eps_list = EPS_QUICK if cfg.quick else EPS_FULL
+    eps_list = (1e-3,) if cfg.smoke else EPS_QUICK if cfg.quick else EPS_FULL
     # JIT warm-up: first call per checker in this process against the median of later calls.
     warm = {}
     for method, case in (("toleranced", cases[-1]), ("extrusion", cases[0])):
@@ -200,7 +205,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
             ]
             if ee:
                 rows.append({"checker": method, "epsilon": eps, "group": group, **_score(ee)})
-    facets = _facet_sweep(cfg)
+    facets = {"skipped": "smoke run"} if cfg.smoke or cfg.shared.get("skip_facets") else _facet_sweep(cfg)
     figs = []
     peer_lines = cfg.shared.get("peer_lines", {})
     report.plot_time_vs_epsilon(
@@ -602,8 +607,9 @@ def suite_seeds(cfg: BenchConfig) -> dict[str, Any]:
                 "error": r.get("error"),
             }
         )
-    rows += _agv_rows(cfg)
-    sw = _sw_rows(cfg)
+    if not cfg.smoke:
+        rows += _agv_rows(cfg)
+    sw = _sw_rows(cfg) if not cfg.smoke else {"skipped": "smoke run"}
     md.append(
         f"Paper hardware: {PAPER_HW['sw']}; {PAPER_HW['cameron']}. Our seconds are medians on this machine "
         "(see header); the ratio to a 1990 or 2009 machine is not a speed claim."
@@ -651,7 +657,7 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
             {"experiment": f"Cameron AGV {k}", "error": "AGV case builder not available", "paper_seconds": v}
             for k, v in CAMERON_SECONDS.items()
         ]
-    import monitor
+    from monitor.certify.engine import certify
 
     rows = []
     for variant, paper in (
@@ -663,7 +669,7 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
         ts = []
         for _ in range(cfg.reps):
             t = time.perf_counter()
-            cert = monitor.certify(scene, plan, method="auto")
+            cert = certify(scene, plan, method="auto")
             ts.append(time.perf_counter() - t)
         rows.append(
             {
@@ -760,6 +766,8 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
 
     env_ids = ["Reacher-v5", "Pusher-v5", "Ant-v5", "monitor/Arm-v0"]
     steps = 40 if cfg.quick else 300
+    if cfg.smoke:
+        env_ids, steps = ["Reacher-v5"], 3
     reps = 3 if cfg.quick else 5
     rows = []
     for env_id in env_ids:
@@ -887,12 +895,13 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
     if miss:
         return {"skipped": miss}
     import monitor
+    from monitor.certify.engine import certify
 
     rows = []
     limit = 60.0 if cfg.quick else 600.0
     for motion in ("translating", "rotating"):
         for density in ("sparse", "dense"):
-            for n in (10, 100, 1000):
+            for n in (10,) if cfg.smoke else (10, 100, 1000):
                 prev = [
                     r for r in rows if (r["motion"], r["density"]) == (motion, density) and r.get("seconds")
                 ]
@@ -915,7 +924,7 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
                     ts, cert = [], None
                     for _ in range(1 if n >= 1000 else cfg.reps):
                         t = time.perf_counter()
-                        cert = monitor.certify(scene, bm, epsilon=1e-3)
+                        cert = certify(scene, bm, epsilon=1e-3)
                         ts.append(time.perf_counter() - t)
                     rows.append(
                         {
@@ -1029,7 +1038,7 @@ def _nary(cfg: BenchConfig) -> dict[str, Any]:
         return {"skipped": str(exc)}
     rows = []
     for density in ("sparse", "dense"):
-        for n in (10, 20) if cfg.quick else (10, 20, 40):
+        for n in (4,) if cfg.smoke else (10, 20) if cfg.quick else (10, 20, 40):
             model, bm = scaling_scene(n, density, "translating")
             from monitor.geometry.polytope import box_polytope
 

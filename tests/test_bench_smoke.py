@@ -1,0 +1,182 @@
+"""Smoke tests of the benchmark harness (issue 7): oracle, peers, report, suites, CLI.
+
+The oracle is checked against closed forms (axis-aligned boxes passing each other
+at a known gap), and the exact LP against the sampling oracle; peers are checked
+on an obvious collision and an obvious miss. No timings are asserted.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from monitor.bench import oracle, report  # noqa: E402
+from monitor.bench.cases import PairCase, ShapeSpec  # noqa: E402
+
+IDQ = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def slab_case(gap: float, *, turn: float = 0.0, both: bool = False, name: str = "slab") -> PairCase:
+    """Box A (half 0.1, 0.08, 0.05) passes along x over box B (half 0.1) with y gap ``gap``.
+
+    A rotates by ``turn`` rad about y (preserves y), so the min distance is exactly ``gap``.
+    With ``both``, B moves along z by 0.01 (its top face stays at y = 0.1): still exact.
+    """
+    a, b = ShapeSpec.box([0.1, 0.08, 0.05]), ShapeSpec.box([0.1, 0.1, 0.1])
+    y = 0.1 + 0.08 + gap
+    pos = np.array([[[-0.6, y, 0.0], [0.6, y, 0.0]], [[0.0, 0.0, 0.0], [0.0, 0.0, 0.01 if both else 0.0]]])
+    quat = np.tile(IDQ, (2, 2, 1))
+    quat[0, 1] = [math.cos(turn / 2), 0.0, math.sin(turn / 2), 0.0]
+    group = "rotating" if turn else "translating"
+    return PairCase(name, group, "collide" if gap < 0 else "near", gap, (a, b), pos, quat, (True, both))
+
+
+@pytest.fixture(scope="module")
+def small_set():
+    cases = [slab_case(-0.01, name="col"), slab_case(1e-3, name="near3"), slab_case(0.05, turn=1.0, name="rot"),
+             slab_case(-1e-3, turn=0.5, both=True, name="rotcol")]
+    return cases, [oracle.label(c) for c in cases]
+
+
+def test_oracle_closed_form(small_set):
+    cases, labels = small_set
+    got = {c.name: lab for c, lab in zip(cases, labels)}
+    assert got["col"].label == "collide" and got["rotcol"].label == "collide"
+    for name, gap in (("near3", 1e-3), ("rot", 0.05)):
+        lab = got[name]
+        assert lab.label == "clear"
+        assert 0.0 < lab.clearance_lower <= gap + 1e-9
+        assert lab.distance_upper >= gap - 1e-6
+    assert got["col"].lp is True and got["near3"].lp is False  # exact LP agrees on the translating cases
+
+
+def test_lp_matches_sampling_on_random_translations():
+    rng = np.random.default_rng(3)
+    for _ in range(12):
+        a = ShapeSpec.box(rng.uniform(0.05, 0.2, 3))
+        pts = rng.normal(size=(10, 3)) * 0.1
+        b = ShapeSpec.hull(pts)
+        pos = np.zeros((2, 2, 3))
+        pos[0, 0], pos[0, 1] = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3)
+        quat = np.tile(IDQ, (2, 2, 1))
+        case = PairCase("r", "translating", "near", 0.0, (a, b), pos, quat, (True, False))
+        lab = oracle.label(case, resolution=1e-7)
+        sampled = lab.hit_time is not None
+        if lab.label != "near":
+            assert sampled == oracle.lp_overlap(case)
+
+
+def test_speed_bound_is_conservative():
+    case = slab_case(0.01, turn=2.0)
+    ts = np.linspace(0, 1, 2001)
+    P, R = case.poses(ts)
+    corners = case.shapes[0].vertices
+    X = np.einsum("tij,nj->tni", R[:, 0], corners) + P[:, 0, None, :]
+    speed = np.linalg.norm(np.diff(X, axis=0), axis=2).max() / (ts[1] - ts[0])
+    assert speed <= case.speed_bounds()[0]
+
+
+def test_peers_on_obvious_cases(small_set):
+    from monitor.bench import peers
+
+    cases, _ = small_set
+    col, clear = cases[0], cases[2]
+    for n in (10, 100):
+        s = peers.MujocoSampler(n)
+        assert s.query(s.prepare(col))[0] is True
+        assert s.query(s.prepare(clear))[0] is False
+    if peers.have_fcl():
+        p = peers.FclPeer("CCDM_LINEAR", "CCDC_NAIVE")
+        assert p.query(p.prepare(col))[0] is True
+        assert p.query(p.prepare(clear))[0] is False
+    if peers.have_ipctk():
+        p = peers.IpctkPeer()
+        assert p.applies(col)
+        assert p.query(p.prepare(col))[0] is True
+        assert p.query(p.prepare(clear))[0] is False
+
+
+def test_captured_fds_sees_c_level_output():
+    from monitor.bench.peers import captured_fds
+
+    with captured_fds() as cap:
+        os.write(1, b"hello-fd1 ")
+        os.write(2, b"not supported")
+    assert "hello-fd1" in cap[0] and "not supported" in cap[0]
+
+
+def test_fcl_probe_classifies():
+    from monitor.bench import peers
+
+    if not peers.have_fcl():
+        pytest.skip("python-fcl not installed")
+    res = peers.probe_fcl(motions=("CCDM_LINEAR",), solvers=("CCDC_NAIVE", "CCDC_POLYNOMIAL_SOLVER"))
+    assert res["CCDM_LINEAR|CCDC_NAIVE|box"]["status"] == "ok"
+    assert res["CCDM_LINEAR|CCDC_POLYNOMIAL_SOLVER|box"]["status"] == "unsupported"
+
+
+def test_report_files(tmp_path):
+    rows = [{"checker": "toleranced", "group": "rotating", "epsilon": e, "us_median": 100 / e ** 0.2,
+             "us_p95": 150 / e ** 0.2} for e in (1e-1, 1e-3)]
+    report.plot_time_vs_epsilon(tmp_path / "a.png", rows, {"fcl": 10.0})
+    pts = [{"checker": "toleranced", "clearance": c, "epsilon": 1e-3, "verdict": v}
+           for c, v in ((1e-4, "uncertain"), (1e-2, "certified"), (1e-1, "certified"))]
+    report.plot_uncertain(tmp_path / "b.png", pts)
+    assert (tmp_path / "a.png").stat().st_size > 1000 and (tmp_path / "b.png").stat().st_size > 1000
+    res = {"command": "x", "quick": True, "wall_seconds": 1.0, "machine": report.machine_info(),
+           "suites": {"s": {"markdown": [report.table(rows, ["checker", "epsilon", "us_median"])],
+                            "figures": ["a.png"], "value": float("nan")}, "t": {"skipped": "why"}}}
+    report.write_json(tmp_path / "r.json", res)
+    report.write_markdown(tmp_path / "r.md", res)
+    back = json.loads((tmp_path / "r.json").read_text())
+    assert back["suites"]["s"]["value"] is None and back["machine"]["cores_logical"] >= 1
+    md = (tmp_path / "r.md").read_text()
+    assert "Skipped: why" in md and "| toleranced |" in md
+
+
+def test_peers_suite_on_small_set(small_set, tmp_path):
+    from monitor.bench.suites import BenchConfig, suite_peers
+
+    cases, labels = small_set
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None)
+    cfg.shared["cases"], cfg.shared["labels"] = cases, labels
+    res = suite_peers(cfg)
+    if res.get("skipped"):
+        pytest.skip(res["skipped"])
+    rows = {(r["checker"], r["group"]): r for r in res["rows"]}
+    ours = rows.get(("ours/toleranced eps=1e-3", "all"))
+    if ours is not None:
+        assert ours["misses"] == 0
+    assert rows[("mujoco/N=1000", "all")]["misses"] == 0
+    assert (tmp_path / "peers.png").exists()
+
+
+def test_accuracy_suite_on_small_set(small_set, tmp_path):
+    pytest.importorskip("monitor.certify.engine")
+    from monitor.bench import suites
+
+    cases, labels = small_set
+    cfg = suites.BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None)
+    cfg.shared["cases"], cfg.shared["labels"] = cases, labels
+    cfg.shared["skip_facets"] = True
+    res = suites.suite_accuracy(cfg)
+    for r in res["rows"]:
+        assert r["false_negatives"] == 0, r
+        assert r["errors"] == 0, r
+    assert (tmp_path / "time_vs_epsilon.png").exists() and (tmp_path / "uncertain_vs_clearance.png").exists()
+
+
+def test_cli_writes_results(tmp_path):
+    from monitor.cli import main
+
+    rc = main(["bench", "--quick", "--out", str(tmp_path), "--suite", "seeds"])
+    assert rc in (0, 1)
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert "seeds" in res["suites"] and res["machine"]["cpu"]
+    assert (tmp_path / "results.md").exists()
