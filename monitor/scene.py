@@ -25,7 +25,10 @@ Pair modes:
 
 * ``"mujoco"``: MuJoCo's static candidate filter (mj_collision without the
   bounding-volume test): no plane/hfield-plane/hfield pairs; ``<pair>`` geoms
-  always (bypassing every other rule); otherwise skip the same weld group,
+  always (bypassing every other rule, so static-static and same-body pairs are
+  kept), except a ``<pair>`` of a geom with itself, which MuJoCo accepts and
+  collides but which has no meaning for a monitor (dropped: the one deviation
+  from mj_collision); otherwise skip the same weld group,
   pairs whose weld groups both have no dof (static or mocap: MuJoCo >= 3.12
   never collides them), parent-child weld groups when ``filterparent`` is on and
   neither weld group is the world, ``<exclude>`` body pairs, and pairs failing
@@ -404,7 +407,7 @@ def _filter_pairs(model: Any, mode: str) -> np.ndarray:
     sel = np.concatenate(out).astype(np.int64)
     if mode == "mujoco" and explicit:
         ex = np.array(sorted(explicit), dtype=np.int64).reshape(-1, 2)
-        ex = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]])]
+        ex = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]]) & (ex[:, 0] != ex[:, 1])]
         sel = np.unique(np.concatenate([sel, ex]), axis=0)
     return sel.reshape(-1, 2)
 

@@ -556,3 +556,18 @@ def test_scene_pickles(load_asset):
         assert a.name == b.name and a.type == b.type
         if a.shape is not None:
             np.testing.assert_array_equal(a.shape.points, b.shape.points)
+
+
+def test_explicit_pair_edge_cases_in_mujoco_mode():
+    """<pair> keeps static-static and mocap-mocap pairs like MuJoCo; a self pair (which MuJoCo
+    accepts and even reports as a contact) is dropped."""
+    xml = ('<mujoco><worldbody><geom name="a" type="box" size=".1 .1 .1"/>'
+           '<body name="s" pos="0.05 0 0"><geom name="b" size=".1"/></body>'
+           '<body name="m" mocap="true"><geom name="c" size=".1"/></body>'
+           '<body name="m2" mocap="true"><geom name="d" size=".1"/></body>'
+           '<body name="f"><freejoint/><geom name="e" size=".1" contype="0" conaffinity="0"/></body>'
+           '</worldbody><contact><pair geom1="a" geom2="b"/><pair geom1="a" geom2="c"/>'
+           '<pair geom1="c" geom2="d"/><pair geom1="e" geom2="e"/></contact></mujoco>')
+    scene = Scene.from_model(mujoco.MjModel.from_xml_string(xml))
+    assert scene.candidate_pairs == (("a", "b"), ("a", "c"), ("c", "d"))
+    assert {tuple(p) for p in scene.pair_ids.tolist()} == contact_pairs(xml) - {(4, 4)}
