@@ -98,6 +98,16 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b of quaternions (..., 4)."""
+    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz,
+                     aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw], axis=-1)
+
+
 def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Rotate vectors v (..., 3) by unit quaternions q (..., 4)."""
     w = q[..., :1]
@@ -189,6 +199,18 @@ class QuatTrack:
         out[exact] = a[exact]
         out[at_end] = self.q[-1]
         return out
+
+    def angular_velocity(self, i: np.ndarray, dt: np.ndarray) -> np.ndarray:
+        """Constant angular velocity (N, 3) rad/s on segments i, in the frame the quaternions map into.
+
+        Slerp is R(s) = Rot(a_i, s phi_i) R_i with a_i the axis of R_{i+1} R_i^T, i.e.
+        a rotation about a fixed axis at constant rate phi_i / dt_i. The vector part
+        of q_{i+1} q_i^* is sin(phi_i / 2) a_i; dividing by sinc keeps tiny angles exact.
+        """
+        d = quat_mul(self.target[i], self.q[i] * np.array([1.0, -1.0, -1.0, -1.0]))
+        vec = d[:, 1:] * np.sign(d[:, :1] + (d[:, :1] == 0))
+        scale = 2.0 / np.sinc(self.phi[i] / (2.0 * np.pi)) / dt
+        return vec * scale[:, None]
 
     def path(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Cumulative rotation path length (rad) at (segment, parameter) (T,)."""
