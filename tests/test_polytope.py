@@ -223,7 +223,8 @@ def ellipsoid_lower_distance(V, e, D):
 
 
 @pytest.mark.parametrize("radii,facets", [((0.1, 0.2, 0.3), 16), ((1, 1, 1), 16), ((1, 1, 1), 4),
-                                          ((0.5, 0.01, 0.05), 12), ((2, 2, 0.3), 7)])
+                                          ((0.5, 0.01, 0.05), 12), ((2, 2, 0.3), 7),
+                                          ((1000, 1, 0.001), 16)])
 def test_ellipsoid_contains_and_reports(radii, facets):
     e = np.array(radii, float)
     shape = ellipsoid_polytope(e, facets)

@@ -313,7 +313,12 @@ def _with_error(shape: ConvexShape, err: float) -> ConvexShape:
 
 
 def _contain(shape: ConvexShape, support, tol: Tolerances) -> ConvexShape:
-    """Scale a centred polytope about the origin until its H-rep contains the true geom.
+    """Scale a centred polytope about the origin until every face clears the true geom.
+
+    The test uses, per face, the LOWEST of ``normal . v`` over the face's own loop
+    vertices (not just the offset), so a face whose vertices are not exactly
+    coplanar after rounding still lies outside the geom by ``rel_pad`` relative:
+    both the H-rep and the hull of the vertices contain the geom.
 
     Args:
         shape: polytope whose interior contains the origin (the geom centre).
@@ -322,11 +327,15 @@ def _contain(shape: ConvexShape, support, tol: Tolerances) -> ConvexShape:
         tol: tolerances (``rel_pad`` pads the scale factor).
     """
     h = support(shape.normals)
+    loops = np.concatenate(shape.faces)
+    starts = np.cumsum([0] + [len(f) for f in shape.faces[:-1]])
+    face_of = np.repeat(np.arange(len(shape.faces)), [len(f) for f in shape.faces])
     k = 1.0
     for _ in range(8):
         V = shape.points * k
         offsets = (shape.normals @ V.T).max(axis=1)  # recomputed: the H-rep contains V exactly
-        ratio = float((h / offsets).max())
+        low = np.minimum.reduceat(np.einsum("ij,ij->i", shape.normals[face_of], V[loops]), starts)
+        ratio = float((h / low).max())
         if ratio <= 1.0 / (1.0 + tol.rel_pad):
             return ConvexShape("polytope", V, 0.0, shape.edges, shape.faces, shape.normals, offsets,
                                shape.approx_error)
