@@ -10,11 +10,12 @@ Circumscribed shapes (cylinder, ellipsoid, thickened flat point sets) report
 in ``approx_error`` an upper bound (m) on the distance from any point of the
 shape to the true geom (the one-sided Hausdorff excess).
 
-Containment of the primitives is *verified* after construction with the exact
-support function of the true geom in every face normal direction: if rounding
-made any face cut the geom, all vertices are scaled about the centre until no
-face does (plus a relative rounding pad), so the polytope's H-representation
-contains the geom.
+Containment of the primitives (cylinder, ellipsoid) is *verified* after
+construction with the exact support function of the true geom in every face
+normal direction, against the lowest loop vertex of each face: if rounding made
+any face cut the geom, all vertices are scaled about the centre until no face
+does (plus a relative rounding pad), so both the H-representation and the hull
+of the vertices contain the geom.
 
 Degenerate point sets (:func:`polytope_from_points`): a coplanar, collinear or
 single-point set has no 3-D hull. By default this raises
@@ -42,10 +43,11 @@ _COPLANAR_REL = 1e-12
 """Two adjacent hull triangles are merged into one face when each one's vertices
 lie within ``_COPLANAR_REL * scale`` of the other's plane (scale = the point
 set's largest extent). This is ~4500 ulp: it merges the triangles qhull splits
-a flat facet into (identical planes up to rounding) but never two genuinely
-distinct faces of a float32 mesh (whose noise is ~1e-7 relative). Merging is
+a flat facet into (identical planes up to rounding), nothing coarser. A face of a
+float32 mesh that was flat before float32 rounding (noise ~1e-7 relative) stays
+split into its triangles: more faces, but every face exactly planar. Merging is
 not a soundness decision: every offset is recomputed as the max over all
-vertices, so the H-rep always contains the vertex set."""
+input points, so the H-rep always contains the point set."""
 
 _FLAT_REL = 1e-9
 """A point set whose width along a principal direction is at most this times its
