@@ -58,8 +58,9 @@ def slab_model(half_a, hb: float, kind: str = "box", tilt: float = 0.0, offset=(
     """MJCF model: free body A (geom gA), static box B (geom gB) at ``offset``."""
     asset, geom = _geom_xml(kind, np.asarray(half_a, float))
     o = " ".join(repr(float(x)) for x in offset)
-    xml = (f'<mujoco><option gravity="0 0 0"/><asset>{asset}</asset><worldbody>'
-           f'<body name="A"><freejoint/>{geom}</body>'
+    xml = (f'<mujoco><compiler inertiafromgeom="false"/><option gravity="0 0 0"/><asset>{asset}</asset>'
+           '<worldbody><body name="A"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+           f'{geom}</body>'
            f'<body name="B" pos="{o}"><geom name="gB" type="box" size="{hb!r} {hb!r} {hb!r}"/></body>'
            "</worldbody></mujoco>")
     return mujoco.MjModel.from_xml_string(xml)
@@ -224,29 +225,26 @@ def test_fast_rotation(engine, gap):
 
 
 def test_flat_mesh_is_typed_or_sound(engine):
-    """A flat mesh (all points in one plane) is either rejected with a typed error
-    (by MuJoCo's compiler, a ValueError, or by monitor) or certified soundly."""
-    import monitor
+    """A flat mesh (all points in one plane): MuJoCo refuses to compile it as a moving geom,
+    so it can only reach the checkers through ``polytope_from_points``. That must either
+    raise a typed error or return a shape containing the points whose distance bounds
+    bracket the closed form (flat square at height y over a box of half size 0.1)."""
+    from monitor.geometry.distance import shape_distance
+    from monitor.geometry.polytope import box_polytope, polytope_from_points
 
-    pts = np.array([[x, 0.0, z] for x in (-0.1, 0.1) for z in (-0.05, 0.05)] + [[0.0, 0.0, 0.0]])
-    v = " ".join(repr(float(x)) for x in pts.ravel())
-    xml = (f'<mujoco><compiler inertiafromgeom="false"/><option gravity="0 0 0"/>'
-           f'<asset><mesh name="flat" vertex="{v}"/></asset><worldbody>'
-           '<body name="A"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
-           '<geom name="gA" type="mesh" mesh="flat"/></body>'
-           '<body name="B"><geom name="gB" type="box" size="0.1 0.1 0.1"/></body></worldbody></mujoco>')
-    try:
-        model = mujoco.MjModel.from_xml_string(xml)
-    except ValueError:
-        pytest.skip("MuJoCo refuses to compile a flat mesh (no monitor code involved)")
-    scene, err = _call(monitor.Scene.from_model, model, pairs="all")
+    pts = np.array([[x, 0.0, z] for x in (-0.1, 0.1) for z in (-0.05, 0.05)] + [[0.0, 0.0, 0.0]] * 2)
+    flat, err = _call(polytope_from_points, pts)
     if err is not None:
-        return  # typed rejection is acceptable
-    for gap, truth in ((-1e-3, "collide"), (1e-3, "clear")):
-        bm = slab_motion(x_travel=0.5, y_a=0.1 + gap, turns=0.2)
-        cert, err = _call(monitor.certify, scene, bm, epsilon=1e-3)
-        if err is None:
-            assert_sound(cert, truth, f"flat mesh gap {gap}")
+        return
+    inside = flat.normals @ pts.T <= flat.offsets[:, None] + 1e-12
+    assert inside.all()
+    box = box_polytope(np.full(3, 0.1))
+    eye = np.eye(3)
+    for gap in (-1e-3, 1e-9, 1e-3):
+        r = shape_distance(flat, (eye, np.array([0.0, 0.1 + gap, 0.0])), box, (eye, np.zeros(3)))
+        assert r.lower <= gap + 1e-12
+        if gap < 0:
+            assert r.lower < 0  # a penetrating flat plate is never reported clear
 
 
 # ----------------------------------------------------------------------------- fuzzing
@@ -298,7 +296,7 @@ def test_fuzz_bodymotion_and_certify(engine):
         if err is not None:
             typed += 1
             continue
-        cert, err = _call(monitor.certify, scene, bm, epsilon=1e-3)
+        cert, err = _call(certify, scene, bm, epsilon=1e-3)
         typed += err is not None
     assert typed > 0  # the corruptions are not all silently accepted
     # certify arguments
@@ -309,7 +307,7 @@ def test_fuzz_bodymotion_and_certify(engine):
                                             (-5.0, -4.0), (0.5, 0.5), "ab")]
     bad_kwargs += [dict(pairs=p) for p in ([("gA", "nope")], [("gA",)], "nope", [(1, 2, 3)])]
     for kw in bad_kwargs:
-        _, err = _call(monitor.certify, scene, good, **kw)
+        _, err = _call(certify, scene, good, **kw)
         assert err is not None, f"certify accepted bad input {kw}"
 
 
@@ -332,7 +330,7 @@ def test_fuzz_plan(engine):
         args[trial % 2] = _corrupt(rng, args[trial % 2])
         p, err = _call(Plan, *args, model=model)
         if err is None:
-            _, err = _call(monitor.certify, scene, p, epsilon=1e-3)
+            _, err = _call(certify, scene, p, epsilon=1e-3)
         typed += err is not None
     assert typed > 0
     for bad_model in (None, "model", 5):
