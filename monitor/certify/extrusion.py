@@ -596,13 +596,14 @@ class _Search:
         p.tests += 1
         res = lp_null_test(la, lb, blo - cz, bhi - cz, self.tol)
         if res.verdict == "violation":
-            self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="lp", depth=-res.upper)
+            self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="lp", found=res, found_c=c)
         elif res.verdict == "unresolved":
             p.verdict = "unresolved"
             p.unresolved.append((s0 + float(blo[3]), s0 + float(bhi[3])))
 
     def _lp_collision(self, p: _PairState, s0: float, s1: float, st: dict, tl: float, th: float,
-                      x_lo: np.ndarray, x_hi: np.ndarray, proof: str, depth: float | None = None) -> None:
+                      x_lo: np.ndarray, x_hi: np.ndarray, proof: str, found: NullResult | None = None,
+                      found_c: np.ndarray | None = None) -> None:
         """A proved collision of an LP pair in this span: exact first contact and witness."""
         c = 0.5 * (x_lo + x_hi)
         la, lb = self._centred(p, st, c)
@@ -610,14 +611,16 @@ class _Search:
         hi = np.r_[x_hi - c, th]
         G = np.vstack([la.G, lb.G])
         h = np.concatenate([la.h, lb.h])
-        full = lp_null_test(la, lb, lo, hi, self.tol)
-        self.stats["lps"] += 1
-        p.tests += 1
-        smax = -full.upper
-        if full.verdict != "violation":  # pragma: no cover - the region proof says otherwise
-            smax = depth if depth is not None else 0.0
-        first_tau, first_x = full.tau, full.point
-        w_tau, w_x = full.tau, full.point
+        if found is None:  # full-region proof: find the deepest point once
+            found = lp_null_test(la, lb, lo, hi, self.tol)
+            self.stats["lps"] += 1
+            p.tests += 1
+            found_x = found.point
+        else:  # the region LP's witness, re-expressed about this centre
+            found_x = found.point + found_c - c
+        smax = -found.upper
+        first_tau, first_x = found.tau, found_x
+        w_tau, w_x = found.tau, found_x
         if self.earliest:
             e = lp_earliest(la, lb, lo, hi, 0.0, self.tol)
             self.stats["lps"] += 1
