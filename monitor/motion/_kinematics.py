@@ -91,6 +91,11 @@ def quat_to_mat(q: np.ndarray) -> np.ndarray:
     return out
 
 
+def norm3(v: np.ndarray) -> np.ndarray:
+    """Euclidean norm over the last axis of (..., 3) arrays (cheaper than ``np.linalg.norm``)."""
+    return np.sqrt(v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1] + v[..., 2] * v[..., 2])
+
+
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of broadcastable (..., 3) arrays (cheaper than ``np.cross`` for small batches)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -121,6 +126,14 @@ def axis_rotate(axis: np.ndarray, angle: np.ndarray, v: np.ndarray) -> np.ndarra
     c = np.cos(angle)[:, None]
     s = np.sin(angle)[:, None]
     return v * c + cross(axis, v) * s + (v @ axis)[:, None] * axis * (1.0 - c)
+
+
+def axis_angle_mat(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Rotation matrices (N, 3, 3) about the unit ``axis`` (3,) by ``angle`` (N,) rad (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s = np.sin(angle)[:, None, None]
+    c = np.cos(angle)[:, None, None]
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
 def quat_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -244,6 +244,7 @@ class Plan:
         }
         self._body_pos = np.array(model.body_pos, dtype=np.float64)
         self._body_quat = np.array(model.body_quat, dtype=np.float64)
+        self._body_mat = K.quat_to_mat(self._body_quat)
         self._parent = [int(x) for x in parent]
         qwidth = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}
         own_moving = np.zeros(nbody, dtype=bool)
@@ -268,6 +269,35 @@ class Plan:
         self._moving = moving
         self._rotating = rotating
         self._moving.setflags(write=False)
+
+        # Virtual joints: one per hinge/slide/ball, two per free joint (translation
+        # then rotation about the body origin). kind: 0 hinge, 1 slide, 2 ball,
+        # 3 free translation, 4 free rotation. Chains run root -> body over the
+        # moving bodies only (a mocap or static ancestor is a constant frame).
+        vkind, vjoint, vbody = [], [], []
+        first_v = {}
+        for j in range(model.njnt):
+            first_v[j] = len(vkind)
+            typ = int(jtype[j])
+            kinds = {_HINGE: [0], _SLIDE: [1], _BALL: [2], _FREE: [3, 4]}[typ]
+            for kd in kinds:
+                vkind.append(kd)
+                vjoint.append(j)
+                vbody.append(int(model.jnt_bodyid[j]))
+        self._vkind = np.array(vkind, dtype=np.int64)
+        self._vjoint = vjoint
+        self._first_v = first_v
+        own_v = [[v for v in range(len(vkind)) if vbody[v] == b] for b in range(nbody)]
+        self._chain_v: list[np.ndarray] = []
+        self._own_count: list[int] = []
+        for b in range(nbody):
+            chain: list[int] = []
+            c = b
+            while c != 0 and moving[c]:
+                chain = own_v[c] + chain
+                c = int(parent[c])
+            self._chain_v.append(np.array(chain, dtype=np.int64))
+            self._own_count.append(len(own_v[b]) if moving[b] else 0)
 
         # Waypoint poses (for translation segments and the rounding scale).
         self._wp_pos, self._wp_mat = self._fk(q)
@@ -395,6 +425,7 @@ class Plan:
         return MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
 
     def _bounds(self, ta: np.ndarray, tb: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds (N, nbody) for validated sub-intervals; see the module docstring."""
         m = self._model
         tol = self._tol
         N = ta.shape[0]
@@ -408,97 +439,148 @@ class Plan:
         Qb = self._qpos_many(tb, iv.loc_b)
         Qm = self._qpos_many(iv.tm, iv.loc_m)
         lin = self._lin
+        qmag = self._magnitude["q"]
         dq = np.zeros((N, m.nq))
         dq[:, lin] = K.scalar_deviation(self._qpos[:, lin], Qa[:, lin], Qb[:, lin], Qm[:, lin], iv)
-        dq += tol.rel_pad * self._magnitude["q"]
+        dq += tol.rel_pad * qmag
 
+        # Single-segment sub-intervals: rates per unit segment parameter s, and the
+        # half-width h in s of every sub-interval (from the parameters the
+        # interpolation itself computes; t -> s is monotone in floating point).
+        use_velocity = "velocity" in self._bound_kinds
+        single = ~iv.valid.any(axis=1) if iv.C else np.ones(N, dtype=bool)
+        use_velocity = use_velocity and bool(single.any())
+        seg = iv.loc_m[0]
+        if use_velocity:
+            s_m = iv.loc_m[1]
+            s_a = np.where(iv.loc_a[0] == seg, iv.loc_a[1], s_m)
+            s_b = np.where(iv.loc_b[0] == seg, iv.loc_b[1], np.where(iv.loc_b[0] > seg, 1.0, s_m))
+            h = np.maximum(np.maximum(s_b - s_m, s_m - s_a), 0.0)
+            dqs = self._qpos[seg + 1] - self._qpos[seg]  # (N, nq) per unit s
+
+        # Virtual joints at the midpoint, in world coordinates (numpy FK, MuJoCo's rules).
+        nv = self._vkind.shape[0]
+        # Joint-major layout: gathering a chain copies contiguous (N, ...) slabs.
+        anchor = np.zeros((nv, N, 3))
+        axis = np.zeros((nv, N, 3))
+        coef = np.zeros((nv, N))
+        vang = np.zeros((nv, N))
+        rate = np.zeros((nv, N, 3))
         J = self._jnt
         jtype = J["type"]
         jadr = J["adr"]
         qpos0 = J["qpos0"]
-        ref = self._ref
+        frames: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        p_ref: dict[int, np.ndarray] = {}
 
-        # Per joint, once: deviation bounds and the rigid map G_k at the midpoint.
-        joint: dict[int, tuple] = {}
-        for j, typ in enumerate(jtype):
-            bj = int(m.jnt_bodyid[j])
-            if not self._moving[bj]:
-                continue
-            a = jadr[j]
-            if typ == _HINGE:
-                axn = J["axis"][j] / J["axis_norm"][j]
-                joint[j] = (typ, dq[:, a], axn, J["pos"][j], Qm[:, a] - qpos0[a])
-            elif typ == _SLIDE:
-                joint[j] = (typ, dq[:, a] * J["axis_norm"][j],
-                            (Qm[:, a] - qpos0[a])[:, None] * J["axis"][j])
-            else:
-                off = 3 if typ == _FREE else 0
-                track = self._quat_tracks[j]
-                qm = Qm[:, a + off:a + off + 4]
-                qm = qm / np.linalg.norm(qm, axis=-1, keepdims=True)
-                th = K.rotation_deviation(track, qm, iv) + tol.rel_pad * (track.cum[-1] + 1.0)
-                if typ == _BALL:
-                    joint[j] = (typ, th, qm, J["pos"][j])
-                else:
-                    dx = K.vector_deviation(self._qpos[:, a:a + 3], Qa[:, a:a + 3], Qb[:, a:a + 3],
-                                            Qm[:, a:a + 3], iv)
-                    joint[j] = (typ, th, dx + tol.rel_pad * self._magnitude["q"], qm)
-
-        def local(c: int, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-            """Own-joint bounds of body c at its points y (N, 3).
-
-            Returns the displacement bound (N,), the own rotation bound (N,), and y
-            expressed in the parent's frame at the midpoint (None after a free joint).
-            """
-            T = np.zeros(N)
-            Th = np.zeros(N)
-            for j in reversed(self._jnt_of_body[c]):
-                info = joint[j]
-                typ = info[0]
-                if typ == _HINGE:
-                    _, dqj, axn, s, ang = info
-                    T += chord(dqj) * np.linalg.norm(K.cross(axn, y - s), axis=-1)
-                    Th += dqj
-                    y = s + K.axis_rotate(axn, ang, y - s)
-                elif typ == _SLIDE:
-                    T += info[1]
-                    y = y + info[2]
-                elif typ == _BALL:
-                    _, th, qm, s = info
-                    T += chord(th) * np.linalg.norm(y - s, axis=-1)
-                    Th += th
-                    y = s + K.quat_rotate(qm, y - s)
-                else:  # free joint: world pose straight from qpos, about the body origin
-                    _, th, dx, _ = info
-                    return dx + chord(th) * np.linalg.norm(y, axis=-1), th, None
-            return T, Th, self._body_pos[c] + K.quat_rotate(self._body_quat[c], y)
-
-        velocity = self._velocity_setup(iv, Qm, joint) if "velocity" in self._bound_kinds else None
+        def frame(c: int) -> tuple[np.ndarray, np.ndarray]:
+            if c in frames:
+                return frames[c]
+            return self._wp_mat[0, c][None], self._wp_pos[0, c][None]  # constant frame
 
         for b in range(1, nbody):
             if not self._moving[b]:
                 continue
-            T, Th, z = local(b, np.broadcast_to(ref[b], (N, 3)).copy())
+            js = self._jnt_of_body[b]
+            if js and jtype[js[0]] == _FREE:
+                j = js[0]
+                a = jadr[j]
+                track = self._quat_tracks[j]
+                qm = Qm[:, a + 3:a + 7]
+                qm = qm / np.linalg.norm(qm, axis=-1, keepdims=True)
+                th = K.rotation_deviation(track, qm, iv) + tol.rel_pad * (track.cum[-1] + 1.0)
+                dx = K.vector_deviation(self._qpos[:, a:a + 3], Qa[:, a:a + 3], Qb[:, a:a + 3],
+                                        Qm[:, a:a + 3], iv) + tol.rel_pad * qmag
+                x = Qm[:, a:a + 3].copy()
+                R = K.quat_to_mat(qm)
+                vt, vr = self._first_v[j], self._first_v[j] + 1
+                coef[vt] = dx
+                anchor[vr] = x
+                coef[vr] = chord(th)
+                vang[vr] = th
+                if use_velocity:
+                    rate[vt] = dqs[:, a:a + 3]
+                    rate[vr] = track.angular_velocity(seg, np.ones(N))
+            else:
+                R_P, x_P = frame(self._parent[b])
+                R = R_P @ self._body_mat[b]
+                x = x_P + np.einsum("...ij,j->...i", R_P, self._body_pos[b])
+                R = np.broadcast_to(R, (N, 3, 3))
+                x = np.broadcast_to(x, (N, 3))
+                for j in js:
+                    v = self._first_v[j]
+                    a = jadr[j]
+                    typ = jtype[j]
+                    axis_w = np.einsum("nij,j->ni", R, J["axis"][j])
+                    anchor_w = x + np.einsum("nij,j->ni", R, J["pos"][j])
+                    if typ == _HINGE:
+                        unit_w = axis_w / J["axis_norm"][j]
+                        anchor[v] = anchor_w
+                        axis[v] = unit_w
+                        coef[v] = chord(dq[:, a])
+                        vang[v] = dq[:, a]
+                        if use_velocity:
+                            rate[v] = dqs[:, a, None] * unit_w
+                        R = R @ K.axis_angle_mat(J["axis"][j] / J["axis_norm"][j], Qm[:, a] - qpos0[a])
+                        x = anchor_w - np.einsum("nij,j->ni", R, J["pos"][j])
+                    elif typ == _SLIDE:
+                        coef[v] = dq[:, a] * J["axis_norm"][j]
+                        if use_velocity:
+                            rate[v] = dqs[:, a, None] * axis_w
+                        x = x + axis_w * (Qm[:, a] - qpos0[a])[:, None]
+                    else:  # ball
+                        track = self._quat_tracks[j]
+                        qm = Qm[:, a:a + 4]
+                        qm = qm / np.linalg.norm(qm, axis=-1, keepdims=True)
+                        th = K.rotation_deviation(track, qm, iv) + tol.rel_pad * (track.cum[-1] + 1.0)
+                        anchor[v] = anchor_w
+                        coef[v] = chord(th)
+                        vang[v] = th
+                        if use_velocity:
+                            w_loc = track.angular_velocity(seg, np.ones(N))
+                            rate[v] = np.einsum("nij,nj->ni", R, w_loc)
+                        R = R @ K.quat_to_mat(qm)
+                        x = anchor_w - np.einsum("nij,j->ni", R, J["pos"][j])
+            frames[b] = (R, x)
+            p_ref[b] = x + np.einsum("nij,j->ni", R, self._ref[b])
+
+        vk = self._vkind
+        for b in range(1, nbody):
+            if not self._moving[b]:
+                continue
+            ch = self._chain_v[b]
+            kind = vk[ch]
+            own = self._own_count[b]
+            p = p_ref[b]
+            D = p[None] - anchor[ch]  # (L, N, 3)
+            dist_pt = K.norm3(D)
+            lever = np.where(((kind == 2) | (kind == 4))[:, None], dist_pt, 1.0)
+            hinge = np.flatnonzero(kind == 0)
+            if hinge.size:
+                lever[hinge] = K.norm3(K.cross(axis[ch[hinge]], D[hinge]))
+            term = coef[ch] * lever  # single-joint deviation bounds at the reference point
+            T_dir = term.sum(axis=0)
+            T_own = term[len(ch) - own:].sum(axis=0)
+            Th = vang[ch[len(ch) - own:]].sum(axis=0)
             P = self._parent[b]
-            if z is not None and P != 0 and self._moving[P]:
-                # (i) through the parent's bound (its rigid extension)
-                T_rec = T + trans[:, P] + chord(angle[:, P]) * np.linalg.norm(z - ref[P], axis=-1)
-                # (ii) carrying ref_b itself up through every ancestor's joints
-                T_dir = T.copy()
-                c = P
-                while z is not None and c != 0 and self._moving[c]:
-                    Tc, _, z = local(c, z)
-                    T_dir += Tc
-                    c = self._parent[c]
+            T = T_dir
+            if P != 0 and self._moving[P] and own < len(ch):
+                # Through the parent's bound (valid for its rigid extension).
+                T_rec = T_own + trans[:, P] + chord(angle[:, P]) * np.linalg.norm(p - p_ref[P], axis=-1)
                 T_dir = T_dir * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * scale
                 T = np.minimum(T_rec, T_dir)
                 Th = Th + angle[:, P]
-            if velocity is not None:
-                T2, Th2 = self._velocity_bound(b, velocity, joint)
+            if use_velocity:
+                T2, Th2 = self._velocity_bound(kind, rate[ch], D, dist_pt, h, qmag)
+                T2 = np.where(single, T2, np.inf)
+                Th2 = np.where(single, Th2, np.inf)
                 if "chain" not in self._bound_kinds:  # tests: the velocity bound on its own
                     T, Th = T2, Th2
                 T = np.minimum(T, T2)
                 Th = np.minimum(Th, Th2)
+            elif "chain" not in self._bound_kinds:
+                T = np.full(N, np.inf)
+                Th = np.full(N, np.inf)
             if self._rotating[b]:
                 Th = np.minimum(Th, np.pi)
                 angle[:, b] = np.minimum(Th * (1.0 + tol.rel_pad) + tol.abs_pad, np.pi)
@@ -507,156 +589,67 @@ class Plan:
             trans[:, b] = T * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * scale
         return trans, angle
 
-    def _velocity_setup(self, iv: K.IntervalVertices, Qm: np.ndarray, joint: dict) -> dict | None:
-        """Per-joint constant rates (per unit segment parameter s) on single-segment sub-intervals.
-
-        Returns None when no sub-interval lies within one segment.
-        """
-        N = iv.tm.shape[0]
-        single = ~iv.valid.any(axis=1) if iv.C else np.ones(N, dtype=bool)
-        if not single.any():
-            return None
-        i, s_m, _ = iv.loc_m
-        s_a = np.where(iv.loc_a[0] == i, iv.loc_a[1], s_m)
-        s_b = np.where(iv.loc_b[0] == i, iv.loc_b[1], 1.0)
-        s_b = np.where(iv.loc_b[0] < i, s_m, s_b)
-        h = np.maximum(np.maximum(s_b - s_m, s_m - s_a), 0.0)
-        q = self._qpos
-        J = self._jnt
-        rate: dict[int, tuple] = {}
-        for j, info in joint.items():
-            typ = info[0]
-            a = J["adr"][j]
-            if typ in (_HINGE, _SLIDE):
-                rate[j] = (q[i + 1, a] - q[i, a],)
-            elif typ == _BALL:
-                rate[j] = (self._quat_tracks[j].angular_velocity(i, np.ones(N)),)
-            else:
-                rate[j] = (q[i + 1, a:a + 3] - q[i, a:a + 3],
-                           self._quat_tracks[j].angular_velocity(i, np.ones(N)))
-        return {"single": single, "h": h, "rate": rate, "N": N}
-
-    def _velocity_bound(self, b: int, vel: dict, joint: dict) -> tuple[np.ndarray, np.ndarray]:
-        r"""Second-order bound on sub-intervals inside one segment (inf elsewhere).
+    def _velocity_bound(self, kind: np.ndarray, w: np.ndarray, D: np.ndarray, r0: np.ndarray,
+                        h: np.ndarray, qmag: float) -> tuple[np.ndarray, np.ndarray]:
+        r"""Second-order bound for one body on sub-intervals inside one segment.
 
         On one segment every coordinate moves at a constant rate in the segment
         parameter s (hinge/slide: b - a; ball/free: rotation about a fixed axis at
         rate phi_i, see ``QuatTrack.angular_velocity``), so the chain is a
-        composition of screw motions at constant rates omega_k (hinges, balls, the
-        free rotation about the body origin) and v_k (slides, the free position).
-        The reference point p has velocity p' = sum_k J_k with
-        J_k = omega_k a_k x (p - s_k) (or v_k a_k) and the body angular velocity is
-        W = sum_k omega_k a_k, both computed exactly at the midpoint. With
-        Omega_k = sum_{l < k} |omega_l| (joints nearer the root), the axes move as
-        a_k' = W_{k-1} x a_k and the anchors as s_k' = sum_{l<k} J_l(s_k), so
+        composition of screw motions at constant rates: rotations omega_k a_k about
+        anchors s_k (hinges, balls, the free rotation about the body origin) and
+        translations v_k (slides, the free position). At the midpoint the
+        reference point p has velocity p' = sum_k J_k, J_k = omega_k a_k x (p - s_k)
+        (or v_k), and the body angular velocity is W = sum_k omega_k a_k (exact).
+        With Omega_k = sum_{l < k} |omega_l| (joints nearer the root), the axes move as
+        a_k' = W_{k-1} x a_k and the anchors as s_k' = sum_{l<k} J_l(s_k), hence
+        p' - s_k' = W_{k-1} x (p - s_k) + sum_{l >= k} J_l(p) and
 
-            |J_k'| <= |omega_k| (2 Omega_k r_k + S_k)    (hinge-like),
-            |J_k'| <= |v_k| Omega_k                      (slide-like),
+            |J_k'| <= |omega_k| (2 Omega_k r_k + S_k)  (rotations),  |J_k'| <= |v_k| Omega_k  (translations),
 
-        where S_k = sum_{l >= k} (|omega_l| r_l + |v_l|) bounds |p' - s_k' - W_{k-1} x (p - s_k)|
-        and r_k >= |p - s_k| over the sub-interval: by rule (2) of the module
-        docstring, r_k = |p(m) - s_k(m)| + sum_{l > k} e_l with
-        e_l = chord(|omega_l| h) r_l(m) (or |v_l| h). Taylor with remainder gives
+        with S_k = sum_{l >= k} (|omega_l| r_l + |v_l|) and r_k >= |p - s_k| over the
+        sub-interval: by rule (2) of the module docstring applied to the joints
+        beyond k, r_k = |p(m) - s_k(m)| + sum_{l > k} e_l, e_l = chord(|omega_l| h) r_l(m)
+        (or |v_l| h). Taylor's theorem with the remainder bound gives
 
             |p(s) - p(s_m)| <= h |p'(s_m)| + h^2 / 2 * sum_k |J_k'|,
             angle(R(s) R(s_m)^T) <= h |W(s_m)| + h^2 / 2 * sum_k |omega_k| Omega_k,
 
-        with h = max |s - s_m| over the sub-interval, computed from the very
-        parameters s(ta), s(tb) that the interpolation uses (floating-point
-        t -> s is monotone, so every pose the checkers evaluate lies in range).
+        h = max |s - s_m| over the sub-interval.
+
+        Args:
+            kind: (L,) virtual joint kinds of the chain, root first.
+            w: (L, N, 3) rates (world): rotation vectors for rotations, velocities for translations.
+            D: (L, N, 3) reference point minus anchor (world, midpoint).
+            r0: (L, N) ||D||.
+            h: (N,) half-width in the segment parameter.
+            qmag: magnitude of the joint coordinates (rounding pad).
+
+        Returns:
+            (T2 (N,), Th2 (N,)), rounding padded.
         """
-        N = vel["N"]
-        h = vel["h"]
-        rate = vel["rate"]
-        J = self._jnt
-        jtype = J["type"]
         tol = self._tol
-        y = np.broadcast_to(self._ref[b], (N, 3)).copy()
-        V = np.zeros((N, 3))
-        W = np.zeros((N, 3))
-        recs: list[tuple[bool, np.ndarray, np.ndarray]] = []  # (hinge-like, |rate|, r(m)), body first
-        c = b
-        done = False
-        while not done and c != 0 and self._moving[c]:
-            for j in reversed(self._jnt_of_body[c]):
-                typ = jtype[j]
-                info = joint[j]
-                if typ == _HINGE:
-                    _, _, axn, s, ang = info
-                    r0 = np.linalg.norm(y - s, axis=-1)
-                    y = s + K.axis_rotate(axn, ang, y - s)
-                    V = K.axis_rotate(axn, ang, V)
-                    W = K.axis_rotate(axn, ang, W)
-                    wv = rate[j][0][:, None] * axn
-                    V += K.cross(wv, y - s)
-                    W += wv
-                    recs.append((True, np.abs(rate[j][0]), r0))
-                elif typ == _SLIDE:
-                    y = y + info[2]
-                    v = rate[j][0][:, None] * J["axis"][j]
-                    V += v
-                    recs.append((False, np.linalg.norm(v, axis=-1), np.zeros(N)))
-                elif typ == _BALL:
-                    _, _, qm, s = info
-                    wv = rate[j][0]
-                    r0 = np.linalg.norm(y - s, axis=-1)
-                    y = s + K.quat_rotate(qm, y - s)
-                    V = K.quat_rotate(qm, V)
-                    W = K.quat_rotate(qm, W)
-                    V += K.cross(wv, y - s)
-                    W += wv
-                    recs.append((True, np.linalg.norm(wv, axis=-1), r0))
-                else:  # free: rotation about the body origin, then translation (world axes)
-                    qmid = info[3]
-                    dx_rate, wv = rate[j]
-                    r0 = np.linalg.norm(y, axis=-1)
-                    yr = K.quat_rotate(qmid, y)
-                    V = K.quat_rotate(qmid, V)
-                    W = K.quat_rotate(qmid, W)
-                    V += K.cross(wv, yr)
-                    W += wv
-                    recs.append((True, np.linalg.norm(wv, axis=-1), r0))
-                    V += dx_rate
-                    recs.append((False, np.linalg.norm(dx_rate, axis=-1), np.zeros(N)))
-                    done = True
-            if not done:
-                y = self._body_pos[c] + K.quat_rotate(self._body_quat[c], y)
-                V = K.quat_rotate(self._body_quat[c], V)
-                W = K.quat_rotate(self._body_quat[c], W)
-                c = self._parent[c]
-        # Second-order terms (recs are ordered from the body towards the root).
-        n = len(recs)
-        e_before = np.zeros(N)  # sum of e_l for joints nearer the body
-        r_max = []
-        for hinge, w, r0 in recs:
-            r_max.append(r0 + e_before)
-            e_before = e_before + (chord(w * h) * r0 if hinge else w * h)
-        omega_after = np.zeros(N)  # Omega_k: sum of |omega| nearer the root
-        Omegas = [None] * n
-        for k in range(n - 1, -1, -1):
-            Omegas[k] = omega_after.copy()
-            if recs[k][0]:
-                omega_after = omega_after + recs[k][1]
-        A = np.zeros(N)
-        AW = np.zeros(N)
-        S = np.zeros(N)
-        rsum = np.zeros(N)
-        for k in range(n):
-            hinge, w, _ = recs[k]
-            S = S + (w * r_max[k] if hinge else w)
-            if hinge:
-                A += w * (2.0 * Omegas[k] * r_max[k] + S)
-                AW += w * Omegas[k]
-                rsum += r_max[k]
-            else:
-                A += w * Omegas[k]
-        mag = self._magnitude["q"] + self._magnitude["path"] + 1.0
-        T2 = h * np.linalg.norm(V, axis=-1) + 0.5 * h * h * A
-        T2 = T2 + tol.rel_pad * (4.0 * h * S + mag * (rsum + n))
-        Th2 = h * np.linalg.norm(W, axis=-1) + 0.5 * h * h * AW
-        Th2 = Th2 + tol.rel_pad * (4.0 * h * omega_after + mag * n)
-        single = vel["single"]
-        return np.where(single, T2, np.inf), np.where(single, Th2, np.inf)
+        rot = ((kind == 0) | (kind == 2) | (kind == 4))[:, None]  # (L, 1)
+        wabs = K.norm3(w)  # (L, N)
+        V = np.where(rot[..., None], K.cross(w, D), w).sum(axis=0)
+        W = np.where(rot[..., None], w, 0.0).sum(axis=0)
+        r0 = np.where(rot, r0, 0.0)
+        e = np.where(rot, chord(wabs * h) * r0, wabs * h)
+        suffix_e = np.cumsum(e[::-1], axis=0)[::-1] - e  # joints nearer the body
+        r_max = r0 + suffix_e
+        w_rot = np.where(rot, wabs, 0.0)
+        Omega = np.cumsum(w_rot, axis=0) - w_rot  # joints nearer the root
+        S = np.cumsum(np.where(rot, wabs * r_max, wabs)[::-1], axis=0)[::-1]
+        A = np.where(rot, wabs * (2.0 * Omega * r_max + S), wabs * Omega).sum(axis=0)
+        AW = (w_rot * Omega).sum(axis=0)
+        n = kind.shape[0]
+        mag = qmag + self._magnitude["path"] + 1.0
+        T2 = h * K.norm3(V) + 0.5 * h * h * A
+        Th2 = h * K.norm3(W) + 0.5 * h * h * AW
+        if n:
+            T2 = T2 + tol.rel_pad * (4.0 * h * S[0] + mag * (r_max.sum(axis=0) + n))
+            Th2 = Th2 + tol.rel_pad * (4.0 * h * w_rot.sum(axis=0) + mag * n)
+        return T2, Th2
 
     # ------------------------------------------------------------ structure
     def moving_bodies(self) -> np.ndarray:
