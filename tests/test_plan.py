@@ -6,7 +6,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from monitor.errors import InvalidInputError
-from monitor.motion.base import Trajectory
+from monitor.motion.base import Trajectory, chord
 from monitor.motion.plan import Plan
 
 XML = """
@@ -328,3 +328,29 @@ def test_chunked_bounds_equal_unchunked(model, monkeypatch):
     got = plan.motion_bounds(ta, tb)
     np.testing.assert_array_equal(got.trans, ref.trans)
     np.testing.assert_array_equal(got.angle, ref.angle)
+
+
+def test_sub_intervals_at_and_across_waypoints_one_ulp():
+    """Sub-intervals touching a waypoint, down to one ulp wide, stay certified (no h = 0 shortcut)."""
+    m = mujoco.MjModel.from_xml_string("""<mujoco><worldbody><body>
+        <joint type="hinge" axis="0 0 1"/><geom size=".1" pos="1 0 0"/>
+        <body pos="1 0 0"><joint type="ball"/><geom size=".1" pos="0 1 0"/></body>
+        </body></worldbody></mujoco>""")
+    times = np.array([0.0, 0.3, 1.0])
+    qpos = np.array([[0.0, 1, 0, 0, 0], [2.0, 0, 1, 0, 0], [-1.0, 0, 0, 1, 0]])
+    plan = Plan(times, qpos, model=m)
+    w = times[1]
+    cases = [(np.nextafter(w, 0), w), (w, np.nextafter(w, 1)), (np.nextafter(w, 0), np.nextafter(w, 1)),
+             (w - 1e-9, w), (w, w + 1e-9), (w - 1e-9, w + 1e-9), (w, w), (0.0, w), (w, 1.0)]
+    ta = np.array([c[0] for c in cases])
+    tb = np.array([c[1] for c in cases])
+    mb = plan.motion_bounds(ta, tb)
+    for i in range(len(cases)):
+        ts = np.unique(np.concatenate([[ta[i], tb[i]], np.linspace(ta[i], tb[i], 50)]))
+        pos, mat = plan.body_poses(np.concatenate([[0.5 * (ta[i] + tb[i])], ts]))
+        for b in (1, 2):
+            pts = plan.ref_points[b] + np.array([[0, 0, 0], [3, 0, 0], [0, -5, 2]])
+            world = pos[:, b, None] + np.einsum("tij,nj->tni", mat[:, b], pts)
+            dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
+            r = np.linalg.norm(pts - plan.ref_points[b], axis=-1)
+            assert (dev <= mb.trans[i, b] + chord(mb.angle[i, b]) * r).all(), (cases[i], b)
