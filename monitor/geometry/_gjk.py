@@ -494,6 +494,31 @@ def _simplex_directions_bound(VA, VB, W, k):
 
 
 @njit(cache=True)
+def _edge_perp_bound(VA, VB, EA, EB, v):
+    """Best axis bound over v projected perpendicular to each edge direction of A and B."""
+    best = -np.inf
+    d = np.empty(3)
+    n = np.empty(3)
+    for side in range(2):
+        V = VA if side == 0 else VB
+        E = EA if side == 0 else EB
+        for i in range(E.shape[0]):
+            for r in range(3):
+                d[r] = V[E[i, 1], r] - V[E[i, 0], r]
+            dd = _dot(d, d)
+            if not dd > 0.0:
+                continue
+            s = _dot(v, d) / dd
+            for r in range(3):
+                n[r] = v[r] - s * d[r]
+            s = _dot(n, d) / dd
+            for r in range(3):
+                n[r] -= s * d[r]
+            best = max(best, _axis_bound(VA, VB, n))
+    return best
+
+
+@njit(cache=True)
 def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a, dpad_b, rel_pad,
                   abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
@@ -661,6 +686,13 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
                 best_lower = lb
         if sv - best_lower > 8.0 * rel_pad * S + 1e-13 * sv:
             lb = _sat_lower(VA, VB, EA, EB, WNA, WNB, any_polytope, max_edge_pairs, vn)
+            if lb > best_lower:
+                best_lower = lb
+        if sv - best_lower > 8.0 * rel_pad * S + 1e-13 * sv:
+            # parallel edges overlapping by a tiny amount: the Minkowski edge is tiny, so
+            # its computed direction is poor, but the true normal is v made exactly
+            # perpendicular to the (long, accurate) edge direction of A or B
+            lb = _edge_perp_bound(VA, VB, EA, EB, vn)
             if lb > best_lower:
                 best_lower = lb
         lower = best_lower - pad
