@@ -243,7 +243,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         from monitor.certify import toleranced
         items = [(ga.shape, ga.body_id, gb.shape, gb.body_id) for _i, ga, gb in tol_items]
         outs = toleranced.check_pairs(plan, items, (t0, t1), margin, epsilon, tol, bud,
-                                      static=static & ~moving, check_start=False)
+                                      static=~moving, check_start=False)
         for (i, _ga, _gb), o in zip(tol_items, outs):
             outcomes[i] = ("toleranced", o)
     # -- 5. witnesses ---------------------------------------------------------------------
