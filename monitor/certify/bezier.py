@@ -298,7 +298,7 @@ def paper72_case(n: int, kind: str, mass: str = "global") -> dict:
                      [0.995, 0.05, -0.08, 0.1], [1.0, 0.03, -0.05, 0.12]])
     lift = {"collision": -0.03, "near": 0.01, "clear": 0.10}[kind]
     s = np.linspace(0, 1, 9)
-    trans = np.stack([0.15 + 0.5 * s, 0.1 + 0.4 * s, 0.0 * s], axis=1)
+    trans = np.stack([0.15 + 0.5 * s, 0.1 + 0.4 * s, 0.25 * (2 * s - 1) ** 2], axis=1)
     curve0 = quaternion_motion(quat, trans)
     # place the lowest point of the moving surface over time at height `lift`
     ts = np.linspace(0, 1, 401)
