@@ -201,7 +201,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     Returns:
         dict with ``checked``, ``model_source``, ``mismatches`` (rows: index,
         sim_time, logged, recomputed, critical, logged_clearance, clearance),
-        ``critical`` (number of certified <-> not-certified flips), ``missing_plans``,
+        ``critical`` (number of certified <-> not-certified flips, except logged
+        "uncertain" windows whose ``stats["budget_exhausted"]`` is true), ``missing_plans``,
         ``errors`` (rows: index, error), ``pairs_differ`` (windows whose pair set
         differs from the scene's).
 
@@ -258,12 +259,16 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         out["checked"] += 1
         if new.verdict != c["verdict"]:
             critical = (new.verdict == "certified") != (c["verdict"] == "certified")
+            budget = bool((c.get("stats") or {}).get("budget_exhausted")) and c["verdict"] == "uncertain"
+            if budget:  # the logged run ran out of its work budget: "uncertain" was the honest answer then
+                critical = False
             out["critical"] += int(critical)
             out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": c["verdict"],
                                       "recomputed": new.verdict, "critical": critical,
                                       "logged_clearance": c.get("clearance"),
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
-                                      "witness": new.witness.to_dict() if new.witness else None})
+                                      "witness": new.witness.to_dict() if new.witness else None,
+                                      "reason": "budget exhausted when logged" if budget else None})
     return out
 
 
@@ -332,7 +337,8 @@ def render_text(result: dict[str, Any]) -> str:
                 for mm in ver["mismatches"]:
                     lines.append(f"     window {mm['index']} t={_fmt(mm['sim_time'], '.4f')}: logged "
                                  f"{mm['logged']} -> recomputed {mm['recomputed']}"
-                                 + ("  [CRITICAL]" if mm["critical"] else ""))
+                                 + ("  [CRITICAL]" if mm["critical"] else "")
+                                 + (f"  ({mm['reason']})" if mm.get("reason") else ""))
                 for e in ver["errors"][:10]:
                     lines.append(f"     window {e['index']}: {e['error']}")
     tot = result.get("total")

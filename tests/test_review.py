@@ -196,6 +196,23 @@ def test_verify_plumbing_with_oracle_engine(tmp_path, monkeypatch, capsys):
     assert "logged violation -> recomputed certified  [CRITICAL]" in capsys.readouterr().out
 
 
+def test_verify_budget_uncertain_is_not_critical(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("monitor.motion.plan")
+    monkeypatch.setattr(review, "_engine", lambda: (_FakeScene, _fake_certify))
+    model = mujoco.MjModel.from_xml_string(XML)
+    path = tmp_path / "budget.mcap"
+    with MonitorLog(path, model=model, foxglove=False) as log:
+        for k, (y, exhausted) in enumerate([(1.0, True), (1.2, False)]):
+            t0 = 0.01 * k
+            c = _fake_certify(None, _plan(model, t0, y), window=(t0, t0 + 0.01)).to_dict()
+            c.update(verdict="uncertain", stats={"budget_exhausted": exhausted})
+            log.write_window(t0, _plan(model, t0, y), c)
+    assert main(["review", "--verify", "--json", str(path)]) == 1
+    ver = json.loads(capsys.readouterr().out)["logs"][0]["verify"]
+    assert [(m["index"], m["critical"]) for m in ver["mismatches"]] == [(0, False), (1, True)]
+    assert ver["mismatches"][0]["reason"] == "budget exhausted when logged"
+
+
 def test_verify_without_engine_is_a_clear_error(hand_log, monkeypatch, capsys):
     def missing():
         raise ImportError("No module named 'monitor.certify.engine'")
@@ -211,7 +228,6 @@ def test_verify_without_engine_is_a_clear_error(hand_log, monkeypatch, capsys):
 def _engine_or_skip():
     try:
         from monitor.certify.engine import certify
-
         from monitor.motion.plan import Plan
         from monitor.scene import Scene
     except ImportError as exc:
