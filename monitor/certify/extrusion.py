@@ -247,6 +247,13 @@ class _PairState:
     done: bool = False
 
 
+def _pair_box(rb: Any, va: np.ndarray, vb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Static box (3,) lo, hi holding both tightened moving boxes' overlap over [t_l, t_h]."""
+    sa_lo, sa_hi = swept_box(rb.a_lo, rb.a_hi, va, rb.t_lo, rb.t_hi)
+    sb_lo, sb_hi = swept_box(rb.b_lo, rb.b_hi, vb, rb.t_lo, rb.t_hi)
+    return np.maximum(sa_lo, sb_lo), np.minimum(sa_hi, sb_hi)
+
+
 def _mode(sa: ConvexShape, sb: ConvexShape, r: float, name: tuple[str, str]) -> str:
     """Which exact test decides a leaf pair."""
     if sa.kind == "halfspace" and sb.kind == "halfspace":
@@ -283,6 +290,7 @@ class _Search:
                   for b in bodies]
         self.scale = float(max(coords)) if coords else 0.0
         self.box_pad = self.tol.pad(self.scale) + self.tol.scale_pad * self.scale
+        self._w = np.zeros(3)
         self.stats: dict[str, Any] = {"spans": [], "lps": 0, "nnls": 0, "regions": 0,
                                       "full_region_proofs": 0, "leaf_pairs": len(pairs)}
 
@@ -350,7 +358,7 @@ class _Search:
         groups: dict[tuple[int, int], list[_PairState]] = {}
         for p in live:
             groups.setdefault((p.ia, p.ib), []).append(p)
-        work: list[tuple[_PairState, float, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        items: list[tuple[_PairState, Any]] = []
         for (ia, ib), plist in groups.items():
             A, B = self.bodies[ia], self.bodies[ib]
             (oa, va), (ob, vb) = st[ia], st[ib]
@@ -383,18 +391,52 @@ class _Search:
                                    sb.t_lo, sb.t_hi)
                 if rb is None:
                     continue
-                sa_lo, sa_hi = swept_box(rb.a_lo, rb.a_hi, va, rb.t_lo, rb.t_hi)
-                sb_lo, sb_hi = swept_box(rb.b_lo, rb.b_hi, vb, rb.t_lo, rb.t_hi)
-                x_lo = np.maximum(sa_lo, sb_lo)
-                x_hi = np.minimum(sa_hi, sb_hi)
-                if np.any(x_lo > x_hi):
-                    continue
-                work.append((p, rb.t_lo, rb.t_hi, x_lo, x_hi, va, vb))
+                items.append((p, rb))
+        # optimal fitting of the final region (App. B): measure space in a frame moving with
+        # w, per axis one of the bodies' velocities; collision is Galilean invariant, so the
+        # rest of the span runs with velocities v - w and points are mapped back with + w tau
+        w = self._frame_velocity(items, st)
+        self._w = w
+        stw = {k: (o, v - w) for k, (o, v) in st.items()}
+        work = []
+        for p, rb in items:
+            x_lo, x_hi = _pair_box(rb, stw[p.ia][1], stw[p.ib][1])
+            if np.any(x_lo > x_hi):
+                continue
+            work.append((p, rb.t_lo, rb.t_hi, x_lo, x_hi, stw[p.ia][1], stw[p.ib][1]))
+            span_stats.setdefault("sbound_regions", []).append(
+                [*(x_hi - x_lo).tolist(), rb.t_hi - rb.t_lo])
+        span_stats["frame_velocity"] = w.tolist()
         span_stats["leaf_pairs_after_sbounds"] = len(work)
         self.stats["spans"].append(span_stats)
-        self._exact_stage(s0, s1, st, work, span_stats)
+        self._exact_stage(s0, s1, stw, work, span_stats)
         for p in live:
             self._clearance(p, s0, s1)
+
+    def _frame_velocity(self, items: list, st: dict) -> np.ndarray:
+        """Per axis, the body velocity whose co-moving frame gives the narrowest region (App. B)."""
+        w = np.zeros(3)
+        if not items:
+            return w
+        for k in range(3):
+            cands = sorted({float(st[p.ia][1][k]) for p, _ in items}
+                           | {float(st[p.ib][1][k]) for p, _ in items})
+            best = (np.inf, 0.0)
+            for c in cands:
+                lo, hi = np.inf, -np.inf
+                dv = np.zeros(3)
+                dv[k] = c
+                for p, rb in items:
+                    xl, xh = _pair_box(rb, st[p.ia][1] - dv, st[p.ib][1] - dv)
+                    if xl[k] <= xh[k]:
+                        lo, hi = min(lo, xl[k]), max(hi, xh[k])
+                width = hi - lo if hi >= lo else 0.0
+                if not np.isfinite(width):
+                    width = np.inf
+                if width < best[0] or (width == best[0] and c == 0.0):
+                    best = (width, c)
+            w[k] = best[1]
+        return w
 
     def _exact_stage(self, s0: float, s1: float, st: dict, work: list, span_stats: dict) -> None:
         """Divide and conquer for LP pairs, direct exact tests for the others."""
@@ -480,9 +522,10 @@ class _Search:
         p.done = True
         p.clearance = -np.inf
         p.witness_time = float(s0 + tw)
-        p.witness_point = np.asarray(wpoint, float) + c
+        p.witness_point = np.asarray(wpoint, float) + c + self._w * tw
         p.info.update({
-            "earliest_time": float(s0 + first), "earliest_point": (np.asarray(fpoint) + c).tolist(),
+            "earliest_time": float(s0 + first),
+            "earliest_point": (np.asarray(fpoint) + c + self._w * first).tolist(),
             "test": how, "span": [s0, s1],
             "depth": float(-res.upper) if how == "lp" else float(-res.upper),
         })
