@@ -100,6 +100,10 @@ class BodyMotion:
         self._scale = float(np.max(np.linalg.norm(p, axis=-1), initial=0.0)) + 3.0 * float(
             np.max(ref_norm, initial=0.0))
 
+    def __repr__(self) -> str:
+        return (f"BodyMotion(K={self._times.shape[0]}, window=({self.t0!r}, {self.t1!r}), "
+                f"moving bodies={int(self._moving.sum())}/{self.nbody})")
+
     @property
     def times(self) -> np.ndarray:
         """(K,) waypoint times (s)."""

@@ -312,6 +312,10 @@ class Plan:
         self._scale += float(np.max(whole[0], initial=0.0)) + 2.0 * ref_norm
 
     # ------------------------------------------------------------------ basics
+    def __repr__(self) -> str:
+        return (f"Plan(K={self._times.shape[0]}, window=({self.t0!r}, {self.t1!r}), nq={self._model.nq}, "
+                f"moving bodies={int(self._moving.sum())}/{self.nbody})")
+
     @property
     def model(self) -> mujoco.MjModel:
         """The MuJoCo model of the plan."""
