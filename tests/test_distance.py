@@ -143,9 +143,12 @@ def test_box_slab_overlap_depth_is_tight():
     for _ in range(20):
         R, p = rand_rot(rng), rand_offset(rng)
         off = np.array([0.9, rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)])
-        res = shape_distance(A, (R, p), B, (R, p + R @ off))
+        res = shape_distance(A, (R, p), B, (R, p + R @ off), tight_overlap=True)
         check_bounds(res, -0.1)
         assert res.upper < -0.1 + 1e-9
+        fast = shape_distance(A, (R, p), B, (R, p + R @ off))
+        check_bounds(fast, -0.1)
+        assert fast.upper < 0
 
 
 def _seg_seg_ld(p0, p1, q0, q1):
@@ -278,12 +281,13 @@ def test_random_hulls_overlap_sign_vs_lp_and_distance_vs_qp():
         # shift the LP oracle to A's frame for accuracy
         bA0, bB0 = bA - NA @ pa, bB - NB @ pa
         slack = _lp_overlap_slack(NA, bA0, NB, bB0)
-        res = shape_distance(A, (Ra, pa), B, (Rb, pb))
+        res = shape_distance(A, (Ra, pa), B, (Rb, pb), tight_overlap=i % 2 == 0)
         assert res.lower <= res.distance <= res.upper
         if slack > 1e-7:
             n_over += 1
             assert res.upper < 0, (i, slack, res)
-            assert res.upper <= -slack + 1e-9  # the LP ball of radius slack is in both
+            if i % 2 == 0:
+                assert res.upper <= -slack + 1e-9  # the LP ball of radius slack is in both
         elif slack < -1e-7:
             n_sep += 1
             assert res.lower > 0, (i, slack, res)

@@ -20,9 +20,10 @@ the core swept by the radius, so ``dist = core_dist - radius_a - radius_b``):
   point ``x`` with certified depths: a ball ``B(x, d_A)`` inside core A and
   ``B(x, d_B)`` inside core B prove a penetration depth ``>= d_A + d_B``
   (Minkowski difference contains ``B(0, d_A + d_B)``). The depths come from a GJK
-  tetrahedron enclosing the origin, and for polytope cores from an LP (scipy
-  HiGHS) maximising ``d_A + d_B``, re-checked in float64 with padding against
-  the H-representation.
+  tetrahedron enclosing the origin, from the deepest point of a point / segment
+  core in a polytope, and for two polytopes (when still undecided, or with
+  ``tight_overlap=True``) from an LP (scipy HiGHS) maximising ``d_A + d_B``,
+  re-checked in float64 with padding against the H-representation.
 * ``lower`` comes from a direction n: ``dist >= -h_{A-B}(n) / |n|`` for every n
   (support function of the Minkowski difference). Separated cores use the GJK
   direction (tight to ~1e-12 relative); overlapping cores use the separating
@@ -372,7 +373,7 @@ def _halfspace_pair(shape_a, Ra, pa, shape_b, Rb, pb, tol):
 
 
 def shape_distance(shape_a: ConvexShape, X_a, shape_b: ConvexShape, X_b, *,
-                   tolerances: Tolerances = DEFAULT) -> DistanceResult:
+                   tolerances: Tolerances = DEFAULT, tight_overlap: bool = False) -> DistanceResult:
     """Rigorous signed distance bounds between two posed convex shapes.
 
     Args:
@@ -381,6 +382,11 @@ def shape_distance(shape_a: ConvexShape, X_a, shape_b: ConvexShape, X_b, *,
         shape_b: shape B (body frame).
         X_b: (R (3, 3), p (3,)) pose of B.
         tolerances: rounding pads.
+        tight_overlap: for two overlapping polytope cores, always run the depth LP
+            (~1.5 ms) to make ``upper`` as negative as a ball in both bodies allows.
+            By default the LP runs only when the numba kernel could not already
+            prove ``upper < 0`` (the sign is all a witness or start-pose test needs;
+            ``distance`` and ``lower`` are exact either way for polytope pairs).
 
     Returns:
         :class:`DistanceResult` with ``lower <= true signed distance <= upper``
@@ -410,7 +416,8 @@ def shape_distance(shape_a: ConvexShape, X_a, shape_b: ConvexShape, X_b, *,
     rs = ra + rb
     if status != _gjk.SEPARATED:
         p = out[4:7]
-        if ca_.code == _gjk.KIND_POLYTOPE and cb_.code == _gjk.KIND_POLYTOPE:
+        if (ca_.code == _gjk.KIND_POLYTOPE and cb_.code == _gjk.KIND_POLYTOPE
+                and (tight_overlap or upper >= 0.0)):
             got = _depth_lp(shape_a, Ra, pa, shape_b, Rb, pb, p, max(-lower, 1e3 * float(out[10])), tol)
             if got is not None and -got[0] < upper:
                 upper = -got[0]
