@@ -8,7 +8,9 @@ plan libraries, log re-verification):
 * ``backend="local"``, ``workers>1``: a :class:`concurrent.futures.ProcessPoolExecutor`
   with the ``spawn`` start method (safe with MuJoCo, numba and threads). The task
   function and its arguments are pickled, so they must be picklable: module-level
-  functions and classes, not lambdas or closures.
+  functions and classes, not lambdas or closures. As with any ``spawn`` pool, a
+  script that starts one must guard its top-level code with
+  ``if __name__ == "__main__":`` (workers re-import the main module).
 * ``backend="ray"``: one Ray task per item (``num_cpus=1``). If Ray is already
   initialised (e.g. the user called ``ray.init(address="ray://...")`` to use an
   existing cluster) that cluster is used; otherwise a local Ray instance is
@@ -32,6 +34,7 @@ import multiprocessing
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
@@ -136,6 +139,11 @@ def run_tasks(fn: Callable[[Any], Any], items: Sequence[Any], *, backend: str = 
                     for f in done:
                         results[futures[f]] = f.result()
                         bar.update(1)
+            except BrokenProcessPool as exc:
+                raise BrokenProcessPool(
+                    f"a worker process died ({exc}). Workers are started with 'spawn', which re-imports "
+                    "the main script: guard the script's top-level code with `if __name__ == \"__main__\":`"
+                ) from exc
             except BaseException:
                 for f in pending:
                     f.cancel()
