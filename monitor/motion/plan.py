@@ -568,6 +568,9 @@ class Plan:
             if hinge.size:
                 lever[hinge] = K.norm3(K.cross(axis[ch[hinge]], D[hinge]))
             term = coef[ch] * lever  # single-joint deviation bounds at the reference point
+            # The levers are differences of world points of size ~scale: absolute rounding.
+            rot_lever = ((kind != 1) & (kind != 3))[:, None]
+            term = term + tol.rel_pad * scale * np.where(rot_lever, coef[ch], 0.0)
             T_dir = term.sum(axis=0)
             T_own = term[len(ch) - own:].sum(axis=0)
             Th = vang[ch[len(ch) - own:]].sum(axis=0)
@@ -580,7 +583,7 @@ class Plan:
                 T = np.minimum(T_rec, T_dir)
                 Th = Th + angle[:, P]
             if use_velocity:
-                T2, Th2 = self._velocity_bound(kind, rate[ch], D, dist_pt, h, qmag)
+                T2, Th2 = self._velocity_bound(kind, rate[ch], D, dist_pt, h, qmag, scale)
                 T2 = np.where(single, T2, np.inf)
                 Th2 = np.where(single, Th2, np.inf)
                 if "chain" not in self._bound_kinds:  # tests: the velocity bound on its own
@@ -599,7 +602,7 @@ class Plan:
         return trans, angle
 
     def _velocity_bound(self, kind: np.ndarray, w: np.ndarray, D: np.ndarray, r0: np.ndarray,
-                        h: np.ndarray, qmag: float) -> tuple[np.ndarray, np.ndarray]:
+                        h: np.ndarray, qmag: float, scale: float) -> tuple[np.ndarray, np.ndarray]:
         r"""Second-order bound for one body on sub-intervals inside one segment.
 
         On one segment every coordinate moves at a constant rate in the segment
@@ -633,6 +636,7 @@ class Plan:
             r0: (L, N) ||D||.
             h: (N,) half-width in the segment parameter.
             qmag: magnitude of the joint coordinates (rounding pad).
+            scale: coordinate magnitude of the plan (m): D carries absolute rounding ~u * scale.
 
         Returns:
             (T2 (N,), Th2 (N,)), rounding padded.
@@ -656,7 +660,8 @@ class Plan:
         T2 = h * K.norm3(V) + 0.5 * h * h * A
         Th2 = h * K.norm3(W) + 0.5 * h * h * AW
         if n:
-            T2 = T2 + tol.rel_pad * (4.0 * h * S[0] + mag * (r_max.sum(axis=0) + n))
+            T2 = T2 + tol.rel_pad * (4.0 * h * S[0] + mag * (r_max.sum(axis=0) + n)
+                                     + 4.0 * h * w_rot.sum(axis=0) * scale)
             Th2 = Th2 + tol.rel_pad * (4.0 * h * w_rot.sum(axis=0) + mag * n)
         return T2, Th2
 
