@@ -284,7 +284,7 @@ def make_case(seed):
         if d > 0.02:
             break
         base = base + (0.1 - min(d, 0.0)) * away
-    d, _, n = _closest(scene, plan)
+    d, _, n = _closest(scene, plan, levels=2)
     scene, plan = build(base + (d - target) * n)
     return scene, plan, margin, cat, f"{ka}-{kb}-{mode}"
 

@@ -175,3 +175,11 @@ def test_plan_of_another_model_is_rejected(scene):
         certify(scene, _plan(other))
     same = mujoco.MjModel.from_xml_string(XML)   # same XML, different object: accepted
     assert certify(scene, _plan(same)).verdict == "certified"
+
+
+def test_public_entry_point_is_monitor_certify(scene, model):
+    import monitor
+
+    cert = monitor.certify(scene, _plan(model, (0.3, 0.2)), margin=0.0, epsilon=1e-3, method="toleranced")
+    assert cert.verdict == "certified"
+    assert cert.clearance >= 0.0
