@@ -506,6 +506,26 @@ def test_degenerate_polytope_cores_vs_sphere_closed_form():
         check_bounds(res2, truth)
 
 
+def test_incomplete_face_normals_never_overstate_depth():
+    """A box whose H-rep lacks its +z face: measured with the remaining normals a point
+    just under the top would look 0.5 m deep. The per-shape completeness check must
+    stop such a depth certificate (upper stays >= the true signed distance)."""
+    full = box_polytope([0.5, 0.5, 0.5])
+    keep = np.flatnonzero(full.normals[:, 2] < 0.5)
+    broken = ConvexShape("polytope", full.points, 0.0, full.edges, full.faces,
+                         full.normals[keep], full.offsets[keep])
+    for r, shape in ((0.0, ConvexShape("sphere", np.zeros((1, 3)), 0.0)), (0.05, sphere_shape(0.05)),
+                     (0.02, capsule_shape(0.02, 0.1))):
+        R = I3 if shape.kind != "capsule" else Rotation.from_euler("y", 90, degrees=True).as_matrix()
+        c = np.array([0.1, -0.2, 0.49])
+        truth = -0.01 - r
+        res = shape_distance(shape, (R, c), broken, (I3, np.zeros(3)))
+        check_bounds(res, truth, est_tol=1.0)  # the estimate may be off: the H-rep is wrong
+        good = shape_distance(shape, (R, c), full, (I3, np.zeros(3)))
+        check_bounds(good, truth)
+        assert good.upper < -r
+
+
 def test_tiny_scales():
     rng = np.random.default_rng(10)
     for _ in range(50):
