@@ -85,6 +85,7 @@ budget runs out.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -210,6 +211,10 @@ def _loops_and_edges(shape_points: np.ndarray, edges: np.ndarray, loops: list[np
     return np.array(E, dtype=np.int64).reshape(-1, 2), per_loop
 
 
+_MOVING: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_FIXED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def moving_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | None = None,
                     metric: Metric | None = None) -> MovingFeatures:
     """Moving feature set of a shape's core (body frame), or of a flat convex polygon.
@@ -222,6 +227,15 @@ def moving_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | N
         metric: mass distribution; default :func:`monitor.motion.metric.shape_metric`
             (or the polygon's vertices plus off-plane points).
     """
+    if polygon is None and metric is None and shape is not None:
+        hit = _MOVING.get(shape)
+        if hit is None:
+            hit = _MOVING[shape] = _moving_features(shape, None, None)
+        return hit
+    return _moving_features(shape, polygon, metric)
+
+
+def _moving_features(shape, polygon, metric) -> MovingFeatures:
     if polygon is not None:
         V = np.asarray(polygon, float).reshape(-1, 3)
         loops = [np.arange(len(V))]
@@ -270,6 +284,15 @@ def moving_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | N
 def fixed_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | None = None
                    ) -> FixedFeatures:
     """Fixed feature set of a shape's core (its own frame), or of a flat convex polygon."""
+    if polygon is None and shape is not None:
+        hit = _FIXED.get(shape)
+        if hit is None:
+            hit = _FIXED[shape] = _fixed_features(shape, None)
+        return hit
+    return _fixed_features(shape, polygon)
+
+
+def _fixed_features(shape, polygon) -> FixedFeatures:
     normals = None
     if polygon is not None:
         V = np.asarray(polygon, float).reshape(-1, 3)
@@ -389,57 +412,101 @@ def _pad_cat(hns: list[np.ndarray], hcs: list[np.ndarray]) -> tuple[np.ndarray, 
     return out_n, out_c
 
 
-def _build_tables(pairs: list[_PairData], C: _Concat) -> _Tables:
+@dataclass(eq=False)
+class _Template:
+    """Rows and units of one (moving, fixed) feature-set pair in LOCAL feature indices."""
+
+    cols: dict[str, np.ndarray]     # per type: (n_t, 1 or 2) local feature ids
+    unit_ptr: np.ndarray            # (n_units + 1,)
+    unit_type: np.ndarray           # (sum,) type index of each unit row
+    unit_idx: np.ndarray            # (sum,) row index within its type
+
+
+_TEMPLATES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _template(A: MovingFeatures, B: FixedFeatures) -> _Template:
+    """Cached row/unit template of a feature-set pair (built once per pair of feature sets)."""
+    per_a = _TEMPLATES.setdefault(A, weakref.WeakKeyDictionary())
+    tpl = per_a.get(B)
+    if tpl is not None:
+        return tpl
     cols: dict[str, list[tuple[int, ...]]] = {t: [] for t in _TYPES}
     index: dict[tuple, int] = {}
-    unit_rows: list[list[tuple[str, int]]] = []
-    unit_pair: list[int] = []
-    pair_units: list[np.ndarray] = []
+    units: list[list[tuple[int, int]]] = []
+    tnum = {t: k for k, t in enumerate(_TYPES)}
 
-    def row(t: str, key: tuple[int, ...], pi: int) -> tuple[str, int]:
+    def row(t: str, key: tuple[int, ...]) -> tuple[int, int]:
         k = (t, *key)
         if k not in index:
             index[k] = len(cols[t])
-            cols[t].append((*key, pi))
-        return (t, index[k])
+            cols[t].append(key)
+        return (tnum[t], index[k])
 
-    for pi, pd in enumerate(pairs):
-        A, B = pd.A, pd.B
-        av, ae, af = int(C.av_off[pi]), int(C.ae_off[pi]), int(C.af_off[pi])
-        be, bf = int(C.be_off[pi]), int(C.bf_off[pi])
-        mine = []
-        if B.kind == "halfspace":
-            for v in range(len(A.verts)):
-                unit_rows.append([row("VH", (av + v,), pi)])
-                unit_pair.append(pi)
-                mine.append(len(unit_pair) - 1)
-        else:
-            for vs, es, fa in A.units:
-                for ges, fb in B.units:
-                    rs = []
-                    if fb >= 0:
-                        rs += [row("VF", (av + int(v), bf + fb), pi) for v in vs]
-                        rs += [row("EF", (ae + int(e), bf + fb), pi) for e in es if not A.e_deg[e]]
-                    rs += [row("EE", (ae + int(e), be + int(g)), pi) for e in es for g in ges]
-                    if fa >= 0:
-                        rs += [row("FE", (af + fa, be + int(g)), pi) for g in ges]
-                    unit_rows.append(rs)
-                    unit_pair.append(pi)
-                    mine.append(len(unit_pair) - 1)
-        pair_units.append(np.array(mine, dtype=np.int64))
-    start, s = {}, 0
+    if B.kind == "halfspace":
+        units = [[row("VH", (v,))] for v in range(len(A.verts))]
+    else:
+        for vs, es, fa in A.units:
+            for ges, fb in B.units:
+                rs = []
+                if fb >= 0:
+                    rs += [row("VF", (int(v), fb)) for v in vs]
+                    rs += [row("EF", (int(e), fb)) for e in es if not A.e_deg[e]]
+                rs += [row("EE", (int(e), int(g))) for e in es for g in ges]
+                if fa >= 0:
+                    rs += [row("FE", (fa, int(g))) for g in ges]
+                units.append(rs)
+    width = {"VF": 2, "EE": 2, "FE": 2, "EF": 2, "VH": 1}
+    arr = {t: np.array(cols[t], dtype=np.int64).reshape(-1, width[t]) for t in _TYPES}
+    flat = [x for u in units for x in u]
+    tpl = _Template(arr, np.cumsum([0] + [len(u) for u in units]).astype(np.int64),
+                    np.array([x[0] for x in flat], dtype=np.int64).reshape(-1),
+                    np.array([x[1] for x in flat], dtype=np.int64).reshape(-1))
+    per_a[B] = tpl
+    return tpl
+
+
+def _build_tables(pairs: list[_PairData], C: _Concat) -> _Tables:
+    """Concatenate the cached templates of all pairs into global row and unit tables."""
+    tpls = [_template(pd.A, pd.B) for pd in pairs]
+    counts = np.array([[len(tp.cols[t]) for t in _TYPES] for tp in tpls], np.int64).reshape(-1, len(_TYPES))
+    type_off = np.cumsum(np.vstack([np.zeros((1, len(_TYPES)), np.int64), counts]), axis=0)[:-1]
+    totals = counts.sum(axis=0)
+    start_arr = np.concatenate([[0], np.cumsum(totals)[:-1]])
+    start = {t: int(start_arr[k]) for k, t in enumerate(_TYPES)}
+    rows: dict[str, dict[str, np.ndarray]] = {}
+    # feature-id offsets per column: A vertices / edges / faces, B edges / faces
+    offs = {"VF": (C.av_off, C.bf_off), "EE": (C.ae_off, C.be_off), "FE": (C.af_off, C.be_off),
+            "EF": (C.ae_off, C.bf_off), "VH": (C.av_off, None)}
     for t in _TYPES:
-        start[t] = s
-        s += len(cols[t])
-    names = {"VF": ("a", "b"), "EE": ("a", "b"), "FE": ("a", "b"), "EF": ("a", "b"), "VH": ("a",)}
-    rows = {}
-    for t in _TYPES:
-        arr = np.array(cols[t], dtype=np.int64).reshape(-1, len(names[t]) + 1)
-        rows[t] = {nm: arr[:, j] for j, nm in enumerate(names[t])}
-        rows[t]["pair"] = arr[:, -1]
-    ptr = np.cumsum([0] + [len(u) for u in unit_rows]).astype(np.int64)
-    flat = np.array([start[t] + i for u in unit_rows for t, i in u], dtype=np.int64)
-    return _Tables(rows, start, s, ptr, flat, np.array(unit_pair, np.int64), pair_units)
+        oa, ob = offs[t]
+        a_l, b_l, p_l = [], [], []
+        for pi, tp in enumerate(tpls):
+            c = tp.cols[t]
+            if not len(c):
+                continue
+            a_l.append(c[:, 0] + oa[pi])
+            if ob is not None:
+                b_l.append(c[:, 1] + ob[pi])
+            p_l.append(np.full(len(c), pi, np.int64))
+        e = np.zeros(0, np.int64)
+        rows[t] = {"a": np.concatenate(a_l) if a_l else e, "pair": np.concatenate(p_l) if p_l else e}
+        if ob is not None:
+            rows[t]["b"] = np.concatenate(b_l) if b_l else e
+    ptrs, flats, upair, pair_units = [np.zeros(1, np.int64)], [], [], []
+    nunit = 0
+    nflat = 0
+    for pi, tp in enumerate(tpls):
+        nu = len(tp.unit_ptr) - 1
+        ptrs.append(tp.unit_ptr[1:] + nflat)
+        flats.append(start_arr[tp.unit_type] + type_off[pi][tp.unit_type] + tp.unit_idx)
+        nflat += len(tp.unit_type)
+        upair.append(np.full(nu, pi, np.int64))
+        pair_units.append(np.arange(nunit, nunit + nu, dtype=np.int64))
+        nunit += nu
+    return _Tables(rows, start, int(totals.sum()), np.concatenate(ptrs),
+                   np.concatenate(flats) if flats else np.zeros(0, np.int64),
+                   np.concatenate(upair) if upair else np.zeros(0, np.int64), pair_units)
 
 
 # ============================================================================ kernels
