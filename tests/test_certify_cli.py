@@ -1,0 +1,169 @@
+"""``python -m monitor certify PLANS.npz --model scene.xml``: layouts, verdicts, logs, errors.
+
+Scene: models/arm (3 hinge joints, posts, shelf, floor). Oracle for the verdicts:
+MuJoCo's own ``mj_geomDistance`` for every candidate pair, sampled densely along
+the plan (linear in joint space). A negative sampled distance means the plan
+collides; a minimum sampled distance larger than the Lipschitz gap between
+samples (joint speed x lever arm x half the sample spacing) means it does not.
+"""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from monitor._paths import scene_path
+from monitor.cli import main
+
+T = np.linspace(0.0, 0.5, 6)
+
+
+def _yaw(to: float, k: int = 6) -> np.ndarray:
+    q = np.zeros((k, 3))
+    q[:, 0] = np.linspace(0.0, to, k)
+    return q
+
+
+PLANS = {
+    "clear": (T, _yaw(-0.3)),                                   # swings away from every obstacle
+    "post": (T, _yaw(0.7)),                                     # sweeps through post_a
+    "floor": (np.linspace(0, 0.3, 4), np.array([[0, 0, 0], [0, 0.5, 0], [0, 1.0, 0], [0, 1.5, 0.0]])),
+}
+
+
+@pytest.fixture(scope="module")
+def model():
+    return mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+
+
+def _per_plan_npz(path, names):
+    arrays = {}
+    for i, n in enumerate(names):
+        arrays[f"plan{i}_times"], arrays[f"plan{i}_qpos"] = PLANS[n]
+    np.savez(path, **arrays, names=np.array(names))
+    return str(path)
+
+
+def _oracle(model, cert_dict, times, qpos, n=401):
+    """(min sampled distance over candidate pairs, Lipschitz gap between samples)."""
+    d = mujoco.MjData(model)
+    ids = [(model.geom(a).id, model.geom(b).id) for a, b in (p["geoms"] for p in cert_dict["pairs"])]
+    ts = np.linspace(times[0], times[-1], n)
+    best = np.inf
+    for t in ts:
+        d.qpos[:] = [np.interp(t, times, qpos[:, j]) for j in range(model.nq)]
+        mujoco.mj_kinematics(model, d)
+        for a, b in ids:
+            best = min(best, mujoco.mj_geomDistance(model, d, a, b, 1.0, None))
+    speed = np.max(np.abs(np.diff(qpos, axis=0)) / np.diff(times)[:, None])
+    lever = 1.0  # m: every arm point is within 1 m of every joint axis
+    return best, speed * lever * (ts[1] - ts[0]) / 2
+
+
+def _run(capsys, *argv):
+    code = main(["certify", *map(str, argv)])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_verdicts_against_dense_mujoco_distance(tmp_path, capsys, model):
+    names = ["clear", "post", "floor"]
+    code, out, err = _run(capsys, _per_plan_npz(tmp_path / "p.npz", names), "--model", "arm", "--json",
+                          "--margin", "0.0")
+    assert code == 1, err  # some plan is not certified
+    res = json.loads(out)
+    assert [p["name"] for p in res["plans"]] == names
+    seen = set()
+    for name, p in zip(names, res["plans"]):
+        dist, gap = _oracle(model, p, *PLANS[name])
+        if dist < 0:
+            assert p["verdict"] == "violation", name
+            seen.add("collides")
+        elif dist > gap:
+            assert p["verdict"] == "certified", (name, dist, gap)
+            seen.add("clear")
+    assert seen == {"collides", "clear"}  # the oracle decided both kinds
+    assert res["counts"]["violation"] >= 2
+
+
+def test_stacked_layout_gives_the_same_certificates(tmp_path, capsys):
+    per = _per_plan_npz(tmp_path / "per.npz", ["clear", "post"])
+    st = tmp_path / "st.npz"
+    np.savez(st, times=T, qpos=np.stack([PLANS["clear"][1], PLANS["post"][1]]))
+    _, out1, _ = _run(capsys, per, "--model", "arm", "--json")
+    _, out2, _ = _run(capsys, st, "--model", str(scene_path("arm")), "--json")
+    a, b = json.loads(out1)["plans"], json.loads(out2)["plans"]
+    for x, y in zip(a, b):
+        for k in ("verdict", "window", "clearance", "earliest_time", "witness"):
+            assert x[k] == y[k]
+    assert [p["name"] for p in b] == ["plan0", "plan1"]
+
+
+def test_all_certified_exit_0_text_output(tmp_path, capsys):
+    code, out, _ = _run(capsys, _per_plan_npz(tmp_path / "c.npz", ["clear"]), "--model", "arm")
+    assert code == 0
+    assert "certified 1, violation 0, uncertain 0" in out
+    assert sum(" clear " in line for line in out.splitlines()) == 1
+
+
+def test_log_reverifies_with_review(tmp_path, capsys):
+    log = tmp_path / "plans.mcap"
+    code, _, err = _run(capsys, _per_plan_npz(tmp_path / "p.npz", ["clear", "post"]), "--model", "arm",
+                        "--log", log, "--margin", "0.002")
+    assert code == 1 and log.stat().st_size > 0, err
+    code = main(["review", "--verify", str(log)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "windows 2: certified 1, violation 1" in out
+    assert "2 re-derived, 0 mismatch(es), 0 critical" in out
+
+
+def test_two_local_workers_same_result(tmp_path, capsys):
+    npz = _per_plan_npz(tmp_path / "p.npz", ["clear", "post"])
+    _, out1, _ = _run(capsys, npz, "--model", "arm", "--json")
+    _, out2, _ = _run(capsys, npz, "--model", "arm", "--json", "--workers", "2")
+
+    def strip(out):
+        drop = ("certify_us", "stats")  # wall times
+        return [{k: v for k, v in p.items() if k not in drop} for p in json.loads(out)["plans"]]
+
+    assert strip(out1) == strip(out2)
+
+
+@pytest.mark.parametrize("arrays, needle", [
+    ({"plan0_times": T}, "plan0_qpos is missing"),
+    ({"plan0_times": T, "plan0_qpos": _yaw(0.1), "plan2_times": T, "plan2_qpos": _yaw(0.1)}, "gaps"),
+    ({"plan0_times": T, "plan0_qpos": _yaw(0.1), "plan0_qpso": _yaw(0.1)}, "unknown key"),
+    ({"plan0_times": T, "plan0_qpos": _yaw(0.1), "qpos": _yaw(0.1)[None]}, "mixes"),
+    ({"plan0_times": T, "plan0_qpos": np.zeros((6, 4))}, "plan 'plan0'"),
+    ({"times": T[:5], "qpos": _yaw(0.1)[None]}, "stacked times"),
+    ({"times": T, "qpos": np.zeros(6)}, "stacked qpos"),
+    ({"plan0_times": T, "plan0_qpos": _yaw(0.1), "names": np.array(["a", "b"])}, "names"),
+    ({"plan0_times": T[::-1], "plan0_qpos": _yaw(0.1)}, "plan 'plan0'"),
+    ({}, "no plans"),
+])
+def test_bad_npz_exit_2_with_message(tmp_path, capsys, arrays, needle):
+    p = tmp_path / "bad.npz"
+    np.savez(p, **arrays)
+    code, out, err = _run(capsys, p, "--model", "arm")
+    assert code == 2
+    assert needle in err and "Traceback" not in err
+
+
+def test_bad_files_exit_2(tmp_path, capsys):
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(np.random.default_rng(0).bytes(200))
+    code, _, err = _run(capsys, junk, "--model", "arm")
+    assert code == 2 and "not a readable .npz" in err
+    ok = _per_plan_npz(tmp_path / "p.npz", ["clear"])
+    code, _, err = _run(capsys, ok, "--model", "no_such_scene")
+    assert code == 2 and "no such MJCF file" in err
+    bad_xml = tmp_path / "bad.xml"
+    bad_xml.write_text("<mujoco><worldbody><geom type='nonsense'/></worldbody></mujoco>")
+    code, _, err = _run(capsys, ok, "--model", bad_xml)
+    assert code == 2 and "does not load" in err
+    code, _, err = _run(capsys, ok, "--model", "arm", "--epsilon", "0")
+    assert code == 2 and "--epsilon" in err
