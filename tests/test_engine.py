@@ -183,3 +183,33 @@ def test_public_entry_point_is_monitor_certify(scene, model):
     cert = monitor.certify(scene, _plan(model, (0.3, 0.2)), margin=0.0, epsilon=1e-3, method="toleranced")
     assert cert.verdict == "certified"
     assert cert.clearance >= 0.0
+
+
+def test_swept_sphere_gap_is_a_lower_bound_of_the_sampled_distance():
+    from monitor.certify.broadphase import swept_sphere_gaps
+    from monitor.geometry.distance import shape_distance_batch
+    from monitor.geometry.polytope import box_polytope, capsule_shape, halfspace_shape
+    from monitor.motion.bodymotion import BodyMotion
+
+    rng = np.random.default_rng(7)
+    shapes = [box_polytope(np.array([0.1, 0.2, 0.05])), capsule_shape(0.05, 0.2), halfspace_shape()]
+    checked = 0
+    for _ in range(20):
+        K = 3
+        pos = np.zeros((K, 3, 3))
+        quat = np.tile([1.0, 0, 0, 0], (K, 3, 1))
+        pos[:, 1] = rng.normal(size=(K, 3)) * 0.5 + [0, 0, 0.6]
+        pos[:, 2] = rng.normal(size=(K, 3)) * 0.5 + [0, 0, 0.6]
+        q = rng.normal(size=(K, 2, 4))
+        quat[:, 1:] = q / np.linalg.norm(q, axis=2, keepdims=True)
+        bm = BodyMotion(np.array([0.0, 0.5, 1.0]), pos, quat)
+        sa, sb = [shapes[0], shapes[1], shapes[0]], [shapes[1], shapes[0], shapes[2]]
+        ba, bb = np.array([1, 2, 1]), np.array([2, 1, 0])
+        gaps = swept_sphere_gaps(bm, sa, ba, sb, bb, (0.0, 1.0))
+        ts = np.linspace(0, 1, 401)
+        P, R = bm.body_poses(ts)
+        for k in range(3):
+            _, up = shape_distance_batch(sa[k], (R[:, ba[k]], P[:, ba[k]]), sb[k], (R[:, bb[k]], P[:, bb[k]]))
+            assert gaps[k] <= up.min() + 1e-12
+            checked += np.isfinite(gaps[k])
+    assert checked > 20

@@ -50,34 +50,48 @@ def swept_sphere_gaps(traj: Trajectory, shapes_a: list[ConvexShape], bodies_a: n
     pos, rot = traj.body_poses(mids)
     mb = traj.motion_bounds(ta, tb)
     ref = np.asarray(traj.ref_points, float)
+    ch = chord(mb.angle)                                     # (T, nbody)
+    grow_f = 1.0 + 8 * tolerances.rel_pad
     out = np.full(P, -np.inf)
-
-    def sphere(shape, body):
-        c = shape.bounding_center
-        rad = shape.bounding_radius
-        cw = np.einsum("tij,j->ti", rot[:, body], c) + pos[:, body]
-        grow = mb.trans[:, body] + chord(mb.angle[:, body]) * (np.linalg.norm(c - ref[body]) + rad)
-        return cw, rad + grow * (1.0 + 8 * tolerances.rel_pad)
-
+    sa_l, sb_l, ba_l, bb_l, half = [], [], [], [], []
     for i in range(P):
         sa, sb = shapes_a[i], shapes_b[i]
         ba, bb = int(bodies_a[i]), int(bodies_b[i])
-        if sa.kind == "halfspace" and sb.kind == "halfspace":
-            continue
         if sa.kind == "halfspace":
             sa, sb, ba, bb = sb, sa, bb, ba
-        ca, ra = sphere(sa, ba)
-        if sb.kind == "halfspace":
-            if (mb.trans[:, bb] > 0).any() or (mb.angle[:, bb] > 0).any():
-                continue  # moving plane: no cull (planes are world-fixed in practice)
-            n_W = np.einsum("tij,j->ti", rot[:, bb], sb.normals[0])
-            pt_W = np.einsum("tij,j->ti", rot[:, bb], sb.points[0]) + pos[:, bb]
-            gap = np.einsum("ti,ti->t", ca - pt_W, n_W) - ra
-        else:
-            cb, rb = sphere(sb, bb)
-            gap = np.linalg.norm(ca - cb, axis=1) - ra - rb
-        mag = float(np.abs(pos[:, [ba, bb]]).max()) + 1.0
-        out[i] = float(gap.min()) - tolerances.pad(mag) - tolerances.scale_pad * mag
+        sa_l.append(sa)
+        sb_l.append(sb)
+        ba_l.append(ba)
+        bb_l.append(bb)
+        half.append(sb.kind == "halfspace")
+    ba_a, bb_a, half = np.array(ba_l), np.array(bb_l), np.array(half)
+    both_half = np.array([x.kind == "halfspace" for x in sa_l])
+
+    def spheres(shapes, bodies):
+        c = np.array([s.bounding_center if s.kind != "halfspace" else np.zeros(3) for s in shapes])
+        rad = np.array([s.bounding_radius if s.kind != "halfspace" else 0.0 for s in shapes])
+        cw = np.einsum("tpij,pj->tpi", rot[:, bodies], c) + pos[:, bodies]      # (T, P, 3)
+        lever = np.linalg.norm(c - ref[bodies], axis=1) + rad                    # (P,)
+        grow = mb.trans[:, bodies] + ch[:, bodies] * lever[None, :]
+        return cw, rad[None, :] + grow * grow_f
+
+    ca, ra = spheres(sa_l, ba_a)
+    mag = np.abs(pos).max() + 1.0
+    pad = tolerances.pad(mag) + tolerances.scale_pad * mag
+    gap = np.full((len(mids), P), -np.inf)
+    ns = ~half
+    if ns.any():
+        cb, rb = spheres(sb_l, bb_a)
+        gap[:, ns] = (np.linalg.norm(ca - cb, axis=2) - ra - rb)[:, ns]
+    for i in np.nonzero(half & ~both_half)[0]:
+        bb, sb = bb_a[i], sb_l[i]
+        if (mb.trans[:, bb] > 0).any() or (mb.angle[:, bb] > 0).any():
+            continue  # moving plane: no cull (planes are world-fixed in practice)
+        n_W = rot[:, bb] @ sb.normals[0]
+        pt_W = rot[:, bb] @ sb.points[0] + pos[:, bb]
+        gap[:, i] = np.einsum("ti,ti->t", ca[:, i] - pt_W, n_W) - ra[:, i]
+    out = gap.min(axis=0) - pad
+    out[both_half] = -np.inf
     return out
 
 
