@@ -150,9 +150,9 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     if qpos.ndim != 2 or qpos.shape[1] != model.nq:
         raise InvalidInputError(f"logged plan qpos has shape {qpos.shape}, model has nq={model.nq}")
     kw = {}
-    for key in ("mocap_pos", "mocap_quat"):
-        if msg.get(key) is not None:
-            kw[key] = np.asarray(msg[key], dtype=np.float64)
+    for key, width in (("mocap_pos", 3), ("mocap_quat", 4)):
+        if msg.get(key) is not None:  # JSON writes a (0, 3) array as []: restore the shape
+            kw[key] = np.asarray(msg[key], dtype=np.float64).reshape(-1, width)
     return Plan(times, qpos, model=model, **kw)
 
 
