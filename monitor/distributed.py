@@ -219,6 +219,8 @@ def _verify_task(job: tuple[str, str, int | None]) -> dict[str, Any]:
         return {"error": f"verification needs the certification engine: {exc}"}
     except (MonitorError, ValueError) as exc:
         return {"error": str(exc)}
+    except Exception as exc:  # noqa: BLE001 - one bad log must not abort the other tasks
+        return {"error": f"{path}: unexpected {type(exc).__name__}: {exc}"}
 
 
 def verify_logs(paths: Sequence[str | os.PathLike[str]], *, backend: str = "ray", workers: int | None = None,

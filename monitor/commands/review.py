@@ -4,6 +4,11 @@ Exit codes: 0 fine; 1 ``--verify`` found a window whose verdict flips between
 certified and not certified; 2 an input is unreadable (missing, not MCAP, no
 certificates recovered) or the verification could not run. Truncated logs (a
 killed writer) are reviewed from their recovered part with a warning, exit 0.
+
+A LOG argument may be a directory: its ``*.mcap`` files are reviewed (sorted).
+``--ray`` re-verifies the logs in parallel, one Ray task per log
+(:func:`monitor.distributed.verify_logs`); it implies ``--verify`` and gives the
+same summary and exit code as the serial review.
 """
 
 from __future__ import annotations
@@ -23,6 +28,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                    help="model attachment used by --verify "
                         "(auto: exact MJB if same MuJoCo version, else XML)")
     p.add_argument("--limit", type=int, default=None, help="--verify only the first N windows of each log")
+    p.add_argument("--ray", action="store_true",
+                   help="re-verify the logs in parallel as Ray tasks (implies --verify; uses a running "
+                        "ray.init(), else starts a local instance; needs the 'ray' extra)")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON instead of text")
     p.add_argument("--report", metavar="OUT.html", default=None, help="write a self-contained HTML report")
     p.add_argument("--progress", dest="progress", action="store_true", default=None,
@@ -30,7 +38,8 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", dest="progress", action="store_false", help="never show progress bars")
 
 
-def _review_one(path: str, args: argparse.Namespace) -> tuple[dict[str, Any], int]:
+def _review_one(path: str, args: argparse.Namespace,
+                verified: dict[str, Any] | None = None) -> tuple[dict[str, Any], int]:
     from monitor.errors import LogFormatError, MonitorError
     from monitor.log.reader import read_log
     from monitor.review import analyze, verify
@@ -46,7 +55,10 @@ def _review_one(path: str, args: argparse.Namespace) -> tuple[dict[str, Any], in
         entry["error"] = (f"{path}: no certificate could be recovered ({contents.n_messages} message(s) "
                           f"read, {contents.unreadable_bytes} unreadable byte(s); {why})")
         return entry, 2
-    if args.verify:
+    if verified is not None:  # computed in parallel (--ray): same dict as verify(), or {"error": ...}
+        entry["verify"] = verified
+        code = 2 if verified.get("error") else (1 if verified["critical"] else 0)
+    elif args.verify:
         try:
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
                                      limit=args.limit)
@@ -63,12 +75,33 @@ def _review_one(path: str, args: argparse.Namespace) -> tuple[dict[str, Any], in
 
 def run(args: argparse.Namespace) -> int:
     """Run the review; returns the exit code (0 ok, 1 verify mismatch, 2 unreadable input)."""
+    from monitor.distributed import expand_logs
     from monitor.review import combine, render_text, strip_series, write_report
 
-    entries, codes = [], []
-    for path in args.logs:
+    paths = expand_logs(args.logs)
+    if not paths:
+        print(f"error: no .mcap logs in {' '.join(map(str, args.logs))}", file=sys.stderr)
+        return 2
+    verified: dict[str, Any] = {}
+    if getattr(args, "ray", False):
+        from monitor.distributed import verify_logs
+        from monitor.errors import DependencyNotInstalled
+
+        args.verify = True
         try:
-            entry, code = _review_one(path, args)
+            verified = dict(zip(paths, verify_logs(paths, backend="ray", model_source=args.model_source,
+                                                   limit=args.limit, progress=args.progress)))
+        except DependencyNotInstalled as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
+        except Exception as exc:  # noqa: BLE001 - Ray start-up/cluster failure: a message, not a traceback
+            print(f"error: parallel re-verification on Ray failed: {type(exc).__name__}: {exc}",
+                  file=sys.stderr)
+            return 2
+    entries, codes = [], []
+    for path in paths:
+        try:
+            entry, code = _review_one(path, args, verified.get(path))
         except Exception as exc:  # noqa: BLE001 - last resort: a clear message, never a traceback
             entry, code = {"path": path, "file": {"path": path},
                            "error": f"{path}: unexpected {type(exc).__name__}: {exc}"}, 2
