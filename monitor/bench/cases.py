@@ -30,7 +30,7 @@ from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 NEAR_CLEARANCES_FULL = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
-NEAR_CLEARANCES_QUICK = (1e-2, 1e-3, 1e-4)
+NEAR_CLEARANCES_QUICK = (1e-2, 1e-4)
 CLEAR_DISTANCE = 0.2
 """Designed minimum clearance (m) of the ``"clear"`` cases."""
 

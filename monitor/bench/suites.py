@@ -33,7 +33,7 @@ from monitor.bench.cases import PairCase, ShapeSpec, make_cases
 EPS_FULL = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 EPS_QUICK = (1e-1, 1e-3, 1e-5)
 FACETS_FULL = (6, 8, 16, 32, 64)
-FACETS_QUICK = (8, 16, 32)
+FACETS_QUICK = (8, 32)
 
 
 @dataclass
@@ -57,6 +57,11 @@ class BenchConfig:
     log: Callable[[str], None] = field(default=lambda s: print(s, file=sys.stderr, flush=True))
     shared: dict[str, Any] = field(default_factory=dict)
     smoke: bool = False
+
+    @property
+    def budget_s(self) -> float:
+        """Per-call work limit (s) of ``monitor.certify`` in the sweeps (exhausted -> uncertain)."""
+        return 1.0 if self.quick else 10.0
 
 
 def _missing(*modules: str) -> str | None:
@@ -93,9 +98,23 @@ def case_set(cfg: BenchConfig) -> tuple[list[PairCase], list[oracle.OracleLabel]
     return cfg.shared["cases"], cfg.shared["labels"]
 
 
-def run_ours(case: PairCase, method: str, epsilon: float, reps: int, facets: int = 16) -> dict[str, Any]:
-    """Certify ``case`` ``reps`` times with ``monitor.certify``; verdict, tests, depth, median µs."""
+def run_ours(
+    case: PairCase,
+    method: str,
+    epsilon: float,
+    reps: int,
+    facets: int = 16,
+    budget_s: float | None = None,
+    min_total_s: float = 0.5,
+) -> dict[str, Any]:
+    """Certify ``case`` with ``monitor.certify``; verdict, tests, depth, median µs.
+
+    Repeats up to ``reps`` times but stops once ``min_total_s`` seconds were spent
+    (long runs are already stable). ``budget_s`` is a per-call work limit: an
+    exhausted budget gives "uncertain" (never "certified"), recorded as ``exhausted``.
+    """
     import monitor  # noqa: F401
+    from monitor.certify.common import Budget
     from monitor.certify.engine import certify
     from monitor.errors import MonitorError
 
@@ -103,9 +122,12 @@ def run_ours(case: PairCase, method: str, epsilon: float, reps: int, facets: int
     ts, cert = [], None
     try:
         for _ in range(max(1, reps)):
+            budget = Budget(seconds=budget_s) if budget_s else None
             t = time.perf_counter()
-            cert = certify(scene, motion, margin=0.0, epsilon=epsilon, method=method)
+            cert = certify(scene, motion, margin=0.0, epsilon=epsilon, method=method, budget=budget)
             ts.append(time.perf_counter() - t)
+            if sum(ts) > min_total_s:
+                break
     except MonitorError as exc:
         return {"verdict": "error", "error": f"{type(exc).__name__}: {exc}", "us": None}
     except Exception as exc:  # noqa: BLE001  (an untyped exception is a bug: record it, keep going)
@@ -124,6 +146,10 @@ def run_ours(case: PairCase, method: str, epsilon: float, reps: int, facets: int
         "pair_method": pr.method if pr else None,
         "clearance": cert.clearance,
         "earliest_time": cert.earliest_time,
+        "exhausted": bool(budget_s)
+        and cert.verdict == "uncertain"
+        and float(np.median(ts)) >= 0.95 * budget_s,
+        "reps": len(ts),
     }
 
 
@@ -144,11 +170,75 @@ def _score(entries: list[dict[str, Any]]) -> dict[str, Any]:
         "not_certified_clear": sum(e["verdict"] != "certified" for e in clr),
         "uncertain_frac": (sum(e["verdict"] == "uncertain" for e in entries) / n) if n else None,
         "errors": sum(e["verdict"] in ("error", "exception") for e in entries),
+        "budget_exhausted": sum(bool(e.get("exhausted")) for e in entries),
         "us_median": _pct(us, 50),
         "us_p95": _pct(us, 95),
         "tests_median": _pct([e["tests"] for e in entries if e.get("tests") is not None], 50),
         "depth_max": max([e["depth"] for e in entries if e.get("depth") is not None], default=None),
     }
+
+
+# ------------------------------------------------------------------------------ JIT warm-up
+_WARM_SCRIPT = r"""
+import json, time
+t0 = time.perf_counter()
+import numpy as np
+from monitor.bench.cases import PairCase, ShapeSpec
+from monitor.certify.engine import certify
+t_import = time.perf_counter() - t0
+q = np.array([1.0, 0, 0, 0]); q1 = np.array([np.cos(0.5), 0, np.sin(0.5), 0])
+shapes = (ShapeSpec.box([0.1, 0.08, 0.05]), ShapeSpec.box([0.1, 0.1, 0.1]))
+pos = np.array([[[-0.6, 0.2, 0.0], [0.6, 0.2, 0.0]], [[0.0, 0, 0], [0.0, 0, 0]]])
+rot = PairCase("r", "rotating", "near", 0.02, shapes, pos, np.array([[q, q1], [q, q]]), (True, False))
+tra = PairCase("t", "translating", "near", 0.02, shapes, pos, np.array([[q, q], [q, q]]), (True, False))
+out = {"import_s": t_import}
+for method, case in (("toleranced", rot), ("extrusion", tra)):
+    scene, bm = case.scene(), case.body_motion()
+    ts = []
+    for _ in range(4):
+        t = time.perf_counter()
+        v = certify(scene, bm, epsilon=1e-3, method=method).verdict
+        ts.append(time.perf_counter() - t)
+    out[method] = {"first_s": ts[0], "later_median_s": float(np.median(ts[1:])), "verdict": v}
+print("WARMUP " + json.dumps(out))
+"""
+
+
+def jit_warmup(cfg: BenchConfig) -> dict[str, Any]:
+    """First-call cost of each checker in a fresh interpreter.
+
+    Two modes: with the on-disk numba cache (the normal case) and with an empty
+    cache (``NUMBA_CACHE_DIR`` = a new temp dir: full JIT compilation). Reports
+    import time, first call and the median of 3 later calls.
+    """
+    import json
+    import os
+    import subprocess
+    import tempfile
+
+    root = Path(__file__).resolve().parents[2]
+    out: dict[str, Any] = {}
+    modes = ("cached",) if cfg.smoke else ("cached", "cold")
+    for mode in modes:
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join([str(root), env.get("PYTHONPATH", "")])
+        with tempfile.TemporaryDirectory() as tmp:
+            if mode == "cold":
+                env["NUMBA_CACHE_DIR"] = tmp
+            try:
+                p = subprocess.run(
+                    [sys.executable, "-c", _WARM_SCRIPT],
+                    capture_output=True,
+                    text=True,
+                    timeout=600,
+                    env=env,
+                    cwd=tmp,
+                )
+                line = [x for x in p.stdout.splitlines() if x.startswith("WARMUP ")]
+                out[mode] = json.loads(line[-1][7:]) if line else {"error": p.stderr[-400:]}
+            except subprocess.TimeoutExpired:
+                out[mode] = {"error": "timeout (600 s)"}
+    return out
 
 
 # ------------------------------------------------------------------------------ suite 1
@@ -159,39 +249,27 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
         return {"skipped": miss}
     cases, labels = case_set(cfg)
     eps_list = (1e-3,) if cfg.smoke else EPS_QUICK if cfg.quick else EPS_FULL
-    # JIT warm-up: first call per checker in this process against the median of later calls.
-    warm = {}
-    for method, case in (("toleranced", cases[-1]), ("extrusion", cases[0])):
-        t = time.perf_counter()
-        first = run_ours(case, method, 1e-3, 1)
-        t_first = time.perf_counter() - t
-        later = run_ours(case, method, 1e-3, cfg.reps)
-        warm[method] = {
-            "first_call_s": t_first,
-            "median_s": (later["us"] or 0) * 1e-6,
-            "warmup_s": t_first - (later["us"] or 0) * 1e-6,
-            "case": case.name,
-            "verdict": first["verdict"],
-        }
+    warm = jit_warmup(cfg)
     per_case: list[dict[str, Any]] = []
     plans = [("toleranced", e) for e in eps_list] + [("extrusion", None), ("auto", 1e-3)]
     for method, eps in plans:
         for case, lab in zip(cases, labels):
             if method == "extrusion" and case.group != "translating":
                 continue
-            r = run_ours(case, method, eps if eps is not None else 1e-3, cfg.reps)
+            r = run_ours(case, method, eps if eps is not None else 1e-3, cfg.reps, budget_s=cfg.budget_s)
+            cfg.shared.setdefault("ours", {})[(case.name, method, eps)] = r
             per_case.append(
                 {
+                    **r,
+                    "certified_clearance": r.get("clearance"),
                     "case": case.name,
                     "group": case.group,
                     "checker": method,
                     "epsilon": eps,
                     "label": lab.label,
-                    "clearance": lab.clearance_lower
-                    if lab.label == "clear"
-                    else (lab.distance_upper if lab.label == "near" else -1.0),
-                    "nominal": case.nominal,
-                    **r,
+                    "oracle_clearance_lower": lab.clearance_lower,
+                    # true min distance: the construction's local minimisation (oracle bounds bracket it)
+                    "clearance": case.nominal,
                 }
             )
         cfg.log(f"[bench] accuracy: {method} eps={eps} done")
@@ -256,10 +334,17 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
         "µs per pair-window = one `monitor.certify` call on a one-pair scene (median over cases of the "
         "per-case median of repetitions). false_negatives must be 0.",
         report.table(rows, cols),
-        "JIT / first-call warm-up (first call in this process minus the median of later calls):",
+        "JIT warm-up, in a fresh interpreter: `cached` = with the on-disk numba cache (normal start), "
+        "`cold` = empty NUMBA_CACHE_DIR (full compilation). first call vs median of 3 later calls (s):",
         report.table(
-            [{"checker": k, **v} for k, v in warm.items()],
-            ["checker", "first_call_s", "median_s", "warmup_s", "case"],
+            [
+                {"cache": mode, "import_s": w.get("import_s"), "checker": k, **v}
+                for mode, w in warm.items()
+                for k, v in w.items()
+                if isinstance(v, dict)
+            ]
+            + [{"cache": mode, "error": w["error"]} for mode, w in warm.items() if "error" in w],
+            ["cache", "import_s", "checker", "first_s", "later_median_s", "verdict", "error"],
         ),
     ]
     if facets.get("rows"):
@@ -283,7 +368,7 @@ def _facet_cases(cfg: BenchConfig) -> list[tuple[PairCase, oracle.OracleLabel]]:
     """
     rng = np.random.default_rng(cfg.seed + 1)
     out = []
-    clearances = (3e-2, 1e-2, 3e-3, 1e-3) if not cfg.quick else (1e-2, 1e-3)
+    clearances = (3e-2, 1e-2, 3e-3, 1e-3) if not cfg.quick else (1e-2,)
     from monitor.bench.cases import _place, _unit
     from monitor.bench.oracle import mujoco_distance
 
@@ -335,7 +420,7 @@ def _facet_sweep(cfg: BenchConfig) -> dict[str, Any]:
             for case, lab in fc:
                 if method == "extrusion" and case.group != "translating":
                     continue
-                r = run_ours(case, method, 1e-4, cfg.reps, facets=facets)
+                r = run_ours(case, method, 1e-4, cfg.reps, facets=facets, budget_s=cfg.budget_s)
                 approx = max(case.scene(facets).approximations.values(), default=0.0)
                 ee.append({"label": lab.label, "approx": approx, **r})
             if ee:
@@ -425,12 +510,14 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
             prepared[c.name] = c.prepare(case)
         times: dict[str, list[float]] = {k: [] for k in entries}
         answers: dict[str, Any] = {}
-        for _ in range(cfg.reps):  # interleave: ours then every peer, repeated
-            for name, method, eps in ours:
-                r = run_ours(case, method, eps, 1)
-                answers[name] = r
-                if r.get("us") is not None:
-                    times[name].append(r["us"])
+        for name, method, eps in ours:  # ours: from suite 1 of this run when it ran, else measured here
+            r = cfg.shared.get("ours", {}).get((case.name, method, eps))
+            if r is None:
+                r = run_ours(case, method, eps, cfg.reps, budget_s=cfg.budget_s)
+            answers[name] = r
+            if r.get("us") is not None:
+                times[name].append(r["us"])
+        for _ in range(cfg.reps):  # interleaved repetitions of the peers
             for c in checkers:
                 if c.name not in prepared:
                     continue
@@ -438,7 +525,8 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
                     t = time.perf_counter()
                     col, _ = c.query(prepared[c.name])
                     times[c.name].append(1e6 * (time.perf_counter() - t))
-                answers[c.name] = (col, cap[0].strip())
+                prev = answers.get(c.name, ([], ""))
+                answers[c.name] = (prev[0] + [col], (prev[1] + " " + cap[0].strip()).strip())
         for name, _, _ in ours:
             r = answers[name]
             entries[name].append(
@@ -455,8 +543,15 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
         for c in checkers:
             if c.name not in prepared:
                 continue
-            col, text = answers[c.name]
-            v = "unsupported" if col is None else ("violation" if col else "certified")
+            cols, text = answers[c.name]
+            if any(x is None for x in cols):
+                v = "unsupported"
+            elif all(cols):
+                v = "violation"
+            elif not any(cols):
+                v = "certified"
+            else:  # repetitions disagree: reported, and counted as a miss on collide cases
+                v = "inconsistent"
             entries[c.name].append(
                 {
                     "case": case.name,
@@ -479,8 +574,10 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
                 "checker": name,
                 "group": group,
                 "n": s["n"],
-                "misses": s["false_negatives"],
+                "misses": s["false_negatives"]
+                + sum(e["verdict"] == "inconsistent" and e["label"] == "collide" for e in ee),
                 "false_alarms": s["false_violations"],
+                "inconsistent": sum(e["verdict"] == "inconsistent" for e in ee),
                 "uncertain": s["uncertain_clear"],
                 "unsupported": sum(e["verdict"] == "unsupported" for e in ee),
                 "collide_cases": s["collide_cases"],
@@ -517,6 +614,7 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
                 "uncertain",
                 "clear_cases",
                 "unsupported",
+                "inconsistent",
                 "us_median",
                 "us_p95",
                 "ratio_to_ours",
@@ -593,7 +691,7 @@ def suite_seeds(cfg: BenchConfig) -> dict[str, Any]:
     # Cameron sphere-cube
     case = cameron_sphere_cube()
     for method in ("extrusion", "toleranced"):
-        r = run_ours(case, method, 1e-3, cfg.reps)
+        r = run_ours(case, method, 1e-3, cfg.reps, budget_s=10 * cfg.budget_s)
         rows.append(
             {
                 "experiment": "Cameron §4.1 sphere-cube",
@@ -687,56 +785,93 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
 
 
 def _sw_rows(cfg: BenchConfig) -> dict[str, Any]:
-    """S&W §7.2 n x n squares via ``monitor.certify.bezier`` (issue 3's builders)."""
+    """S&W §7.1 octagons and §7.2 n x n squares via ``monitor.certify.bezier`` (issue 3's builders).
+
+    Verdict here is the checker's own: "certified" (no interval left) or "intervals"
+    (possible violation intervals remain, i.e. not certified). Tests are the paper's
+    polygon-against-fat-polygon tests (``unit_tests``), summed over the n^4 pairs.
+    """
     try:
-        from monitor.certify import bezier  # type: ignore[attr-defined]
+        from monitor.certify.bezier import check_bezier, octagon, paper71_motion, paper72_case
+        from monitor.certify.common import Budget
+        from monitor.certify.toleranced import fixed_features, moving_features
     except ImportError as exc:
         return {"skipped": f"monitor.certify.bezier not available ({exc})"}
-    fn = getattr(bezier, "paper72_case", None)
-    run = getattr(bezier, "run_case", None)
-    if fn is None:
-        return {"skipped": "monitor.certify.bezier.paper72_case missing"}
     rows = []
-    ns = (1, 2, 3, 4) if cfg.quick else tuple(range(1, 11))
-    budget_s = 60.0 if cfg.quick else 1200.0
+    for variant, shift, paper in (("clear", 0.06, "173 tests, depth 8"), ("colliding", 0.8, "9 tests")):
+        t = time.perf_counter()
+        res = check_bezier(
+            paper71_motion(shift),
+            [moving_features(polygon=octagon(1.0))],
+            [fixed_features(polygon=octagon(1.0))],
+            epsilon=0.02,
+        )
+        rows.append(
+            {
+                "experiment": "§7.1 octagons",
+                "n": 1,
+                "kind": variant,
+                "mass": "global",
+                "verdict": "intervals" if res.intervals[0] else "certified",
+                "seconds": time.perf_counter() - t,
+                "tests": int(res.unit_tests[0]),
+                "depth": int(res.max_depth[0]),
+                "paper": paper,
+            }
+        )
+    ns = (1, 2, 3) if cfg.quick else tuple(range(1, 11))
+    budget_s = 30.0 if cfg.quick else 1500.0
+    per_run = 10.0 if cfg.quick else 300.0
     t_start = time.perf_counter()
     for n in ns:
         for kind in ("collision", "near", "clear"):
             for mass in ("global", "per-square"):
-                if time.perf_counter() - t_start > budget_s:
-                    rows.append({"n": n, "kind": kind, "mass": mass, "verdict": "skipped (time budget)"})
+                row = {
+                    "experiment": "§7.2 squares",
+                    "n": n,
+                    "kind": kind,
+                    "mass": mass,
+                    "paper": f"{SW_TABLE[n][0]}-{SW_TABLE[n][1]} s" if n in SW_TABLE else None,
+                }
+                left = budget_s - (time.perf_counter() - t_start)
+                if left <= 0:
+                    rows.append(dict(row, verdict="skipped (suite time budget)"))
                     continue
                 try:
-                    c = fn(n, kind, mass)
+                    c = paper72_case(n, kind, mass)
                     t = time.perf_counter()
-                    res = run(c) if run else c.run()
+                    res = check_bezier(
+                        c["curve"],
+                        c["moving"],
+                        c["fixed"],
+                        c["pairs"],
+                        epsilon=c["epsilon"],
+                        budget=Budget(seconds=min(per_run, left)),
+                    )
                     sec = time.perf_counter() - t
+                    verdict = (
+                        "budget exhausted"
+                        if res.exhausted
+                        else ("intervals" if any(res.intervals) else "certified")
+                    )
                     rows.append(
-                        {
-                            "n": n,
-                            "kind": kind,
-                            "mass": mass,
-                            "verdict": getattr(res, "verdict", None),
-                            "seconds": sec,
-                            "tests": getattr(res, "tests", None),
-                            "depth": getattr(res, "max_depth", None),
-                            "paper_seconds": f"{SW_TABLE[n][0]}-{SW_TABLE[n][1]}" if n in SW_TABLE else None,
-                        }
+                        dict(
+                            row,
+                            verdict=verdict,
+                            seconds=sec,
+                            tests=int(np.sum(res.unit_tests)),
+                            depth=int(np.max(res.max_depth)),
+                        )
                     )
                 except Exception as exc:  # noqa: BLE001
-                    rows.append(
-                        {
-                            "n": n,
-                            "kind": kind,
-                            "mass": mass,
-                            "verdict": "error",
-                            "error": f"{type(exc).__name__}: {exc}",
-                        }
-                    )
+                    rows.append(dict(row, verdict="error", error=f"{type(exc).__name__}: {exc}"))
+        cfg.log(f"[bench] seeds: S&W 7.2 n={n} done")
     return {
         "rows": rows,
-        "cols": ["n", "kind", "mass", "verdict", "seconds", "tests", "depth", "paper_seconds", "error"],
-        "note": f"S&W §7.2 n x n squares (paper: {PAPER_HW['sw']}, 0.11-0.49 s at n=1, 226-738 s at n=10).",
+        "cols": ["experiment", "n", "kind", "mass", "verdict", "seconds", "tests", "depth", "paper", "error"],
+        "note": f"Schröcker & Weber (paper: {PAPER_HW['sw']}; §7.2 Tables 1-2: 0.11-0.49 s at n=1, "
+        "226-738 s at n=10). §7.1 epsilon 0.02; §7.2 epsilon 1 % of the square diameter. "
+        "verdict 'intervals' = not certified (possible-violation intervals remain).",
     }
 
 
@@ -748,27 +883,37 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
         return {"skipped": miss}
     import gymnasium as gym
 
+    from monitor.gate import Rollout
     from monitor.gym_gate import SafetyGate
 
     class PredictOnly(gym.Wrapper):
-        """Runs the gate's rollout prediction of the window, then steps (no certification)."""
+        """Runs the gate's rollout prediction of the window, then steps (no certification).
 
-        def __init__(self, env: gym.Env, gate: Any):
+        ``states_only``: only the scratch simulation (``Rollout.states``), no Plan object.
+        """
+
+        def __init__(self, env: gym.Env, gate: Any, states_only: bool = False):
             super().__init__(env)
             self._gate = gate
+            self._states_only = states_only
+            self._rollout = Rollout(env.unwrapped.model)
+            self._nstep = int(getattr(env.unwrapped, "frame_skip", 1))
 
         def step(self, action):
             space = self.env.action_space
-            self._gate.predict(
-                self.env.unwrapped.data, np.clip(np.asarray(action, float), space.low, space.high)
-            )
+            a = np.clip(np.asarray(action, float), space.low, space.high)
+            if self._states_only:
+                self._rollout.states(self.env.unwrapped.data, a, self._nstep)
+            else:
+                self._gate.predict(self.env.unwrapped.data, a)
             return self.env.step(action)
 
     env_ids = ["Reacher-v5", "Pusher-v5", "Ant-v5", "monitor/Arm-v0"]
-    steps = 40 if cfg.quick else 300
+    steps = 10 if cfg.quick else 100  # gated variants
+    fast_steps = 200 if cfg.quick else 1000  # ungated and prediction-only variants
     if cfg.smoke:
-        env_ids, steps = ["Reacher-v5"], 3
-    reps = 3 if cfg.quick else 5
+        env_ids, steps, fast_steps = ["Reacher-v5"], 3, 10
+    reps = 2 if cfg.quick else 5
     rows = []
     for env_id in env_ids:
         try:
@@ -776,8 +921,11 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
                 import envs  # noqa: F401
             variants = {"ungated": gym.make(env_id)}
             g = SafetyGate(gym.make(env_id), pairs="all")
+            variants["states_only"] = PredictOnly(gym.make(env_id), g.gate, states_only=True)
             variants["predict_only"] = PredictOnly(gym.make(env_id), g.gate)
             variants["gated"] = g
+            gm = SafetyGate(gym.make(env_id), pairs="mujoco")
+            variants["gated_mujoco_pairs"] = gm
         except Exception as exc:  # noqa: BLE001
             rows.append({"env": env_id, "error": f"{type(exc).__name__}: {exc}"})
             continue
@@ -787,7 +935,8 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
             for name, env in variants.items():
                 env.reset(seed=rep)
                 env.action_space.seed(rep)
-                acts = [env.action_space.sample() for _ in range(steps)]
+                n_steps = steps if name.startswith("gated") else fast_steps
+                acts = [env.action_space.sample() for _ in range(n_steps)]
                 t = time.perf_counter()
                 for a in acts:
                     _, _, term, trunc, info = env.step(a)
@@ -796,17 +945,20 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
                         verdicts[str(v)] = verdicts.get(str(v), 0) + 1
                     if term or trunc:
                         env.reset()
-                rates[name].append(steps / (time.perf_counter() - t))
+                rates[name].append(n_steps / (time.perf_counter() - t))
         med = {k: float(np.median(v)) for k, v in rates.items()}
         rows.append(
             {
                 "env": env_id,
                 "pairs": g.gate.npairs,
+                "pairs_mujoco": gm.gate.npairs,
                 "steps_per_s_ungated": med["ungated"],
                 "steps_per_s_predict_only": med["predict_only"],
                 "steps_per_s_gated": med["gated"],
+                "states_ratio": med["ungated"] / med["states_only"],
                 "predict_ratio": med["ungated"] / med["predict_only"],
                 "gated_ratio": med["ungated"] / med["gated"],
+                "gated_mujoco_pairs_ratio": med["ungated"] / med["gated_mujoco_pairs"],
                 "verdicts": verdicts,
             }
         )
@@ -818,7 +970,8 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
         (
             f"Pusher-v5 gated/ungated step time {pusher['gated_ratio']:.2f}x: "
             f"{'MET' if pusher['gated_ratio'] <= 2 else 'MISSED'} (target <= 2x); rollout prediction alone "
-            f"{pusher['predict_ratio']:.2f}x"
+            f"{pusher['predict_ratio']:.2f}x (scratch simulation only {pusher['states_ratio']:.2f}x; "
+            f"gated with pairs='mujoco' {pusher['gated_mujoco_pairs_ratio']:.2f}x)"
         )
         if pusher
         else "not measured"
@@ -827,17 +980,22 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
         f"{steps} steps x {reps} interleaved repetitions per variant (median steps/s); "
         "ratios = ungated steps/s divided by the variant's (time per step relative to ungated). "
         "gated = SafetyGate(pairs='all'), every step certified; "
-        "predict_only = the gate's rollout prediction without certification.",
+        "predict_only = the gate's rollout prediction (scratch simulation + Plan) without certification; "
+        "states_ratio = the scratch simulation alone (`monitor.gate.Rollout.states`); "
+        "gated_mujoco_pairs = SafetyGate(pairs='mujoco'). verdicts = gated (pairs='all') step verdicts.",
         report.table(
             rows,
             [
                 "env",
                 "pairs",
+                "pairs_mujoco",
                 "steps_per_s_ungated",
                 "steps_per_s_predict_only",
                 "steps_per_s_gated",
+                "states_ratio",
                 "predict_ratio",
                 "gated_ratio",
+                "gated_mujoco_pairs_ratio",
                 "verdicts",
                 "error",
             ],
@@ -898,14 +1056,31 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
     from monitor.certify.engine import certify
 
     rows = []
-    limit = 60.0 if cfg.quick else 600.0
+    from monitor.certify.common import Budget
+
+    limit = 30.0 if cfg.quick else 600.0
     for motion in ("translating", "rotating"):
         for density in ("sparse", "dense"):
+            if cfg.quick and (motion, density) == ("rotating", "dense"):
+                rows.append(
+                    {
+                        "motion": motion,
+                        "density": density,
+                        "bodies": None,
+                        "seconds": None,
+                        "note": "not in --quick (toleranced pairs at 0.1-1 s each)",
+                    }
+                )
+                continue
             for n in (10,) if cfg.smoke else (10, 100, 1000):
                 prev = [
                     r for r in rows if (r["motion"], r["density"]) == (motion, density) and r.get("seconds")
                 ]
-                if prev and prev[-1]["seconds"] * (n / prev[-1]["bodies"]) ** 2 > limit:
+                if (
+                    prev
+                    and (prev[-1]["seconds"] + prev[-1]["scene_seconds"]) * (n / prev[-1]["bodies"]) ** 2
+                    > limit
+                ):
                     rows.append(
                         {
                             "motion": motion,
@@ -924,8 +1099,10 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
                     ts, cert = [], None
                     for _ in range(1 if n >= 1000 else cfg.reps):
                         t = time.perf_counter()
-                        cert = certify(scene, bm, epsilon=1e-3)
+                        cert = certify(scene, bm, epsilon=1e-3, budget=Budget(seconds=limit))
                         ts.append(time.perf_counter() - t)
+                        if sum(ts) > 1.0:
+                            break
                     rows.append(
                         {
                             "motion": motion,
