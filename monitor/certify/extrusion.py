@@ -290,6 +290,9 @@ class _Search:
                   for b in bodies]
         self.scale = float(max(coords)) if coords else 0.0
         self.box_pad = self.tol.pad(self.scale) + self.tol.scale_pad * self.scale
+        # rounding made when leaves are placed in the world and centred (|o - c| from
+        # coordinates of size `scale`): widens every exact-test bound (rel_pad = 64 ulp)
+        self.data_pad = self.tol.rel_pad * self.scale + self.tol.abs_pad
         self._w = np.zeros(3)
         self.stats: dict[str, Any] = {"spans": [], "lps": 0, "nnls": 0, "regions": 0,
                                       "full_region_proofs": 0, "leaf_pairs": len(pairs)}
@@ -464,14 +467,14 @@ class _Search:
         rr = la.radius + lb.radius
         if p.mode == "halfspace":
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
-            res, _ = halfspace_null_test(plane, other, 0.0, 0.0, s1 - s0, self.tol)
+            res, _ = halfspace_null_test(plane, other, 0.0, 0.0, s1 - s0, self.tol, self.data_pad)
             low = res.lower - rr
         else:
             D = (la.V[:, None, :] - lb.V[None, :, :]).reshape(-1, 3)
             w = la.v - lb.v
             low, _, _ = min_norm(np.vstack([D, D + w * (s1 - s0)]), self.tol)
             self.stats["nnls"] += 1
-            low -= rr
+            low -= rr + self.data_pad
         p.clearance = min(p.clearance, low)
 
     # -- quadratic / half-space pairs
@@ -485,7 +488,7 @@ class _Search:
         p.tests += 1
         if p.mode == "halfspace":
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
-            res, first = halfspace_null_test(plane, other, p.r, tl, th, self.tol)
+            res, first = halfspace_null_test(plane, other, p.r, tl, th, self.tol, self.data_pad)
             if res.verdict == "violation":
                 # witness: earliest time at which d <= (r + min d) / 2 (half the depth)
                 dmin = 0.5 * (res.lower + res.upper) + p.r
@@ -500,7 +503,7 @@ class _Search:
             else:
                 self._settle(p, res, s0, tl, th)
             return
-        res = quadratic_null_test(la, lb, p.r, tl, th, self.tol)
+        res = quadratic_null_test(la, lb, p.r, tl, th, self.tol, self.data_pad)
         self.stats["nnls"] += 1
         if res.verdict == "violation":
             first, fpoint, n1 = quadratic_first_time(la, lb, p.r, tl, res.tau, p.r, self.tol)
@@ -637,7 +640,7 @@ class _Search:
         self._charge()
         self.stats["lps"] += 1
         p.tests += 1
-        res = lp_null_test(la, lb, blo - cz, bhi - cz, self.tol)
+        res = lp_null_test(la, lb, blo - cz, bhi - cz, self.tol, self.data_pad)
         if res.verdict == "violation":
             self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="lp", found=res, found_c=c)
         elif res.verdict == "unresolved":
@@ -655,7 +658,7 @@ class _Search:
         G = np.vstack([la.G, lb.G])
         h = np.concatenate([la.h, lb.h])
         if found is None:  # full-region proof: find the deepest point once
-            found = lp_null_test(la, lb, lo, hi, self.tol)
+            found = lp_null_test(la, lb, lo, hi, self.tol, self.data_pad)
             self.stats["lps"] += 1
             p.tests += 1
             found_x = found.point
@@ -674,7 +677,7 @@ class _Search:
             self.stats["lps"] += 1
             p.tests += 1
             if wz is not None:
-                if slack_lower(G, h, np.r_[wz[1], wz[0]], self.tol) > 0.0:
+                if slack_lower(G, h, np.r_[wz[1], wz[0]], self.tol) > self.data_pad:
                     w_tau, w_x = wz
         res = NullResult("violation", -np.inf, -smax, w_tau, w_x)
         self._violation(p, s0, s1, c, first_tau, first_x, w_tau, w_x, res, "lp")

@@ -130,8 +130,12 @@ def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) ->
     return float(np.min(terms - 8 * tol.rel_pad * mag) - tol.abs_pad)
 
 
-def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Tolerances) -> NullResult:
+def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Tolerances,
+                 data_pad: float = 0.0) -> NullResult:
     """Slack LP of two extruded polytopes on the box ``lo <= (x, tau) <= hi`` (each (4,)).
+
+    ``data_pad`` (m) bounds the rounding made when the leaves were built from the
+    inputs (world placement, centring); it widens both bounds.
 
     Returns a :class:`NullResult` whose ``lower``/``upper`` bound ``-max_slack``
     (so that, as for distances, negative means overlap).
@@ -144,7 +148,7 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
     if res is None:
         return NullResult("unresolved", -np.inf, np.inf, float(lo[3]), 0.5 * (lo[:3] + hi[:3]))
     z = np.clip(res.x[:4], lo, hi)
-    s_lo = slack_lower(G, h, z, tol)
+    s_lo = slack_lower(G, h, z, tol) - data_pad
     # dual certificate: s <= y.h - (G^T y).z for every feasible (z, s) when y >= 0, sum y = 1
     y = np.clip(-res.ineqlin.marginals, 0.0, None)
     ub = np.inf
@@ -154,7 +158,7 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
         ub_raw = float(y @ h + np.sum(np.maximum(-r * lo, -r * hi)))
         zmax = np.maximum(np.abs(lo), np.abs(hi))
         mag = float(y @ (np.abs(h) + np.abs(G) @ zmax))
-        ub = ub_raw + 16 * tol.rel_pad * mag + tol.abs_pad
+        ub = ub_raw + 16 * tol.rel_pad * mag + tol.abs_pad + data_pad
     if s_lo > 0.0:
         verdict = "violation"
     elif ub <= tol.extrusion_slack:
@@ -315,7 +319,7 @@ def static_distance(a: Leaf, b: Leaf, tau: float, tol: Tolerances) -> tuple[floa
 
 
 def quadratic_null_test(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float,
-                        tol: Tolerances) -> NullResult:
+                        tol: Tolerances, data_pad: float = 0.0) -> NullResult:
     """Exact test of ``min_{tau in [tau_lo, tau_hi]} dist(core_a, core_b) < r`` (``r > 0``).
 
     ``lower``/``upper`` bound ``min distance - r`` (m).
@@ -323,6 +327,7 @@ def quadratic_null_test(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float
     D, w = _cso(a, b)
     P = np.vstack([D + w * tau_lo, D + w * tau_hi])
     lo, up, lam = min_norm(P, tol)
+    lo, up = lo - data_pad, up + data_pad
     tau = float(np.clip(tau_lo + (tau_hi - tau_lo) * lam[len(D):].sum(), tau_lo, tau_hi))
     _, _, point = static_distance(a, b, tau, tol)
     if up < r:
@@ -367,7 +372,7 @@ def quadratic_first_time(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: floa
 # ----------------------------------------------------------------------------- half-space
 
 def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_hi: float,
-                        tol: Tolerances) -> tuple[NullResult, float | None]:
+                        tol: Tolerances, data_pad: float = 0.0) -> tuple[NullResult, float | None]:
     """Closed-form test of a core against a (possibly translating) half-space.
 
     The signed distance of the core to the plane ``{n.x <= o + (n.v_p) tau}`` is
@@ -386,7 +391,7 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
     d0 = other.V @ n - o
     ends = np.stack([d0 + nw * tau_lo, d0 + nw * tau_hi])  # (2, nv)
     mag = np.abs(other.V) @ np.abs(n) + abs(o) + abs(nw) * max(abs(tau_lo), abs(tau_hi))
-    pad = float(8 * tol.rel_pad * mag.max() + tol.abs_pad)
+    pad = float(8 * tol.rel_pad * mag.max() + tol.abs_pad) + data_pad
     k = np.unravel_index(int(np.argmin(ends)), ends.shape)
     dmin = float(ends[k])
     tau = tau_lo if k[0] == 0 else tau_hi
