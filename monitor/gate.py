@@ -112,7 +112,7 @@ class Rollout:
 
     def brake_tail(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
                    brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
-                   vel_tol: float) -> tuple[Any, np.ndarray]:
+                   vel_tol: float) -> tuple[Any, np.ndarray, np.ndarray]:
         """Plan of the braking motion that would follow the window of ``ctrl``.
 
         Integrates the window (``nstep`` substeps under ``ctrl``), then holds the
@@ -120,7 +120,8 @@ class Rollout:
         ``|qvel| <= vel_tol`` or ``max_steps`` substeps.
 
         Returns:
-            (plan of the tail from the window's end, brake control (nu,)).
+            (plan of the tail from the window's end, brake control (nu,),
+            qvel (K, nv) at the tail's waypoints).
         """
         from monitor.motion.plan import Plan
 
@@ -128,16 +129,17 @@ class Rollout:
         m, s = self.model, self.scratch
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
-        times, qpos = [s.time], [s.qpos.copy()]
+        times, qpos, qvel = [s.time], [s.qpos.copy()], [s.qvel.copy()]
         for _ in range(max(int(max_steps), 1)):
             mujoco.mj_step(m, s)
             times.append(s.time)
             qpos.append(s.qpos.copy())
+            qvel.append(s.qvel.copy())
             if m.nv == 0 or float(np.max(np.abs(s.qvel))) <= vel_tol:
                 break
         plan = Plan(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
                     mocap_quat=np.array(data.mocap_quat))
-        return plan, brake
+        return plan, brake, np.array(qvel)
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -188,7 +190,8 @@ class StepReport:
         unsafe: True when the proposed window counted as unsafe (see ``unsafe=``).
         applied_verdict: verdict of the window actually applied (= ``verdict``
             unless replaced).
-        fallback_certificate: certificate of the fallback window, or None.
+        fallback_certificate: certificate of the fallback window (or of the committed
+            braking tail that contains it, see ``brake``), or None.
         fallback_certified: False only when a fallback was applied whose window
             did not certify.
         certify_us: wall time (µs) spent certifying (proposal, brake tail, fallback).
@@ -383,6 +386,7 @@ class Gate:
         self.brake_steps = max(1, int(math.ceil(float(brake_horizon) / model.opt.timestep)))
         self.brake_vel_tol = float(brake_vel_tol)
         self._committed: np.ndarray | None = None
+        self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self.tolerances = tolerances
         self._rollout = Rollout(model)
         self._scene = None
@@ -393,7 +397,7 @@ class Gate:
         self._log_owned = False
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
-                      "fallback_uncertified": 0, "brake_rejected": 0, "certify_us": 0.0,
+                      "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
                       "reused_pairs": 0, "pairs": 0}
         self._warned = False
 
@@ -521,6 +525,30 @@ class Gate:
     def reset(self) -> None:
         """Forget the committed brake (call when the caller's state is reset)."""
         self._committed = None
+        self._tail = None
+
+    def _tail_covers(self, data: mujoco.MjData, n: int) -> Certificate | None:
+        """The committed tail's certificate if it contains the next ``n`` substeps.
+
+        That is the case when the live state equals a tail waypoint bit for bit
+        (time, qpos, qvel, mocap) and the window ends inside the tail: the
+        committed brake then reproduces the tail exactly. Else None.
+        """
+        if self._tail is None:
+            return None
+        plan, cert, qvel = self._tail
+        if not cert.certified:
+            return None
+        hits = np.flatnonzero(plan.times == data.time)
+        if len(hits) != 1:
+            return None
+        k = int(hits[0])
+        if (k + n >= len(plan.times) or not np.array_equal(plan.qpos[k], data.qpos)
+                or not np.array_equal(qvel[k], data.qvel)
+                or not np.array_equal(plan.mocap_pos, data.mocap_pos)
+                or not np.array_equal(plan.mocap_quat, data.mocap_quat)):
+            return None
+        return cert
 
     def _brake_active(self, fallback: Callable[[], Any] | None) -> bool:
         return (self.brake and self.on_violation != "warn" and fallback is None
@@ -568,7 +596,7 @@ class Gate:
         unsafe = self.is_unsafe(cert.verdict)
         brake_verdict, brake_next = "", None
         if not unsafe and self._brake_active(fallback):
-            tail, brake_next = self._rollout.brake_tail(
+            tail, brake_next, tail_qvel = self._rollout.brake_tail(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
             tail_cert, tail_us = self._certify(tail)
             us += tail_us
@@ -587,9 +615,16 @@ class Gate:
             else:
                 applied = cast(self.fallback_ctrl(data))
             replaced, terminated = True, self.on_violation == "terminate"
-            applied_plan = predict(applied)
-            fb_cert, fb_us = self._certify(applied_plan)
-            us += fb_us
+            covered = (self._tail_covers(data, n) if fallback is None and applied is self._committed
+                       else None)
+            if covered is not None:  # this window is part of the committed, certified tail
+                fb_cert = covered
+                applied_plan = None
+                self.stats["tail_reused"] += 1
+            else:
+                applied_plan = predict(applied)
+                fb_cert, fb_us = self._certify(applied_plan)
+                us += fb_us
             applied_verdict = fb_cert.verdict
             fb_ok = fb_cert.verdict == "certified"
             if not fb_ok:
@@ -600,6 +635,7 @@ class Gate:
                 self._warned = True
         elif not unsafe:
             self._committed = brake_next
+            self._tail = None if brake_next is None else (tail, tail_cert, tail_qvel)
         report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
                             applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
         self._account(report)
