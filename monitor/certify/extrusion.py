@@ -73,7 +73,7 @@ from monitor.certify.extrusion_null import (
     quadratic_null_test,
     slack_lower,
 )
-from monitor.certify.extrusion_sbounds import pair_sbounds, root_operator, swept_box
+from monitor.certify.extrusion_sbounds import RootBound, pair_sbounds, swept_box
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.geometry.shapes import ConvexShape
 from monitor.tolerances import DEFAULT, Tolerances
@@ -254,6 +254,20 @@ def _pair_box(rb: Any, va: np.ndarray, vb: np.ndarray) -> tuple[np.ndarray, np.n
     return np.maximum(sa_lo, sb_lo), np.minimum(sa_hi, sb_hi)
 
 
+def _empty_in_own_frames(rb: Any, va: np.ndarray, vb: np.ndarray) -> bool:
+    """True if the pair's overlap box is empty along some axis measured in A's or B's frame.
+
+    Every frame gives a valid bound (App. B, optimal fitting); the n-ary search uses
+    one common frame per span for its regions, so each pair is first culled in its own
+    two candidate frames, as the pairwise search would.
+    """
+    for w in (va, vb):
+        lo, hi = _pair_box(rb, va - w, vb - w)
+        if np.any(lo > hi):
+            return True
+    return False
+
+
 def _mode(sa: ConvexShape, sb: ConvexShape, r: float, name: tuple[str, str]) -> str:
     """Which exact test decides a leaf pair."""
     if sa.kind == "halfspace" and sb.kind == "halfspace":
@@ -390,9 +404,15 @@ class _Search:
                 if not (sb.a_alive[ka] and sb.b_alive[kb]):
                     continue
                 # leaf-pair S-bound (the implicit subtree E_i meet E_j of §6.3)
-                rb = root_operator(sb.a_lo[ka], sb.a_hi[ka], va, sb.b_lo[kb], sb.b_hi[kb], vb,
-                                   sb.t_lo, sb.t_hi)
-                if rb is None:
+                # iterated to convergence like the body-level bound
+                one = np.ones(1, bool)
+                lb = pair_sbounds(sb.a_lo[ka:ka + 1], sb.a_hi[ka:ka + 1], one, va,
+                                  sb.b_lo[kb:kb + 1], sb.b_hi[kb:kb + 1], one, vb, sb.t_lo, sb.t_hi)
+                rb = None if lb is None else RootBound(lb.t_lo, lb.t_hi, lb.a_lo[0], lb.a_hi[0],
+                                                       lb.b_lo[0], lb.b_hi[0])
+                if rb is None or _empty_in_own_frames(rb, va, vb) or self._pruned_in_own_frame(p, rb, st):
+                    span_stats["leaf_pairs_pruned_own_region"] = span_stats.get(
+                        "leaf_pairs_pruned_own_region", 0) + (rb is not None)
                     continue
                 items.append((p, rb))
         # optimal fitting of the final region (App. B): measure space in a frame moving with
@@ -415,6 +435,33 @@ class _Search:
         self._exact_stage(s0, s1, stw, work, span_stats)
         for p in live:
             self._clearance(p, s0, s1)
+
+    def _pruned_in_own_frame(self, p: _PairState, rb: RootBound, st: dict) -> bool:
+        """§4.1 region test of a leaf pair on its own S-bound region (scheme 1 of §6.3).
+
+        The region is the pair's overlap box in its best co-moving frame (per axis A's
+        or B's velocity); a leaf with one extruded half-space excluding the whole
+        region cannot meet the other there.
+        """
+        if p.mode != "lp":
+            return False
+        va, vb = st[p.ia][1], st[p.ib][1]
+        w = np.zeros(3)
+        for k in range(3):
+            widths = []
+            for c in (va[k], vb[k]):
+                dv = np.zeros(3)
+                dv[k] = c
+                lo, hi = _pair_box(rb, va - dv, vb - dv)
+                widths.append(hi[k] - lo[k])
+            w[k] = va[k] if widths[0] <= widths[1] else vb[k]
+        lo, hi = _pair_box(rb, va - w, vb - w)
+        rlo, rhi = np.r_[lo, rb.t_lo], np.r_[hi, rb.t_hi]
+        A, B = self.bodies[p.ia], self.bodies[p.ib]
+        z = np.zeros(3)
+        la = _leaf(A.shapes[p.ga], A.R, st[p.ia][0], va - w, z)
+        lb = _leaf(B.shapes[p.gb], B.R, st[p.ib][0], vb - w, z)
+        return self._classify(la, rlo, rhi)[0] == "empty" or self._classify(lb, rlo, rhi)[0] == "empty"
 
     def _frame_velocity(self, items: list, st: dict) -> np.ndarray:
         """Per axis, the body velocity whose co-moving frame gives the narrowest region (App. B)."""
@@ -544,6 +591,7 @@ class _Search:
         counter = 0
         heapq.heappush(heap, (float(lo[3]), counter, 0, lo, hi, list(range(len(work)))))
         regions = 0
+        tested: set[int] = set()
         leaves = {}  # (pair idx) -> (world leaves at span start, uncentred) for region tests
         for k, (p, *_r) in enumerate(work):
             A, B = self.bodies[p.ia], self.bodies[p.ib]
@@ -565,16 +613,20 @@ class _Search:
             live_idx = []
             for k in idx:
                 p, tl, th, x_lo, x_hi, _, _ = work[k]
-                if p.done:
+                if p.done or k in tested:
                     continue
                 # S-bound of the pair against the region
                 if tl > rhi[3] or th < rlo[3] or np.any(x_lo > rhi[:3]) or np.any(x_hi < rlo[:3]):
                     continue
+                # classify against the region met with the pair's own S-bound box (its
+                # intersection lies there), which is tighter than the region alone
+                blo = np.maximum(rlo, np.r_[x_lo, tl])
+                bhi = np.minimum(rhi, np.r_[x_hi, th])
                 la, lb = leaves[k]
-                ca, fa = self._classify(la, rlo, rhi)
+                ca, _ = self._classify(la, blo, bhi)
                 if ca == "empty":
                     continue
-                cb, fb = self._classify(lb, rlo, rhi)
+                cb, _ = self._classify(lb, blo, bhi)
                 if cb == "empty":
                     continue
                 if ca == "full" and cb == "full":
@@ -585,16 +637,16 @@ class _Search:
             if not live_idx:
                 continue
             if not self.divide or len(live_idx) <= kappa(d) or d >= KAPPA_MAX_DEPTH:
+                # conquer: one LP per leaf pair and span, over its whole S-bound box (the
+                # regions prune, prove full collisions and order by time; re-testing a
+                # pair per region would only multiply LPs)
                 for k in live_idx:
                     p, tl, th, x_lo, x_hi, _, _ = work[k]
-                    if p.done:
+                    if p.done or k in tested:
                         continue
+                    tested.add(k)
                     p.max_depth = max(p.max_depth, d)
-                    blo = np.r_[np.maximum(x_lo, rlo[:3]), max(tl, rlo[3])]
-                    bhi = np.r_[np.minimum(x_hi, rhi[:3]), min(th, rhi[3])]
-                    if np.any(blo > bhi):
-                        continue
-                    self._lp_region(p, s0, s1, st, blo, bhi, tl, th, x_lo, x_hi)
+                    self._lp_region(p, s0, s1, st, np.r_[x_lo, tl], np.r_[x_hi, th], tl, th, x_lo, x_hi)
                 continue
             # divide: bisect the longest axis (time in metres via the fastest speed)
             ext = rhi - rlo
@@ -841,8 +893,8 @@ def compare_pairwise_nary(bodies: Sequence[TranslatingBody], allowed_pairs: Iter
 
     Returns:
         dict with ``pairs``, ``pairwise_seconds``, ``nary_seconds``, ``pairwise_lps``,
-        ``nary_lps``, ``pairwise_nnls``, ``nary_nnls``, ``agree`` (all verdicts and earliest
-        times equal) and ``verdicts`` ({verdict: count}).
+        ``nary_lps``, ``pairwise_nnls``, ``nary_nnls``, ``agree`` (all verdicts equal and
+        earliest times within 1e-9 of the window) and ``verdicts`` ({verdict: count}).
     """
     allowed = list(allowed_pairs) if allowed_pairs is not None else None
     w = _check_window(window, margin)
@@ -861,7 +913,9 @@ def compare_pairwise_nary(bodies: Sequence[TranslatingBody], allowed_pairs: Iter
         lps += s.stats["lps"]
         nn += s.stats["nnls"]
     t2 = time.perf_counter()
-    agree = all(a.verdict == b.verdict and a.info.get("earliest_time") == b.info.get("earliest_time")
+    tol_t = 1e-9 * (w[1] - w[0])
+    agree = all(a.verdict == b.verdict
+                and abs(a.info.get("earliest_time", 0.0) - b.info.get("earliest_time", 0.0)) <= tol_t
                 for a, b in zip(n_out, p_out))
     verdicts: dict[str, int] = {}
     for o in n_out:
