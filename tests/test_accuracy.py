@@ -296,6 +296,8 @@ def _run(n_cases, seed0):
         label, dmin = oracle(scene, plan, margin)
         cert = certify(scene, plan, margin=margin, epsilon=EPS, method="toleranced")
         rows.append((label, cert.verdict, dmin - margin, cat, desc, seed0 + i))
+        # the certified clearance bound can never exceed a sampled distance
+        assert cert.clearance <= dmin + 1e-12, (seed0 + i, cert.clearance, dmin)
     return rows
 
 

@@ -248,6 +248,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
             outcomes[i] = ("toleranced", o)
     # -- 5. witnesses ---------------------------------------------------------------------
     by_i = {i: (ga, gb) for i, ga, gb in checked}
+    refine: list[int] = []
     for i, (meth, o) in outcomes.items():
         ga, gb = by_i[i]
         tests_total += int(o.tests)
@@ -255,8 +256,10 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         names, bodies = (ga.name, gb.name), (ga.body, gb.body)
         if o.verdict == "certified" and i not in start_unproven:
             clear = o.clearance if np.isfinite(o.clearance) else margin
-            done(i, PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (),
-                               float(max(clear, margin) if meth == "toleranced" else clear)))
+            if meth == "toleranced":
+                clear = max(clear, margin)
+                refine.append(i)
+            done(i, PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (), float(clear)))
             continue
         intervals = list(o.intervals)
         if o.verdict == "certified":  # start pose not proven clear
@@ -277,6 +280,13 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         else:
             done(i, PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
                                tuple(intervals) if intervals else ((t0, t1),), float("-inf")))
+    if refine:  # better clearance bounds for toleranced-certified pairs (one pose/bound call)
+        cl = _sampled_clearances(plan, [by_i[i] for i in refine], t0, t1, tol)
+        for i, c in zip(refine, cl):
+            r = results[i]
+            if c > r.clearance:
+                results[i] = PairResult(r.geoms, r.bodies, r.verdict, r.method, r.tests, r.max_depth,
+                                        r.intervals, float(c), r.witness)
     # -- 6. combine -------------------------------------------------------------------------
     ordered = tuple(results[i] for i in sel)
     verdict = combine_verdicts([r.verdict for r in ordered])
@@ -295,6 +305,43 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
              "budget_exhausted": bool(bud is not None and bud.exhausted)}
     return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        ordered, stats)
+
+
+def _sampled_clearances(plan: Any, geoms: list[tuple[Any, Any]], t0: float, t1: float, tol: Tolerances,
+                        n: int = 8) -> list[float]:
+    """Certified clearance lower bounds from n sub-intervals: d_lower(mid) - deviation bounds.
+
+    On [a, b] with midpoint m every point of a shape moves by at most
+    trans + chord(angle) * max_p |p - ref| from its pose at m (motion-bound contract), so
+    the distance stays >= lower(m) - delta_A - delta_B. Half-spaces on a moving body: -inf.
+    """
+    from monitor.geometry.distance import shape_distance_batch
+    from monitor.motion.base import chord
+
+    e = np.linspace(t0, t1, n + 1)
+    a, b = e[:-1], e[1:]
+    m = 0.5 * (a + b)
+    pos, rot = plan.body_poses(m)
+    mb = plan.motion_bounds(a, b)
+    ref = np.asarray(plan.ref_points, float)
+    ch = chord(mb.angle)
+    out = []
+    for ga, gb in geoms:
+        dev = np.zeros(n)
+        ok = True
+        for g in (ga, gb):
+            if g.shape.kind == "halfspace":
+                ok &= not ((mb.trans[:, g.body_id] > 0).any() or (mb.angle[:, g.body_id] > 0).any())
+                continue
+            lever = float(np.linalg.norm(g.shape.points - ref[g.body_id], axis=1).max() + g.shape.radius)
+            dev = dev + mb.trans[:, g.body_id] + ch[:, g.body_id] * lever
+        if not ok:
+            out.append(float("-inf"))
+            continue
+        lo, _ = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
+                                     gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]), tolerances=tol)
+        out.append(float((lo - dev * (1.0 + 8 * tol.rel_pad)).min()))
+    return out
 
 
 def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
