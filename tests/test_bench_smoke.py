@@ -39,8 +39,8 @@ def slab_case(gap: float, *, turn: float = 0.0, both: bool = False, name: str = 
 
 @pytest.fixture(scope="module")
 def small_set():
-    cases = [slab_case(-0.01, name="col"), slab_case(1e-3, name="near3"), slab_case(0.05, turn=1.0, name="rot"),
-             slab_case(-1e-3, turn=0.5, both=True, name="rotcol")]
+    cases = [slab_case(-0.01, name="col"), slab_case(1e-3, name="near3"),
+             slab_case(0.05, turn=1.0, name="rot"), slab_case(-1e-3, turn=0.5, both=True, name="rotcol")]
     return cases, [oracle.label(c) for c in cases]
 
 
@@ -144,7 +144,7 @@ def test_peers_suite_on_small_set(small_set, tmp_path):
     from monitor.bench.suites import BenchConfig, suite_peers
 
     cases, labels = small_set
-    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None)
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
     cfg.shared["cases"], cfg.shared["labels"] = cases, labels
     res = suite_peers(cfg)
     if res.get("skipped"):
@@ -162,7 +162,7 @@ def test_accuracy_suite_on_small_set(small_set, tmp_path):
     from monitor.bench import suites
 
     cases, labels = small_set
-    cfg = suites.BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None)
+    cfg = suites.BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
     cfg.shared["cases"], cfg.shared["labels"] = cases, labels
     cfg.shared["skip_facets"] = True
     res = suites.suite_accuracy(cfg)

@@ -447,9 +447,11 @@ def _facet_sweep(cfg: BenchConfig) -> dict[str, Any]:
             "not_certified_clear",
             "clear_cases",
         ],
-        "note": f"Facet sweep: {len(fc)} cylinder/ellipsoid-vs-box near-misses (clearances "
-        f"{FACETS_QUICK if cfg.quick else FACETS_FULL} facets; epsilon 1e-4; oracle: MuJoCo distance "
-        "of the true shapes). A clearance below the circumscription error cannot be certified.",
+        "note": f"Facet sweep: {len(fc)} cylinder/ellipsoid-vs-box near-misses, clearances "
+        f"{sorted({round(c.nominal, 4) for c, _ in fc})} m, "
+        f"facet counts {FACETS_QUICK if cfg.quick else FACETS_FULL}, "
+        "epsilon 1e-4; oracle: MuJoCo distance of the TRUE shapes (GJK tolerance padded). A clearance below "
+        "the circumscription error (approx_error_max) cannot be certified: it shows as not_certified_clear.",
     }
 
 
@@ -977,7 +979,8 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
         else "not measured"
     )
     md = [
-        f"{steps} steps x {reps} interleaved repetitions per variant (median steps/s); "
+        f"{fast_steps} steps (ungated, prediction only) or {steps} steps (gated) x {reps} interleaved "
+        "repetitions per variant (median steps/s); "
         "ratios = ungated steps/s divided by the variant's (time per step relative to ungated). "
         "gated = SafetyGate(pairs='all'), every step certified; "
         "predict_only = the gate's rollout prediction (scratch simulation + Plan) without certification; "
