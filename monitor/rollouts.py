@@ -453,39 +453,51 @@ def rollouts(model_or_env_id: Any, policy: Callable[[Any, np.random.Generator], 
 def bench_rollouts(model_or_env_id: Any = "tunnel", policy: Any = None, *, episodes: int = 4,
                    steps: int = 100, seeds: int | Sequence[int] = 0,
                    configs: Sequence[tuple[str, int | None]] = (("local", 1), ("local", 2), ("ray", 2)),
-                   gate_kwargs: dict[str, Any] | None = None, log: bool = False,
+                   repeat: int = 2, gate_kwargs: dict[str, Any] | None = None, log: bool = False,
                    progress: bool | None = False) -> list[dict[str, Any]]:
     """Episodes per minute of the same batch on several backends (for ``monitor/bench``).
 
-    Every configuration runs the same seeded episodes; the rows also say whether
-    the per-episode verdict counts and digests equal those of the first
-    configuration. Wall times include spawning local worker processes and the
-    workers' first imports (what a user pays per call); for Ray they exclude
-    ``ray.init`` (reported as ``ray_init_s``, paid once per session) but include
-    the Ray workers' first imports.
+    First one short episode runs in this process (numba compiles or loads its
+    cache, so no configuration pays the compilation). Then every configuration
+    runs the same seeded batch ``repeat`` times: the first run is *cold* (a local
+    pool spawns its processes, which import MuJoCo and load the numba cache; Ray
+    workers do the same on their first task), later runs are *warm* for Ray and
+    for ``workers=1`` (both keep their processes) but not for a local pool, which
+    is started anew by every :func:`rollouts` call. ``ray.init`` is not timed
+    (reported as ``ray_init_s``, paid once per session). Each row also says
+    whether the per-episode verdict counts and digests equal those of the first
+    configuration's first run.
 
     Args:
         model_or_env_id, policy, episodes, steps, seeds, gate_kwargs: as for :func:`rollouts`.
         configs: (backend, workers) pairs; a Ray config is skipped (row with
             ``skipped`` set) when Ray is not installed.
+        repeat: runs per configuration (>= 1).
         log: write logs (to a temporary folder, deleted afterwards).
         progress: progress bars.
 
     Returns:
-        one dict per config: backend, workers, episodes, steps, windows, wall_s,
-        episodes_per_min, windows_per_s, identical (bool), ray_init_s (Ray rows),
-        skipped (str, only when skipped), cpus (``os.cpu_count()``).
+        one dict per config: backend, workers, episodes, steps, windows, runs_s (wall s
+        of every run), wall_s (cold, first run), warm_wall_s (best later run, or None),
+        episodes_per_min and windows_per_s (cold), warm_episodes_per_min (or None),
+        identical (bool, every run), ray_init_s (Ray rows), skipped (str, only when
+        skipped), cpus (``os.cpu_count()``), load_avg (1-min load average before the row).
     """
     import tempfile
 
     from monitor.errors import DependencyNotInstalled
 
+    if int(repeat) < 1:
+        raise InvalidInputError(f"repeat must be >= 1, got {repeat!r}")
+    rollouts(model_or_env_id, policy, episodes=1, steps=2, seeds=seeds if isinstance(seeds, int) else 0,
+             gate_kwargs=gate_kwargs, log_dir=None, progress=False)  # warm-up: numba compile / cache
     rows: list[dict[str, Any]] = []
     ref_counts = None
     with tempfile.TemporaryDirectory(prefix="monitor-bench-rollouts-") as tmp:
         for k, (backend, workers) in enumerate(configs):
             row: dict[str, Any] = {"backend": backend, "workers": workers, "episodes": episodes,
-                                   "steps": steps, "cpus": os.cpu_count()}
+                                   "steps": steps, "cpus": os.cpu_count(),
+                                   "load_avg": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
             if backend == "ray":
                 from monitor.distributed import ensure_ray
 
@@ -499,31 +511,43 @@ def bench_rollouts(model_or_env_id: Any = "tunnel", policy: Any = None, *, episo
                     row["skipped"] = f"ray not installed ({exc})"
                     rows.append(row)
                     continue
-            summary = rollouts(model_or_env_id, policy, episodes=episodes, steps=steps, seeds=seeds,
-                               workers=workers, backend=backend, gate_kwargs=gate_kwargs,
-                               log_dir=Path(tmp) / f"cfg{k}" if log else None, progress=progress)
-            got = [(e.counts(), e.verdict_digest) for e in summary.episodes]
-            if ref_counts is None:
-                ref_counts = got
+            runs, identical = [], True
+            for r in range(int(repeat)):
+                summary = rollouts(model_or_env_id, policy, episodes=episodes, steps=steps, seeds=seeds,
+                                   workers=workers, backend=backend, gate_kwargs=gate_kwargs,
+                                   log_dir=Path(tmp) / f"cfg{k}-{r}" if log else None, progress=progress)
+                got = [(e.counts(), e.verdict_digest) for e in summary.episodes]
+                if ref_counts is None:
+                    ref_counts = got
+                identical = identical and got == ref_counts
+                runs.append(summary.wall_s)
             windows = summary.totals()["steps"]
-            row.update(windows=windows, wall_s=summary.wall_s, episodes_per_min=summary.episodes_per_minute,
-                       windows_per_s=windows / summary.wall_s if summary.wall_s > 0 else math.inf,
-                       identical=got == ref_counts)
+            warm = min(runs[1:]) if len(runs) > 1 else None
+            row.update(windows=windows, runs_s=runs, wall_s=runs[0], warm_wall_s=warm,
+                       episodes_per_min=60.0 * episodes / runs[0],
+                       windows_per_s=windows / runs[0],
+                       warm_episodes_per_min=None if warm is None else 60.0 * episodes / warm,
+                       identical=identical)
             rows.append(row)
     return rows
 
 
 def format_bench(rows: Sequence[dict[str, Any]]) -> str:
     """Markdown table of :func:`bench_rollouts` rows."""
-    out = ["| backend | workers | episodes x steps | wall s | episodes/min | windows/s | same verdicts |",
-           "|---|---|---|---|---|---|---|"]
+    out = ["| backend | workers | episodes x steps | cold wall s | cold episodes/min | warm wall s "
+           "| warm episodes/min | same verdicts | load avg |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if r.get("skipped"):
-            out.append(f"| {r['backend']} | {r['workers']} | - | - | - | - | skipped: {r['skipped']} |")
+            out.append(f"| {r['backend']} | {r['workers']} | - | - | - | - | - | "
+                       f"skipped: {r['skipped']} | - |")
             continue
+        warm = "-" if r["warm_wall_s"] is None else f"{r['warm_wall_s']:.1f}"
+        warm_epm = "-" if r["warm_episodes_per_min"] is None else f"{r['warm_episodes_per_min']:.1f}"
+        load = "-" if r.get("load_avg") is None else f"{r['load_avg']:.1f}"
         out.append(f"| {r['backend']} | {r['workers']} | {r['episodes']} x {r['steps']} | "
-                   f"{r['wall_s']:.1f} | {r['episodes_per_min']:.1f} | {r['windows_per_s']:.1f} | "
-                   f"{r['identical']} |")
+                   f"{r['wall_s']:.1f} | {r['episodes_per_min']:.1f} | {warm} | {warm_epm} | "
+                   f"{r['identical']} | {load} |")
     return "\n".join(out)
 
 

@@ -17,7 +17,7 @@ ray = pytest.importorskip("ray", reason="optional 'ray' extra not installed: pip
 
 from monitor._paths import scene_path  # noqa: E402
 from monitor.cli import main  # noqa: E402
-from monitor.rollouts import RandomPolicy, bench_rollouts, rollouts  # noqa: E402
+from monitor.rollouts import RandomPolicy, bench_rollouts, format_bench, rollouts  # noqa: E402
 
 pytestmark = pytest.mark.ray
 
@@ -135,9 +135,11 @@ def test_certify_cli_ray_backend_same_certificates(tmp_path, capsys):
 
 def test_bench_rollouts_rows():
     rows = bench_rollouts("tunnel", RandomPolicy(hold=3), episodes=2, steps=5,
-                          configs=(("local", 1), ("ray", 2)))
+                          configs=(("local", 1), ("ray", 2)), repeat=2)
     assert [(r["backend"], r["workers"]) for r in rows] == [("local", 1), ("ray", 2)]
     for r in rows:
         assert r["identical"] is True
         assert r["windows"] == 10 and r["episodes_per_min"] > 0
+        assert len(r["runs_s"]) == 2 and r["warm_wall_s"] == min(r["runs_s"][1:])
     assert rows[1]["ray_init_s"] == 0.0  # the module's instance was reused
+    assert "| ray | 2 | 2 x 5 |" in format_bench(rows)
