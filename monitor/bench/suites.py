@@ -911,11 +911,11 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
             return self.env.step(action)
 
     env_ids = ["Reacher-v5", "Pusher-v5", "Ant-v5", "monitor/Arm-v0"]
-    steps = 10 if cfg.quick else 100  # gated variants
+    steps = 10 if cfg.quick else 30  # gated variants
     fast_steps = 200 if cfg.quick else 1000  # ungated and prediction-only variants
     if cfg.smoke:
         env_ids, steps, fast_steps = ["Reacher-v5"], 3, 10
-    reps = 2 if cfg.quick else 5
+    reps = 2 if cfg.quick else 3
     rows = []
     for env_id in env_ids:
         try:
@@ -1061,7 +1061,7 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
     rows = []
     from monitor.certify.common import Budget
 
-    limit = 30.0 if cfg.quick else 600.0
+    limit = 30.0 if cfg.quick else 150.0
     for motion in ("translating", "rotating"):
         for density in ("sparse", "dense"):
             if cfg.quick and (motion, density) == ("rotating", "dense"):
