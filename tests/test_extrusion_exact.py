@@ -220,6 +220,16 @@ def test_case_mix(random_cases):
 
 
 def test_verdicts_and_earliest_match_oracle(random_cases):
+    _check_against_oracle(random_cases)
+
+
+@pytest.mark.slow
+def test_large_sweep_against_oracle():
+    """5000 more cases (about 4 minutes): ``pytest -m slow tests/test_extrusion_exact.py``."""
+    _check_against_oracle(cases(977, 5000))
+
+
+def _check_against_oracle(random_cases):
     mismatches, time_errors = [], []
     for i, (pair, window, label, gap) in enumerate(random_cases):
         out = check_pairs([pair], window)[0]
