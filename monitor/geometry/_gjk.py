@@ -394,14 +394,220 @@ def _tetra_inradius(W, pad_coord, rel_pad):
 
 
 @njit(cache=True)
+def _face_plane(P, i, j, k, pad_coord, rel_pad, nout):
+    """Oriented triangle (i, j, k) of P: unit normal (Pj-Pi)x(Pk-Pi) into ``nout``.
+
+    Returns (dist, certified): the signed distance from the origin to the plane
+    (positive when the origin is on the inner side) and that distance minus a pad
+    covering vertex perturbations of ``pad_coord`` and the cross-product rounding.
+    """
+    e = np.empty(3)
+    f = np.empty(3)
+    for r in range(3):
+        e[r] = P[j, r] - P[i, r]
+        f[r] = P[k, r] - P[i, r]
+    _cross(e, f, nout)
+    nn = np.sqrt(_dot(nout, nout))
+    if not nn > 0.0:
+        return -np.inf, -np.inf
+    for r in range(3):
+        nout[r] /= nn
+    dist = _dot(nout, P[i])
+    le = np.sqrt(_dot(e, e))
+    lf = np.sqrt(_dot(f, f))
+    lw = np.sqrt(_dot(P[i], P[i]))
+    dn = 4.0 * pad_coord * (le + lf) + 4.0 * rel_pad * le * lf
+    pad = pad_coord + 2.0 * dn * lw / nn + 2.0 * rel_pad * (abs(dist) + lw)
+    return dist, dist - pad
+
+
+@njit(cache=True)
+def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
+    """Certified radius r of a ball B(0, r) inside the Minkowski difference, by EPA.
+
+    Expanding-polytope iterations start from the GJK tetrahedron W (4, 3) around
+    the origin and push the face nearest the origin out to the support point in
+    its normal, so the nearest face distance converges to the penetration depth.
+    The result is *verified* independently of how it was built: the faces must
+    form a closed, consistently oriented triangle surface (every directed edge
+    once, its reverse once) whose planes all have the origin strictly on the inner
+    side (certified distances > 0) and whose solid angles at the origin sum to
+    4 pi (winding number 1). Then every ray from the origin crosses exactly one
+    face, at a distance >= that face plane's distance, so B(0, min distance) lies
+    in the star-shaped region bounded by the surface, which lies in the (convex)
+    Minkowski difference because its vertices do. Convexity is not needed.
+    Returns 0 when anything fails (the caller keeps its other bounds).
+
+    ``lb_out[0]`` receives the best separating-axis value ``-h_D(n)`` over the
+    face normals tried (a lower bound on the signed distance whatever happens;
+    it converges to minus the penetration depth).
+    """
+    maxv = 4 + max_iter
+    maxf = 4 + 48 * max_iter
+    P = np.empty((maxv, 3))
+    for q in range(4):
+        for r in range(3):
+            P[q, r] = W[q, r]
+    nv = 4
+    F = np.empty((maxf, 3), np.int64)
+    alive = np.zeros(maxf, np.bool_)
+    fn = np.empty((maxf, 3))
+    fd = np.empty(maxf)
+    nrm = np.empty(3)
+    nf = 0
+    for o in range(4):
+        i = (o + 1) % 4
+        j = (o + 2) % 4
+        k = (o + 3) % 4
+        d, _ = _face_plane(P, i, j, k, pad_coord, rel_pad, nrm)
+        if _dot(nrm, P[o]) - d > 0.0:
+            j, k = k, j
+            d, _ = _face_plane(P, i, j, k, pad_coord, rel_pad, nrm)
+        if not d > 0.0:
+            return 0.0
+        F[nf, 0] = i
+        F[nf, 1] = j
+        F[nf, 2] = k
+        alive[nf] = True
+        fd[nf] = d
+        for r in range(3):
+            fn[nf, r] = nrm[r]
+        nf += 1
+    vis = np.zeros(maxf, np.bool_)
+    hor = np.empty((3 * maxf, 2), np.int64)
+    w = np.empty(3)
+    for _ in range(max_iter):
+        best = -1
+        bd = np.inf
+        for g in range(nf):
+            if alive[g] and fd[g] < bd:
+                bd = fd[g]
+                best = g
+        if best < 0 or nv >= maxv:
+            break
+        ia, sa = _support_max(VA, fn[best])
+        ib, sb = _support_min(VB, fn[best])
+        # -h_D(n) = min_b n.b - max_a n.a (|n| = 1 up to rounding: divide anyway)
+        lb = (sb - sa) / np.sqrt(_dot(fn[best], fn[best]))
+        if lb > lb_out[0]:
+            lb_out[0] = lb
+        for r in range(3):
+            w[r] = VA[ia, r] - VB[ib, r]
+        if _dot(fn[best], w) - bd <= 1e-10 * bd + 4.0 * pad_coord:
+            break
+        # faces visible from w
+        nvis = 0
+        for g in range(nf):
+            vis[g] = False
+            if alive[g]:
+                s = 0.0
+                for r in range(3):
+                    s += fn[g, r] * (w[r] - P[F[g, 0], r])
+                if s > 0.0:
+                    vis[g] = True
+                    nvis += 1
+        if not vis[best]:
+            break
+        # horizon: directed edges of visible faces whose reverse is not in a visible face
+        nh = 0
+        for g in range(nf):
+            if not vis[g]:
+                continue
+            for q in range(3):
+                a = F[g, q]
+                b = F[g, (q + 1) % 3]
+                shared = False
+                for h in range(nf):
+                    if vis[h] and h != g:
+                        for t in range(3):
+                            if F[h, t] == b and F[h, (t + 1) % 3] == a:
+                                shared = True
+                if not shared:
+                    hor[nh, 0] = a
+                    hor[nh, 1] = b
+                    nh += 1
+        if nf + nh > maxf:
+            break
+        for r in range(3):
+            P[nv, r] = w[r]
+        for g in range(nf):
+            if vis[g]:
+                alive[g] = False
+        ok = True
+        for q in range(nh):
+            d, _ = _face_plane(P, hor[q, 0], hor[q, 1], nv, pad_coord, rel_pad, nrm)
+            if not d > 0.0:
+                ok = False
+            F[nf, 0] = hor[q, 0]
+            F[nf, 1] = hor[q, 1]
+            F[nf, 2] = nv
+            alive[nf] = True
+            fd[nf] = d
+            for r in range(3):
+                fn[nf, r] = nrm[r]
+            nf += 1
+        nv += 1
+        if not ok:
+            return 0.0
+    # ---- verification
+    nalive = 0
+    for g in range(nf):
+        if alive[g]:
+            nalive += 1
+    keys = np.empty(3 * nalive, np.int64)
+    m = 0
+    for g in range(nf):
+        if alive[g]:
+            for q in range(3):
+                keys[m] = F[g, q] * maxv + F[g, (q + 1) % 3]
+                m += 1
+    keys.sort()
+    # closedness: every directed edge (a, b) exactly once and its reverse (b, a) present
+    for q in range(m):
+        if q > 0 and keys[q] == keys[q - 1]:
+            return 0.0
+        a = keys[q] // maxv
+        b = keys[q] % maxv
+        rk = b * maxv + a
+        pos = np.searchsorted(keys, rk)
+        if pos >= m or keys[pos] != rk:
+            return 0.0
+    r_min = np.inf
+    omega = 0.0
+    for g in range(nf):
+        if not alive[g]:
+            continue
+        _, dc = _face_plane(P, F[g, 0], F[g, 1], F[g, 2], pad_coord, rel_pad, nrm)
+        if not dc > 0.0:
+            return 0.0
+        if dc < r_min:
+            r_min = dc
+        # solid angle (Van Oosterom - Strackee)
+        pa_ = P[F[g, 0]]
+        pb_ = P[F[g, 1]]
+        pc_ = P[F[g, 2]]
+        _cross(pb_, pc_, nrm)
+        det = _dot(pa_, nrm)
+        la = np.sqrt(_dot(pa_, pa_))
+        lb = np.sqrt(_dot(pb_, pb_))
+        lc = np.sqrt(_dot(pc_, pc_))
+        den = la * lb * lc + _dot(pa_, pb_) * lc + _dot(pa_, pc_) * lb + _dot(pb_, pc_) * la
+        omega += 2.0 * np.arctan2(det, den)
+    if not abs(omega - 4.0 * np.pi) < 1e-3:
+        return 0.0
+    return max(r_min, 0.0)
+
+
+@njit(cache=True)
 def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
     """Max over candidate directions of -h_D(n)/|n| (A-to-B directions).
 
     Candidates: the GJK direction, coordinate axes, face normals of both cores
-    (both signs), cross products of edge pairs (both signs; capped at
-    ``max_edge_pairs``) and, when no core is a polytope, crosses of edges with
-    the axes. For two polytopes with complete edge/face lists this is the exact
-    signed distance (separating-axis theorem); in general a valid lower bound.
+    (both signs), cross products of edge pairs (both signs; skipped when edge
+    pairs x vertices exceeds ``max_edge_pairs``) and, when no core is a
+    polytope, crosses of edges with the axes. For two polytopes with complete
+    edge/face lists this is the exact signed distance (separating-axis theorem);
+    in general a valid lower bound.
     """
     best = -np.inf
     n = np.empty(3)
@@ -424,7 +630,7 @@ def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
             for r in range(3):
                 n[r] = s * NB[i, r]
             best = max(best, _axis_bound(VA, VB, n))
-    if EA.shape[0] * EB.shape[0] <= max_edge_pairs:
+    if EA.shape[0] * EB.shape[0] * (VA.shape[0] + VB.shape[0]) <= max_edge_pairs:
         for i in range(EA.shape[0]):
             for r in range(3):
                 a[r] = VA[EA[i, 1], r] - VA[EA[i, 0], r]
@@ -536,7 +742,7 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
         rel_pad, abs_pad: rounding pads (``Tolerances``).
         eps_rel: GJK relative duality-gap tolerance.
         max_iter: GJK iteration cap.
-        max_edge_pairs: cap on edge-pair cross products in the SAT lower bound.
+        max_edge_pairs: work cap (edge pairs x vertices) on the edge x edge SAT candidates.
         out: (OUT_SIZE,) float64 output: status, estimate, lower, upper (core
             signed distance, metres), p_a (3), p_b (3) in the frame shifted by
             tA (add tA for world), pad, iterations.
@@ -704,14 +910,22 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
     else:
         if status == SEPARATED:
             status = TOUCHING
-        sat = _sat_lower(VA, VB, EA, EB, WNA, WNB, any_polytope, max_edge_pairs, v)
-        if best_lower > sat:
-            sat = best_lower
-        lower = sat - pad
+        sat = best_lower
         if status == OVERLAP:
             r_in = _tetra_inradius(W, pad_coord, rel_pad)
+            if any_polytope:
+                lb_epa = np.full(1, -np.inf)
+                r_in = max(r_in, _epa_inradius(VA, VB, W, pad_coord, rel_pad, 32, lb_epa))
+                if lb_epa[0] > sat:
+                    sat = lb_epa[0]
             if r_in > 0.0 and -r_in < upper:
                 upper = -r_in
+        if not (sat > -np.inf and upper - sat <= 1e-9 * abs(sat) + 4.0 * pad):
+            # not converged (touching, EPA stopped early or not applicable): SAT candidates
+            lb = _sat_lower(VA, VB, EA, EB, WNA, WNB, any_polytope, max_edge_pairs, v)
+            if lb > sat:
+                sat = lb
+        lower = sat - pad
         if kind_a == KIND_POLYTOPE and kind_b != KIND_POLYTOPE:
             dep = _low_dim_depth(VA, WNA, VB, xc) - 2.0 * pad - dpad_a
         elif kind_b == KIND_POLYTOPE and kind_a != KIND_POLYTOPE:

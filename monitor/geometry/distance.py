@@ -64,9 +64,10 @@ _MAX_ITER = 200
 """GJK iteration cap (typical: < 10 for boxes, < 30 for 100-vertex hulls); a
 capped run still returns rigorous (looser) bounds."""
 
-_MAX_EDGE_PAIRS = 20000
-"""Cap on edge x edge cross products in the overlap lower bound (cost ~ pairs x
-vertices). Beyond it only face normals are used: still a valid, looser bound."""
+_MAX_EDGE_PAIRS = 2_000_000
+"""Work cap (edge pairs x vertices, ~1 ns each) on the edge x edge separating-axis
+candidates of the overlap lower bound, used only when EPA did not converge.
+Beyond it only face normals are used: still a valid, looser bound."""
 
 _KINDS = ("sphere", "capsule", "polytope", "halfspace")
 
