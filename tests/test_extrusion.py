@@ -448,3 +448,29 @@ def test_cross_check_against_toleranced_checker():
             assert ext.verdict == "violation", i
             n_viol += 1
     assert n_viol >= 3 and n_cert >= 3
+
+
+def test_check_pairs_nary_mode_equals_pairwise():
+    rng = np.random.default_rng(32)
+    bodies = _random_bodies(rng, 4, 3, spread=0.7)
+    pairs = []
+    for i, A in enumerate(bodies):
+        for B in bodies[i + 1:]:
+            for ka in range(3):
+                for kb in range(3):
+                    pairs.append(TranslatingPair(A.shapes[ka], A.R, A.times, A.origins, B.shapes[kb], B.R,
+                                                 B.times, B.origins, (A.geom_names[ka], B.geom_names[kb])))
+    # plus a pair whose two geoms share one motion (decided alone)
+    A = bodies[0]
+    pairs.append(TranslatingPair(A.shapes[0], A.R, A.times, A.origins, A.shapes[1], A.R, A.times, A.origins,
+                                 (A.geom_names[0], A.geom_names[1])))
+    a = check_pairs(pairs, (0.0, 1.0))
+    b = check_pairs(pairs, (0.0, 1.0), nary=True)
+    assert any(o.verdict == "violation" for o in a)
+    for x, y in zip(a, b):
+        assert x.verdict == y.verdict
+        assert x.info["geoms"] == y.info["geoms"]
+        if x.verdict == "violation":
+            assert x.info["earliest_time"] == pytest.approx(y.info["earliest_time"], abs=1e-9)
+        else:
+            assert x.clearance == pytest.approx(y.clearance, abs=1e-9)
