@@ -226,3 +226,23 @@ def test_clear_configuration_is_excluded_and_inflation_counts():
 def test_metric_of_polygon_uses_off_plane_point():
     m = make_metric(_octagon(np.random.default_rng(3)))
     assert m.added == 2
+
+
+def test_check_pairs_start_containment_and_clear_motion():
+    from monitor.certify.toleranced import check_pairs
+    from monitor.motion.bodymotion import BodyMotion
+
+    box = box_polytope(np.array([0.5, 0.5, 0.5]))
+    ball = sphere_shape(0.05)
+    K = 2
+    pos = np.zeros((K, 3, 3))
+    quat = np.tile([1.0, 0, 0, 0], (K, 3, 1))
+    pos[:, 1] = [[0.0, 0, 0], [0.2, 0.1, 0]]        # ball moves inside the box (never touches a face)
+    pos[:, 2] = [[2.0, 0, 0], [2.0, 0.5, 0]]        # a second box far away
+    bm = BodyMotion(np.array([0.0, 1.0]), pos, quat)
+    out = check_pairs(bm, [(ball, 1, box, 0), (box, 2, box, 0)], (0.0, 1.0), 0.0, 1e-3)
+    assert out[0].verdict == "unresolved" and out[0].info.get("start_overlap")
+    assert out[1].verdict == "certified" and out[1].tests > 0
+    # without the start test the boundary tests alone would (wrongly) clear the contained ball
+    out2 = check_pairs(bm, [(ball, 1, box, 0)], (0.0, 1.0), 0.0, 1e-3, check_start=False)
+    assert out2[0].verdict == "certified"
