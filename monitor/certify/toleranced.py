@@ -901,7 +901,22 @@ def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
 
 
 class _TrajectoryBalls(BallProvider):
-    """Balls from the certified motion bounds of a Trajectory (relative motion of A in B)."""
+    """Balls from the certified motion bounds of a Trajectory (relative motion of A in B's frame).
+
+    Construction (both bodies may move). Sub-interval [ta, tb], midpoint m. The relative
+    pose is X_BA(t) = X_WB(t)^-1 X_WA(t); the centre is g = X_BA(m) (rigid). For a point p
+    of A (body frame), with w(t) = X_WA(t) p and u = g(p) = X_WB(m)^-1 w(m) (a point of B's
+    rigid extension),
+
+        |X_BA(t) p - g(p)| = |w(t) - X_WB(t) u|                     (X_WB(t)^-1 is an isometry)
+                           <= |w(t) - w(m)| + |X_WB(m) u - X_WB(t) u|
+                           <= T_A + ch_A |p - c_A| + T_B + ch_B |g(p) - c_B| =: delta(p),
+
+    by the motion-bound contract applied to A at p and to B at u (c = reference points,
+    ch = chord(angle)). Every relative pose of the sub-interval is then in B_R(g) with
+    R^2 = sum_i w_i delta(m_i)^2 over A's feature points (the metric's definition), which
+    we evaluate per feature point (tighter than the closed form in design.md) and pad.
+    """
 
     def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric]):
         self.traj = traj
