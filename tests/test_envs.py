@@ -114,3 +114,44 @@ def test_tunnel_mujoco_misses_the_wall():
     k = int(np.argmax(xs > 0))
     band = 0.01 + 0.005
     assert xs[k - 1] < -band and xs[k] > band
+
+
+# ----------------------------------------------------------------------------- gated arm vs a post
+def _arm_obstacle_contacts(gated, steps):
+    from monitor.gym_gate import SafetyGate
+
+    env = gym.make("monitor/Arm-v0", max_episode_steps=steps + 1)
+    if gated:
+        env = SafetyGate(env, on_violation="block")
+    u = env.unwrapped
+    m = u.model
+    body_of = [m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)]
+    arm = {g for g, b in enumerate(body_of) if b in ("link1", "link2", "link3", "gripper")}
+    obstacles = {g for g, b in enumerate(body_of) if b in ("post_a", "post_b", "shelf")}
+    env.reset(seed=0)
+    # the stretched arm aimed at post_a
+    into_post = np.array([np.arctan2(0.25, 0.45), 0.0, 0.0], dtype=np.float32)
+    n, replaced = 0, 0
+    for _ in range(steps):
+        _, _, _, _, info = env.step(into_post)
+        n += _ncon_between(m, u.data, arm, obstacles)
+        replaced += int(gated and info["safety"]["replaced"])
+    env.close()
+    return n, replaced
+
+
+def _gate_keeps_arm_off_the_post(steps):
+    free, _ = _arm_obstacle_contacts(gated=False, steps=steps)
+    assert free > 0, "without the gate the policy drives the arm into the post"
+    blocked, replaced = _arm_obstacle_contacts(gated=True, steps=steps)
+    assert blocked == 0, "with the gate MuJoCo reports no arm/obstacle contact"
+    assert replaced > 0
+
+
+def test_gate_keeps_arm_off_the_post_ci():
+    _gate_keeps_arm_off_the_post(60)  # contact comes at step ~7 without the gate
+
+
+@pytest.mark.slow
+def test_gate_keeps_arm_off_the_post_500_steps():
+    _gate_keeps_arm_off_the_post(500)
