@@ -129,8 +129,8 @@ def test_box_box_axis_aligned_closed_form():
         res = shape_distance(box_polytope(ha), (R, pa), box_polytope(hb), (R, pb))
         check_bounds(res, truth, width=1e-11 if truth >= 0 else None)
         if truth < -1e-10 * scale:
-            # certified depth: a ball in both boxes (<= the penetration depth in general)
             assert res.upper < 0
+            assert res.upper - res.lower <= 1e-9 * abs(truth) + 1e-11  # EPA: exact depth
         if truth > 1e-11:  # above the absolute pad (1e-12 per side)
             assert res.lower > 0
 
@@ -288,6 +288,8 @@ def test_random_hulls_overlap_sign_vs_lp_and_distance_vs_qp():
             assert res.upper < 0, (i, slack, res)
             if i % 2 == 0:
                 assert res.upper <= -slack + 1e-9  # the LP ball of radius slack is in both
+            # EPA certifies the penetration depth from both sides
+            assert res.upper - res.lower <= 1e-9 * abs(res.lower) + 1e-11, (i, res)
         elif slack < -1e-7:
             n_sep += 1
             assert res.lower > 0, (i, slack, res)
