@@ -45,7 +45,9 @@ import hashlib
 import math
 import os
 import pickle
+import sys
 import time
+import types
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -550,6 +552,20 @@ def format_bench(rows: Sequence[dict[str, Any]]) -> str:
                    f"{r['identical']} | {load} |")
     return "\n".join(out)
 
+
+class _CallableModule(types.ModuleType):
+    """Module type forwarding calls to :func:`rollouts`.
+
+    ``monitor.rollouts`` is both this module and the public function: importing
+    the module (``from monitor.rollouts import RandomPolicy``) rebinds the package
+    attribute ``monitor.rollouts`` to the module, which must stay callable.
+    """
+
+    def __call__(self, *args: Any, **kwargs: Any) -> RolloutSummary:
+        return rollouts(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
 
 __all__ = ["rollouts", "RolloutSummary", "EpisodeResult", "RandomPolicy", "run_episode", "bench_rollouts",
            "format_bench"]

@@ -134,3 +134,14 @@ def test_ray_missing_raises_dependency_error(monkeypatch):
         require_ray()
     with pytest.raises(DependencyNotInstalled, match=r"monitor\[ray\]"):
         rollouts("tunnel", episodes=1, steps=1, backend="ray", log_dir=None)
+
+
+def test_monitor_rollouts_callable_after_module_import():
+    import importlib
+
+    import monitor
+
+    importlib.import_module("monitor.rollouts")
+    assert callable(monitor.rollouts) and monitor.rollouts.RandomPolicy is RandomPolicy
+    s = monitor.rollouts("tunnel", episodes=1, steps=2, log_dir=None, progress=False)
+    assert isinstance(s, RolloutSummary) and s.episodes[0].steps == 2
