@@ -24,12 +24,19 @@ Pipeline (per time span, spans in time order):
    tau) and the list of live leaf pairs. Per region a leaf is *empty* if one of
    its extruded half-spaces excludes the whole region (dropped), *full* if the
    region lies strictly inside all of them; a pair whose two leaves are both
-   full is a proved collision. Complexity = number of live leaf pairs needing
+   full is a proved collision. Leaves are tested against the region met with
+   the pair's own S-bound box. Complexity = number of live leaf pairs needing
    exact work; conquer when it is ``<= kappa(d) = 2 d + 6`` (the paper's
    threshold, with our complexity unit being a leaf pair, i.e. one LP) or at
    ``d = 12`` binary splits (= 3 levels of the paper's 16-way split), else
    bisect the longest axis (time measured in metres by the fastest speed).
-   Regions are processed earliest-first (heap on ``tau_lo``).
+   Regions are processed earliest-first (heap on ``tau_lo``). A pair reaching
+   conquer is decided by one exact test over its whole S-bound box (one per
+   pair and span: regions prune, prove and order, they never multiply LPs).
+   Before that, each pair is region-tested once on its own S-bound region in
+   its own co-moving frame (the first scheme of §6.3). Regions are measured in
+   a frame moving with a per-axis body velocity (App. B, "optimal fitting");
+   collision is Galilean invariant, so this only shifts velocities.
 4. **Exact null-set test** (§4.2), per remaining convex leaf pair, in
    :mod:`monitor.certify.extrusion_null`: slack LP for polytope pairs at zero
    margin (regularised semantics: touching is not a collision), exact
@@ -667,6 +674,8 @@ class _Search:
 
     def _classify(self, leaf: Leaf, rlo: np.ndarray, rhi: np.ndarray) -> tuple[str, None]:
         """Region test of §4.1 for an H-rep leaf (uncentred world coordinates)."""
+        if len(leaf.N) == 0:  # no half-spaces (sphere / capsule core): undecided
+            return "crossing", None
         G = leaf.G
         Glo, Ghi = G * rlo, G * rhi
         gmax = np.maximum(Glo, Ghi).sum(axis=1) - leaf.h
@@ -733,6 +742,7 @@ class _Search:
                     w_tau, w_x = wz
         res = NullResult("violation", -np.inf, -smax, w_tau, w_x)
         self._violation(p, s0, s1, c, first_tau, first_x, w_tau, w_x, res, "lp")
+        p.info["earliest_exact"] = bool(self.earliest)  # False: earliest_time is just a violating time
         p.info["proof"] = proof
         p.info["max_slack"] = float(smax)
 

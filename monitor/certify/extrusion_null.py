@@ -97,10 +97,10 @@ class NullResult:
     Attributes:
         verdict: ``"certified" | "violation" | "unresolved"`` (unresolved only on an
             LP solver failure in both HiGHS algorithms; never observed).
-        lower: certified lower bound of the decision quantity: for ``lp`` minus the
-            max slack... see ``quantity``; for ``quadratic``/``halfspace`` the min
-            core distance minus r (m).
-        upper: upper bound of the same quantity.
+        lower: certified lower bound (m) of the decision quantity, which is negative
+            exactly for a collision: ``-max slack`` for ``lp``; ``min core distance - r``
+            for ``quadratic`` / ``halfspace``.
+        upper: certified upper bound (m) of the same quantity.
         tau: time (s from span start) of the best point (max slack / min distance).
         point: (3,) centred world point at ``tau`` (inside both / between the cores).
         tests: number of LPs / NNLS solves.
