@@ -32,6 +32,7 @@ from monitor.geometry.polytope import (
     sphere_shape,
 )
 from monitor.geometry.shapes import ConvexShape
+from monitor.tolerances import DEFAULT
 
 LD = np.longdouble
 I3 = np.eye(3)
@@ -527,6 +528,27 @@ def test_incomplete_face_normals_never_overstate_depth():
         good = shape_distance(shape, (R, c), full, (I3, np.zeros(3)))
         check_bounds(good, truth)
         assert good.upper < -r
+
+
+def test_epa_certificate_rejects_a_tetrahedron_that_misses_the_origin():
+    """The EPA kernel verifies its own surface: a start that does not enclose the origin
+    (or is degenerate) yields no certificate; a valid one never exceeds the exact depth."""
+    from monitor.geometry import _gjk
+
+    box = box_polytope([0.5, 0.5, 0.5])
+    VA = np.ascontiguousarray(box.points + [0.9, 0.0, 0.0])  # overlap 0.1 along x
+    VB = np.ascontiguousarray(box.points)
+    lb = np.full(1, -np.inf)
+    dirs = np.array([[1, 1, 1], [-1, -1, 1], [-1, 1, -1], [1, -1, -1]], float)
+    W = np.array([VA[np.argmax(VA @ d)] - VB[np.argmin(VB @ d)] for d in dirs])
+    r = _gjk._epa_inradius(VA, VB, W, 1e-15, DEFAULT.rel_pad, 32, lb)
+    assert 0.1 - 1e-9 < r <= 0.1  # exact penetration depth from inside
+    assert -0.1 - 1e-12 <= lb[0] <= -0.1 + 1e-9
+    off = W + np.array([5.0, 0.0, 0.0])  # origin outside the tetrahedron
+    assert _gjk._epa_inradius(VA, VB, off, 1e-15, DEFAULT.rel_pad, 32, lb) == 0.0
+    flat = W.copy()
+    flat[:, 2] = 0.0  # degenerate start
+    assert _gjk._epa_inradius(VA, VB, flat, 1e-15, DEFAULT.rel_pad, 32, lb) == 0.0
 
 
 def test_tiny_scales():
