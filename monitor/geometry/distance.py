@@ -16,19 +16,25 @@ How the bounds are obtained (cores = point / segment / polytope; the solid is
 the core swept by the radius, so ``dist = core_dist - radius_a - radius_b``):
 
 * ``upper`` always comes from actual points: the closest points GJK found
-  (a convex combination of core vertices), or, when the cores overlap, a common
-  point ``x`` with certified depths: a ball ``B(x, d_A)`` inside core A and
-  ``B(x, d_B)`` inside core B prove a penetration depth ``>= d_A + d_B``
-  (Minkowski difference contains ``B(0, d_A + d_B)``). The depths come from a GJK
-  tetrahedron enclosing the origin, from the deepest point of a point / segment
-  core in a polytope, and for two polytopes (when still undecided, or with
-  ``tight_overlap=True``) from an LP (scipy HiGHS) maximising ``d_A + d_B``,
-  re-checked in float64 with padding against the H-representation.
+  (a convex combination of core vertices), or, when the cores overlap, a proof
+  that the Minkowski difference ``A - B`` contains a ball ``B(0, r)`` (then the
+  penetration depth is ``>= r``):
+  - the GJK tetrahedron around the origin (certified in-radius);
+  - EPA grown from it, whose triangle surface is verified after the fact
+    (closed and consistently oriented, every face plane certified at positive
+    distance from the origin, solid angles summing to 4 pi); this converges to
+    the penetration depth (see :func:`monitor.geometry._gjk._epa_inradius`);
+  - a common point ``x`` with ``B(x, d_A)`` in core A and ``B(x, d_B)`` in core
+    B (``r = d_A + d_B``): the deepest point of a point / segment core in a
+    polytope, and, for two polytopes when nothing else proved ``upper < 0`` (or
+    with ``tight_overlap=True``), an LP (scipy HiGHS) maximising ``d_A + d_B``,
+    re-checked in float64 with padding against the H-representation.
 * ``lower`` comes from a direction n: ``dist >= -h_{A-B}(n) / |n|`` for every n
   (support function of the Minkowski difference). Separated cores use the GJK
-  direction (tight to ~1e-12 relative); overlapping cores use the separating
-  axis candidates (face normals, edge x edge), which give the exact penetration
-  depth for polytope pairs.
+  direction (tight to ~1e-12 relative, with fall-backs for sliver simplices);
+  overlapping cores use EPA's face normals and, when those have not converged,
+  the separating-axis candidates (face normals, edge x edge), which give the
+  exact penetration depth for polytope pairs.
 
 Depth certificates measure depth with a polytope's face normals. Once per
 shape (cached), the normals are checked against the facets of the vertex hull
