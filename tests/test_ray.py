@@ -51,6 +51,14 @@ def test_rollouts_local_and_ray_identical():
     assert sum(c[1] for c in local.counts()) > 0  # there are violations to agree on
 
 
+def test_gym_env_id_on_ray_same_as_local():
+    kw = dict(episodes=2, steps=6, seeds=3, log_dir=None, progress=False)
+    local = rollouts("monitor/Tunnel-v0", RandomPolicy(hold=2), workers=1, **kw)
+    on_ray = rollouts("monitor/Tunnel-v0", RandomPolicy(hold=2), backend="ray", workers=2, **kw)
+    assert local.counts() == on_ray.counts()
+    assert [e.verdict_digest for e in local.episodes] == [e.verdict_digest for e in on_ray.episodes]
+
+
 def test_ray_rollouts_write_one_log_per_episode(ray_logs):
     d, s = ray_logs
     names = sorted(p.name for p in d.glob("*.mcap"))
