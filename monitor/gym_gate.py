@@ -39,8 +39,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         margin: clearance (m) that counts as safe.
         epsilon: certification tolerance (m).
         on_violation: ``"block" | "terminate" | "warn"`` (see :class:`monitor.Gate`).
-        fallback: None (hold position where actuators allow, else zeros), an
-            action array, or a callable ``fallback(env, obs) -> action``.
+        fallback: None (hold position where actuators allow, else zeros; the zero
+            action, clipped to the action space, when the action is not ``data.ctrl``),
+            an action array, or a callable ``fallback(env, obs) -> action``.
         budget: per-step work limit (seconds float, tests int, dict or Budget).
         log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`.
         unsafe: ``"uncertain"`` (default: anything not certified is unsafe) or ``"violation"``.
@@ -77,9 +78,18 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{type(u).__name__} has none")
         if not isinstance(env.action_space, gymnasium.spaces.Box):
             raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
+        action_is_ctrl = tuple(env.action_space.shape) == (model.nu,)
+        if predictor == "rollout" and not action_is_ctrl:
+            raise InvalidInputError(
+                f"predictor='rollout' writes the action to data.ctrl, but the action shape "
+                f"{env.action_space.shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
         self.predictor_mode = predictor
         self.user_fallback = fallback
         self.timing = bool(timing)
+        if fallback is None and not action_is_ctrl:
+            # the action is not data.ctrl: "hold position" is unknown, use the zero action
+            fallback = np.zeros(env.action_space.shape)
+            brake = False  # the braking tail needs the action to be the control
         gate_fallback = None if fallback is None or callable(fallback) else np.asarray(fallback, float)
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,

@@ -155,3 +155,53 @@ def test_gate_keeps_arm_off_the_post_ci():
 @pytest.mark.slow
 def test_gate_keeps_arm_off_the_post_500_steps():
     _gate_keeps_arm_off_the_post(500)
+
+
+# ----------------------------------------------------------------------------- AGV and trays
+agv_only = pytest.mark.skipif(not _agv_available(), reason="models/agv_trays or its schedules not available")
+
+
+def _run_agv(schedule, mode, steps, rate=1.0):
+    from monitor.gym_gate import SafetyGate
+
+    env = SafetyGate(gym.make("monitor/AGV-v0", schedule=schedule), predictor="plan", on_violation=mode)
+    env.reset(seed=0)
+    u = env.unwrapped
+    rows = []
+    for _ in range(steps):
+        obs, _, term, trunc, info = env.step(np.array([rate], dtype=np.float32))
+        s = info["safety"]
+        rows.append((s["verdict"], s["time"], s["earliest_time"], tuple(s["witness_geoms"]), s["replaced"],
+                     u.data.ncon, float(obs[2])))
+        if term or trunc:
+            break
+    env.close()
+    return rows
+
+
+@agv_only
+def test_agv_straight_schedule_violation_found_in_its_window():
+    from monitor.certify.extrusion_scenes import STRAIGHT_FIRST_CONTACT
+
+    rows = _run_agv("straight", "warn", 100)
+    first = next(i for i, r in enumerate(rows) if r[0] == "violation")
+    verdict, t0, earliest, geoms, *_ = rows[first]
+    assert t0 <= STRAIGHT_FIRST_CONTACT <= t0 + 0.1  # the window holding the analytic first contact
+    assert earliest <= STRAIGHT_FIRST_CONTACT + 1e-9
+    assert "plate1" in geoms or "load1" in geoms
+    assert all(r[0] == "certified" for r in rows[:first])
+    assert sum(r[5] for r in rows) > 0, "MuJoCo sees the collision too (independent check)"
+
+
+@agv_only
+def test_agv_straight_schedule_blocked_never_touches():
+    rows = _run_agv("straight", "block", 130)
+    assert sum(r[4] for r in rows) > 0, "the gate stopped the vehicle"
+    assert all(r[5] == 0 for r in rows), "MuJoCo reports no contact at any step state"
+
+
+@agv_only
+def test_agv_weaving_narrow_miss_is_certified():
+    rows = _run_agv("weaving", "block", 125)  # plate 1 passes over the vehicle for t in 8.2..11.8 s
+    assert all(r[0] == "certified" for r in rows)
+    assert not any(r[4] for r in rows)
