@@ -31,6 +31,8 @@ _LAZY = {
     "SafetyGate": "monitor.gym_gate",
     "MonitorLog": "monitor.log.writer",
     "rollouts": "monitor.rollouts",
+    "RolloutSummary": "monitor.rollouts",
+    "RandomPolicy": "monitor.rollouts",
     "Tolerances": "monitor.tolerances",
     "MonitorError": "monitor.errors",
     "InvalidInputError": "monitor.errors",

@@ -9,8 +9,6 @@ import monitor
 
 @pytest.mark.parametrize("name", [n for n in monitor.__all__ if n != "__version__"])
 def test_public_name_imports(name):
-    if name == "rollouts":
-        pytest.importorskip("monitor.rollouts")
     assert getattr(monitor, name) is not None
 
 
