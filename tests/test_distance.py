@@ -619,6 +619,15 @@ def test_invalid_inputs_raise():
         shape_distance(box, (np.eye(2), np.zeros(3)), box, (I3, np.zeros(3)))
     with pytest.raises(InvalidInputError, match="shape_b"):
         shape_distance(box, (I3, np.zeros(3)), "box", (I3, np.zeros(3)))
+    with pytest.raises(InvalidInputError, match="X_b"):
+        shape_distance(box, (I3, np.zeros(3)), box, (I3, np.array([1e155, 1e155, 0.0])))
+    with pytest.raises(InvalidInputError, match="X_a"):
+        shape_distance(box, (I3 * 1e3, np.zeros(3)), box, (I3, np.zeros(3)))
+    with pytest.raises(InvalidInputError, match="shape_a.points"):
+        shape_distance(ConvexShape("sphere", np.full((1, 3), 1e300), 1.0), (I3, np.zeros(3)),
+                       box, (I3, np.zeros(3)))
+    with pytest.raises(InvalidInputError, match="Xs_a"):
+        shape_distance_batch(box, (I3, np.array([[1e300, 0, 0]])), box, (I3, np.zeros(3)))
     bad = ConvexShape("cone", np.zeros((1, 3)))  # type: ignore[arg-type]
     with pytest.raises(InvalidInputError, match="kind"):
         shape_distance(bad, (I3, np.zeros(3)), box, (I3, np.zeros(3)))

@@ -77,6 +77,18 @@ Beyond it only face normals are used: still a valid, looser bound."""
 
 _KINDS = ("sphere", "capsule", "polytope", "halfspace")
 
+_MAX_COORD = 1e9
+"""Largest accepted |coordinate| (m) of a pose translation or a body-frame point.
+Beyond it the input is not physical (float64 spacing at 1e9 m is 1.2e-7 m) and
+the kernels' squares / triple products could overflow, so it is rejected with
+:class:`~monitor.errors.InvalidInputError` rather than answered with bounds that
+rounding has made meaningless."""
+
+_MAX_ROT = 2.0
+"""Largest accepted |entry| of a rotation matrix (a rotation has entries <= 1;
+this only rejects garbage, not slightly non-orthogonal matrices)."""
+
+
 
 @dataclass(frozen=True)
 class DistanceResult:
@@ -137,6 +149,8 @@ def _core(shape: ConvexShape, name: str) -> _Core:
         raise InvalidInputError(f"{name}.points: expected (n>=1, 3), got {np.shape(P)}")
     if not np.isfinite(P).all():
         raise InvalidInputError(f"{name}.points: not finite")
+    if np.abs(P).max() > _MAX_COORD:
+        raise InvalidInputError(f"{name}.points: a coordinate is beyond {_MAX_COORD:g} m")
     r = float(shape.radius)
     if not np.isfinite(r) or r < 0.0:
         raise InvalidInputError(f"{name}.radius must be finite and >= 0, got {shape.radius!r}")
@@ -219,6 +233,9 @@ def _check_pose(X, name: str) -> tuple[np.ndarray, np.ndarray]:
     # any NaN / inf entry makes the sum non-finite
     if not math.isfinite(R.sum() + p.sum()):
         raise InvalidInputError(f"{name}: pose is not finite")
+    if max(p.max(), -p.min()) > _MAX_COORD or max(R.max(), -R.min()) > _MAX_ROT:
+        raise InvalidInputError(f"{name}: translation beyond {_MAX_COORD:g} m or rotation entry beyond "
+                                f"{_MAX_ROT:g}: p={p.tolist()}, max |R_ij|={float(np.abs(R).max()):g}")
     return R, p
 
 
@@ -476,6 +493,9 @@ def _batch_poses(Xs, name):
         raise InvalidInputError(f"{name}: expected (R (T, 3, 3), p (T, 3)), got {R.shape}, {p.shape}")
     if not (np.isfinite(R).all() and np.isfinite(p).all()):
         raise InvalidInputError(f"{name}: poses are not finite")
+    if (p.size and np.abs(p).max() > _MAX_COORD) or (R.size and np.abs(R).max() > _MAX_ROT):
+        raise InvalidInputError(f"{name}: a translation is beyond {_MAX_COORD:g} m or a rotation entry "
+                                f"beyond {_MAX_ROT:g}")
     return R, p
 
 
