@@ -15,7 +15,10 @@ Bounds (D = A - B, the Minkowski difference of the cores, h_D its support functi
   vertices with ``lam >= 0`` gives the points ``sum lam_i a_i`` of A and
   ``sum lam_i b_i`` of B at distance ``|x| / sum lam``: an upper bound.
 * A tetrahedron of Minkowski-difference vertices containing the ball B(0, r)
-  proves a penetration depth >= r: the upper bound ``-r``.
+  proves a penetration depth >= r: the upper bound ``-r``. EPA grows such a
+  region to the penetration depth; its triangle surface is verified after the
+  fact (closed, oriented, winding number 1, certified face distances), so the
+  bound never depends on EPA's topology bookkeeping being right.
 
 All returned bounds are rounding padded with ``pad = 2 * rel_pad * S + abs_pad``
 (S = largest coordinate magnitude in the relative frame): the factor 2 covers
