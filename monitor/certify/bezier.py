@@ -159,7 +159,7 @@ class _BezierBalls(BallProvider):
 def check_bezier(curve: RationalBezier, moving: list[MovingFeatures], fixed: list[FixedFeatures],
                  pairs: list[tuple[int, int]] | None = None, *, margin: float = 0.0,
                  epsilon: float = 1e-3, tolerances: Tolerances = DEFAULT,
-                 budget: Budget | None = None) -> SubdivisionResult:
+                 budget: Budget | None = None, prefilter: bool = False) -> SubdivisionResult:
     """Toleranced check of moving feature sets (body frame) under ``curve`` vs fixed sets (world).
 
     The moving sets are tested as wholes (polygons, segments, points, or every face of a
@@ -176,6 +176,8 @@ def check_bezier(curve: RationalBezier, moving: list[MovingFeatures], fixed: lis
         epsilon: termination: R * rho_max < epsilon.
         tolerances: pads and max depth.
         budget: optional work limit.
+        prefilter: run the cheap separating-plane pre-test first (off by default so that
+            the polygon-vs-fat-polygon counts are comparable with the paper's).
 
     Returns:
         :class:`SubdivisionResult` per pair: intervals (parameter t), ``unit_tests``
@@ -187,7 +189,7 @@ def check_bezier(curve: RationalBezier, moving: list[MovingFeatures], fixed: lis
     pds = [_PairData(moving[i], fixed[j], r) for i, j in pairs]
     prov = _BezierBalls([pd.A.metric for pd in pds], curve.degree)
     H0 = np.repeat(np.asarray(curve.H, float)[None], len(pds), axis=0)
-    return subdivide(pds, prov, 0.0, 1.0, epsilon, tolerances, budget, extra0=H0)
+    return subdivide(pds, prov, 0.0, 1.0, epsilon, tolerances, budget, extra0=H0, prefilter=prefilter)
 
 
 # ---------------------------------------------------------------------------- SE(3) motions

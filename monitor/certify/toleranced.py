@@ -780,6 +780,71 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
     return uf
 
 
+def prefilter_separated(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
+                        tolerances: Tolerances = DEFAULT) -> bool:
+    """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests."""
+    tol = tolerances
+    eps = np.array([tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
+        pd.A.extent + pd.B.extent + float(np.linalg.norm(p)) + 1.0)])
+    ball = _Ball(np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)]),
+                 np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
+    return bool(_Prefilter([pd]).separated(np.zeros(1, np.int64), ball, tol)[0])
+
+
+class _Prefilter:
+    """Cheap sound pre-test: the orbit of A lies in conv{ball(g(v), F(v)) : v vertex of A}.
+
+    F = sqrt(q) is convex and g affine, so ball(g(x), F(x)) for x = sum l_i v_i lies in
+    sum l_i ball(g(v_i), F(v_i)). Its support in direction n is max_v n.g(v) + F(v); if
+    min_v n_j.g(v) - F(v) > off_j for an outward face normal n_j of B (B in its half-space
+    n_j.z <= off_j), the whole orbit misses B and the item is excluded without unit tests.
+    Polygons B are tested on both sides of their plane; points, segments and half-spaces
+    (VH is already this test) are skipped.
+    """
+
+    def __init__(self, pairs: list[_PairData]):
+        P = len(pairs)
+        nv = max(len(pd.A.verts) for pd in pairs)
+        nf = max([len(pd.B.f_n) for pd in pairs] + [1])
+        self.V = np.zeros((P, nv, 3))
+        self.qv = np.zeros((P, nv))
+        self.n = np.zeros((P, nf, 3))
+        self.off = np.zeros((P, nf))
+        self.on = np.zeros(P, bool)
+        self.two = np.zeros(P, bool)
+        for i, pd in enumerate(pairs):
+            k = len(pd.A.verts)
+            self.V[i, :k], self.V[i, k:] = pd.A.verts, pd.A.verts[0]
+            self.qv[i, :k], self.qv[i, k:] = pd.A.qv, pd.A.qv[0]
+            if pd.B.kind in ("polytope", "polygon") and len(pd.B.f_n):
+                m = len(pd.B.f_n)
+                off = np.einsum("ij,ij->i", pd.B.f_n, pd.B.f_o)
+                self.n[i, :m], self.n[i, m:] = pd.B.f_n, pd.B.f_n[0]
+                self.off[i, :m], self.off[i, m:] = off, off[0]
+                self.on[i] = True
+                self.two[i] = pd.B.kind == "polygon"
+
+    def separated(self, pair: np.ndarray, ball: _Ball, tol: Tolerances) -> np.ndarray:
+        """(N,) True where the item's whole orbit is outside one face plane of B."""
+        out = np.zeros(len(pair), bool)
+        idx = np.nonzero(self.on[pair])[0]
+        if not len(idx):
+            return out
+        pr = pair[idx]
+        Y = np.einsum("nij,nvj->nvi", ball.L[idx], self.V[pr]) + ball.p[idx][:, None, :]
+        F = np.sqrt(ball.R2[idx][:, None] * self.qv[pr] + ball.Delta[idx][:, None])
+        h = np.einsum("nfi,nvi->nfv", self.n[pr], Y) - self.off[pr][:, :, None]
+        e = 4.0 * ball.eps[idx]
+        mag = np.abs(h).max(axis=(1, 2)) + F.max(axis=1) + np.abs(self.off[pr]).max(axis=1)
+        pad = 8.0 * tol.rel_pad * mag + e
+        sep = ((h - F[:, None, :]).min(axis=2) > pad[:, None]).any(axis=1)
+        two = self.two[pr]
+        if two.any():
+            sep |= two & ((h + F[:, None, :]).max(axis=2) < -pad[:, None]).any(axis=1)
+        out[idx] = sep
+        return out
+
+
 # ============================================================================ driver
 
 
@@ -816,15 +881,23 @@ class SubdivisionResult:
     max_depth: np.ndarray
     items: np.ndarray        # per pair: ball tests (items evaluated)
     exhausted: bool
+    prefiltered: np.ndarray | None = None  # per pair: items excluded by the pre-filter
 
 
 def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: float, epsilon: float,
               tolerances: Tolerances = DEFAULT, budget: Budget | None = None,
-              active: np.ndarray | None = None, extra0: Any = None) -> SubdivisionResult:
-    """Breadth-first subdivision over all pairs (Listings 1-2, Remark 2 pruning)."""
+              active: np.ndarray | None = None, extra0: Any = None,
+              prefilter: bool = True) -> SubdivisionResult:
+    """Breadth-first subdivision over all pairs (Listings 1-2, Remark 2 pruning).
+
+    ``prefilter`` runs :class:`_Prefilter` on every item first (items it excludes count no
+    unit tests; their number is in ``SubdivisionResult.prefiltered``).
+    """
     tol = tolerances
     C = _Concat(pairs)
     T = _build_tables(pairs, C)
+    pre = _Prefilter(pairs) if prefilter and pairs else None
+    prefiltered = np.zeros(len(pairs), np.int64)
     npair = len(pairs)
     idx_pairs = np.arange(npair) if active is None else np.nonzero(active)[0]
     rho_max = np.array([pd.A.rho_max for pd in pairs]) * (1.0 + 1e-12)
@@ -854,9 +927,17 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         eps_pos = tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
             extent[fr.pair] + np.linalg.norm(p, axis=1) + 1.0)
         ball = _Ball(L, p, R, rho_max[fr.pair], r_pair[fr.pair], eps_pos, tol)
-        unit_fired, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item, fr.unit_id, ball, tol)
+        if pre is not None:
+            sep = pre.separated(fr.pair, ball, tol)
+            np.add.at(prefiltered, fr.pair[sep], 1)
+            live = np.nonzero(~sep[fr.unit_item])[0]
+        else:
+            live = np.arange(len(fr.unit_item))
+        unit_fired = np.zeros(len(fr.unit_item), bool)
+        uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
+        unit_fired[live] = uf_live
         np.add.at(row_tests, fr.pair[u_item], 1)
-        np.add.at(unit_tests, fr.pair[fr.unit_item], 1)
+        np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
         np.add.at(items_n, fr.pair, 1)
         if budget is not None:
             budget.charge(nrow)
@@ -884,7 +965,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     for lst in intervals:
         lst.sort()
     return SubdivisionResult([_merge(x) for x in intervals], unit_tests, row_tests, max_depth, items_n,
-                             exhausted)
+                             exhausted, prefiltered)
 
 
 def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -1035,6 +1116,7 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
                 clearance=float(margin) if not iv else float("-inf"),
                 info={"unit_tests": int(res.unit_tests[i]), "row_tests": int(res.row_tests[i]),
                       "items": int(res.items[i]), "swapped": bool(swapped[i]),
+                      "prefiltered": int(res.prefiltered[i]),
                       "budget_exhausted": bool(res.exhausted)})
     return outs  # type: ignore[return-value]
 
