@@ -190,3 +190,85 @@ def test_step_rejects_bad_ctrl():
         gate.step(d, np.zeros(2))
     with pytest.raises(InvalidInputError, match="NaN"):
         gate.step(d, np.array([np.nan, 0, 0]))
+
+
+# ----------------------------------------------------------------------------- with the real engine
+def _agv_env():
+    pytest.importorskip("monitor.certify.extrusion_scenes")
+    try:
+        scene_path("agv_trays")
+    except FileNotFoundError:
+        pytest.skip("models/agv_trays not available")
+    env = gym.make("monitor/AGV-v0", schedule="weaving").unwrapped
+    env.reset(seed=0)
+    return env
+
+
+def test_reuse_gives_the_same_pair_results_and_skips_fixed_pairs():
+    env = _agv_env()
+    with_reuse, without = Gate(env.model), Gate(env.model, reuse=False)
+    reused = []
+    for rate in (1.0, 0.0, 0.0, 0.0, 1.0, 0.0):  # the vehicle moves, waits, moves, waits
+        plan = env.planned_trajectory(np.array([rate]))
+        before = with_reuse.stats["reused_pairs"]
+        a, b = with_reuse.certify_plan(plan), without.certify_plan(plan)
+        reused.append(with_reuse.stats["reused_pairs"] - before)
+        assert a.verdict == b.verdict
+        assert [p.geoms for p in a.pairs] == [p.geoms for p in b.pairs]
+        assert [p.verdict for p in a.pairs] == [p.verdict for p in b.pairs]
+        env.step(np.array([rate], dtype=np.float32))
+    assert without.stats["reused_pairs"] == 0
+    # a waiting vehicle's pairs with the (static) floor are reused once their pose was certified
+    assert reused[0] == 0 and reused[1] == 0 and reused[2] > 0 and reused[3] > 0
+    assert reused[4] == 0  # moving again: nothing fixed
+    assert reused[5] == 0  # waiting at a NEW pose: first certification there
+
+
+def test_budget_never_certifies_unfinished_work():
+    from monitor.certify.common import Budget
+
+    m, d = _arm()
+    ctrl = np.array([np.arctan2(0.25, 0.45), 0.0, 0.0])  # from rest, the stretched arm swings at post_a
+    free = Gate(m)
+    plan = free.predict(d, ctrl, 60)  # 120 ms: a near miss (MuJoCo contact comes at ~128 ms)
+    cert = free.certify_plan(plan)
+    assert cert.stats["tests"] > 1
+    tight = Gate(m, budget=Budget(tests=1))
+    cert_b = tight.certify_plan(plan)
+    assert cert_b.verdict != "certified"
+    assert cert_b.verdict == "uncertain" or cert.verdict == "violation"
+    per_step = Gate(m, budget=1)  # int = tests per window
+    assert per_step.certify_plan(plan).verdict != "certified"
+
+
+def test_block_on_tunnel_reuses_the_committed_tail():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    gate = Gate(m)
+    xs = []
+    for _ in range(30):
+        r = gate.step(d, np.array([5.0]))
+        xs.append(float(d.qpos[0]))
+        assert r.fallback_certified
+    assert max(xs) < -0.015  # never touches the wall
+    s = gate.summary()
+    assert s["replaced"] > 0 and s["tail_reused"] > 0 and s["fallback_uncertified"] == 0
+
+
+def test_log_has_one_window_per_step(tmp_path):
+    reader = pytest.importorskip("monitor.log.reader")
+    from monitor.log import topics
+
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    path = tmp_path / "gate.mcap"
+    with Gate(m, log=path) as gate:
+        reports = [gate.step(d, np.array([5.0])) for _ in range(8)]
+    log = reader.read_log(path)
+    assert log.complete
+    certs = log.messages[topics.CERTIFICATE]
+    extra = sum(1 for r in reports if r.replaced and not r.fallback_certified)
+    assert len(certs) == len(reports) + extra
+    assert [c["verdict"] for c in certs[: len(reports)]] == [r.verdict for r in reports]
