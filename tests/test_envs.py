@@ -205,3 +205,15 @@ def test_agv_weaving_narrow_miss_is_certified():
     rows = _run_agv("weaving", "block", 125)  # plate 1 passes over the vehicle for t in 8.2..11.8 s
     assert all(r[0] == "certified" for r in rows)
     assert not any(r[4] for r in rows)
+
+
+@pytest.mark.parametrize("env_id", ALL_ENVS)
+def test_check_env_passes_when_gated(env_id):
+    from monitor.gym_gate import SafetyGate
+
+    predictor = "plan" if env_id == "monitor/AGV-v0" else "rollout"
+    env = SafetyGate(gym.make(env_id), predictor=predictor, margin=0.002)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check_env(env, skip_render_check=True)
+    env.close()

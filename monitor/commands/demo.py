@@ -26,7 +26,7 @@ _INTO_OBSTACLES = {
 
 def add_parser(p: argparse.ArgumentParser) -> None:
     """Options of the ``demo`` subcommand."""
-    p.add_argument("--steps", type=int, default=300, help="env steps to run (default 300)")
+    p.add_argument("--steps", type=int, default=150, help="env steps to run (default 150)")
     p.add_argument("--seed", type=int, default=0, help="seed of env and policy (default 0)")
     p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
     p.add_argument("--out", type=Path, default=None, help="log path (default logs/demo-<time>.mcap)")
@@ -119,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"  blocked actions {s['replaced']} (policy aiming at: {blocked_by}); "
           f"uncertified fallbacks {s['fallback_uncertified']}")
     print(f"  certification   {s['mean_certify_us']:.0f} us per step on average "
-          f"(proposal + fallback), {s['reused_pairs']} pair results reused")
+          f"(proposal, braking tail, fallback), {s['reused_pairs']} pair results reused")
     print(f"  MuJoCo contacts arm/obstacles: {contacts}")
     print(f"  log             {log_path if log_path else 'none'}")
     print(f"  wall time       {time.perf_counter() - t_start:.1f} s")
