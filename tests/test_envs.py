@@ -217,3 +217,22 @@ def test_check_env_passes_when_gated(env_id):
         warnings.simplefilter("ignore")
         check_env(env, skip_render_check=True)
     env.close()
+
+
+def test_plan_and_callable_predictors_on_the_arm():
+    from monitor.gym_gate import SafetyGate
+
+    calls = []
+
+    def predictor(env, obs, action):
+        calls.append(obs is not None)
+        return env.unwrapped.planned_trajectory(action)
+
+    for pred in ("plan", predictor):
+        env = SafetyGate(gym.make("monitor/Arm-v0"), predictor=pred, on_violation="warn")
+        env.reset(seed=5)
+        for _ in range(3):
+            env.step(np.array([0.2, -0.2, 0.4], dtype=np.float32))
+            assert np.array_equal(env.gate.last_report.plan.qpos[-1], env.unwrapped.data.qpos)
+        env.close()
+    assert calls == [True, True, True]
