@@ -78,6 +78,15 @@ fire conservatively. Inclusion tests (point in polygon, tau in interval) are wid
 by ``e`` (widening only adds candidates, each of which upper-bounds the true max).
 R is padded upwards, J^-1 is inflated (see metric.py), and Delta uses the padded r.
 
+Non-planar faces: face interiors are tested as the planar polygons (projections of the
+face loops onto the plane through the loop centroid), while vertices and edges are the
+true ones; a loop vertex may lie off that plane (hull facets merged within 1e-12 of the
+extent, rounding) by ``flat_err``. Every true boundary point is within flat_err of the
+projected face, and the unit argument holds for the projected polygons; the difference
+between true and projected vertices/edges moves g(x) by <= |L| flat_A and F by <=
+R sqrt(lambda_max(J^-1)) flat_A. Both go into the per-item length pad e (``_eps_items``),
+which enters every row as a distance uncertainty.
+
 Termination (eq. 11): an item that is not excluded ends as an interval of possible
 violation once R * rho_max < epsilon, or at ``tolerances.max_depth``, or when the
 budget runs out.
@@ -172,6 +181,7 @@ class MovingFeatures:
     rho_max: float
     extent: float                # max |coordinate| (m)
     solid: bool                  # polytope core (needs the start-pose test)
+    flat_err: float = 0.0        # max distance of a face vertex from its face plane (m)
 
 
 @dataclass(eq=False)
@@ -192,6 +202,7 @@ class FixedFeatures:
     h_off: float = 0.0
     extent: float = 0.0
     solid: bool = False
+    flat_err: float = 0.0
 
 
 def _loops_and_edges(shape_points: np.ndarray, edges: np.ndarray, loops: list[np.ndarray]):
@@ -268,17 +279,20 @@ def _moving_features(shape, polygon, metric) -> MovingFeatures:
     f_U = np.zeros((nf, 3, 2))
     f_hn = np.zeros((nf, kmax, 2))
     f_hc = np.ones((nf, kmax))
+    flat = 0.0
     for i, lp in enumerate(loops):
-        o, _n, U, w = _plane_frame(V[lp])
+        o, n_, U, w = _plane_frame(V[lp])
         f_o[i], f_U[i] = o, U
         f_hn[i], f_hc[i] = _halfplanes(w, kmax)
+        flat = max(flat, float(np.abs((V[lp] - o) @ n_).max()))
     f_k0, f_kg, f_K = face_coefficients(metric, f_o, f_U)
     v0 = V[edges[:, 0]]
     d = V[edges[:, 1]] - v0
     qv = metric.rho2(V)
     return MovingFeatures(metric, V, qv, v0, d, edge_coefficients(metric, v0, d),
                           ~(np.abs(d).max(axis=1) > 0), f_o, f_U, f_k0, f_kg, f_K, f_hn, f_hc,
-                          units, float(np.sqrt(qv.max())), float(np.abs(V).max()), solid)
+                          units, float(np.sqrt(qv.max())), float(np.abs(V).max()), solid,
+                          flat * (1.0 + 1e-6) + 4 * _U * float(np.abs(V).max()))
 
 
 def fixed_features(shape: ConvexShape | None = None, *, polygon: np.ndarray | None = None
@@ -324,17 +338,20 @@ def _fixed_features(shape, polygon) -> FixedFeatures:
     f_o, f_n = np.zeros((nf, 3)), np.zeros((nf, 3))
     f_U = np.zeros((nf, 3, 2))
     f_hn, f_hc = np.zeros((nf, kmax, 2)), np.ones((nf, kmax))
+    flat = 0.0
     for i, lp in enumerate(loops):
         o, n, U, w = _plane_frame(V[lp], None if normals is None else normals[i])
         f_o[i], f_n[i], f_U[i] = o, n, U
         f_hn[i], f_hc[i] = _halfplanes(w, kmax)
+        flat = max(flat, float(np.abs((V[lp] - o) @ n).max()))
     if nf:
         units = [(per_loop[i], i) for i in range(nf)]
     else:
         units = [(np.arange(len(edges)), -1)]
     w0 = V[edges[:, 0]]
     return FixedFeatures(kind, V, w0, V[edges[:, 1]] - w0, f_o, f_n, f_U, f_hn, f_hc, units,
-                         extent=float(np.abs(V).max()), solid=solid)
+                         extent=float(np.abs(V).max()), solid=solid,
+                         flat_err=flat * (1.0 + 1e-6) + 4 * _U * float(np.abs(V).max()))
 
 
 # ============================================================================ pair tables
@@ -756,6 +773,25 @@ def _evaluate(C: _Concat, T: _Tables, unit_item: np.ndarray, unit_id: np.ndarray
     return unit_fired, cnt, u_item, len(ukey)
 
 
+def _eps_items(A_ext: np.ndarray, B_ext: np.ndarray, flat_A: np.ndarray, flat_B: np.ndarray,
+               sqrt_jinv: np.ndarray, L: np.ndarray, p: np.ndarray, R: np.ndarray,
+               tol: Tolerances) -> np.ndarray:
+    """Per-item length pad (m): coordinate rounding plus the faces' non-planarity.
+
+    Rounding: abs_pad + (scale_pad + 8 rel_pad) (extent + |p| + 1). Non-planarity (module
+    doc): a true boundary point is within flat_A of the tested (projected) A feature and
+    flat_B of the B feature; mapped by g this moves points by <= |L|_F flat_A and changes F
+    by <= Lip(R rho) flat_A <= R sqrt(lambda_max(J^-1)) flat_A.
+    """
+    Lf = np.sqrt(np.einsum("nij,nij->n", L, L))
+    mag = A_ext + B_ext + np.linalg.norm(p, axis=1) + 1.0
+    return tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * mag + flat_A * (Lf + R * sqrt_jinv) + flat_B
+
+
+def _sqrt_jinv(m: Metric) -> float:
+    return float(np.sqrt(np.linalg.eigvalsh(m.Jinv).max()) * (1.0 + 1e-9))
+
+
 def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
                    tolerances: Tolerances = DEFAULT) -> np.ndarray:
     """One ball test of one pair: which units' fat A-feature meets B (for tests and tools).
@@ -771,10 +807,10 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
     C = _Concat([pd])
     T = _build_tables([pd], C)
     tol = tolerances
-    eps = np.array([tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
-        pd.A.extent + pd.B.extent + float(np.linalg.norm(p)) + 1.0)])
-    ball = _Ball(np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)]),
-                 np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
+    L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
+                     np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
+    ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
     uid = T.pair_units[0]
     uf, *_ = _evaluate(C, T, np.zeros(len(uid), np.int64), uid, ball, tol)
     return uf
@@ -784,10 +820,10 @@ def prefilter_separated(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
                         tolerances: Tolerances = DEFAULT) -> bool:
     """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests."""
     tol = tolerances
-    eps = np.array([tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
-        pd.A.extent + pd.B.extent + float(np.linalg.norm(p)) + 1.0)])
-    ball = _Ball(np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)]),
-                 np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
+    L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
+                     np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
+    ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
     return bool(_Prefilter([pd]).separated(np.zeros(1, np.int64), ball, tol)[0])
 
 
@@ -902,7 +938,11 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     idx_pairs = np.arange(npair) if active is None else np.nonzero(active)[0]
     rho_max = np.array([pd.A.rho_max for pd in pairs]) * (1.0 + 1e-12)
     r_pair = np.array([pd.r for pd in pairs], float)
-    extent = np.array([pd.A.extent + pd.B.extent for pd in pairs], float)
+    a_ext = np.array([pd.A.extent for pd in pairs], float)
+    b_ext = np.array([pd.B.extent for pd in pairs], float)
+    flat_a = np.array([pd.A.flat_err for pd in pairs], float)
+    flat_b = np.array([pd.B.flat_err for pd in pairs], float)
+    sqj = np.array([_sqrt_jinv(pd.A.metric) for pd in pairs], float)
     units_i = [T.pair_units[i] for i in idx_pairs]
     fr = _Frontier(idx_pairs.astype(np.int64), np.full(len(idx_pairs), t0), np.full(len(idx_pairs), t1),
                    np.zeros(len(idx_pairs), np.int64),
@@ -924,9 +964,9 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         np.maximum.at(max_depth, fr.pair, fr.depth)
         L, p, R = provider.balls(fr)
         R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
-        eps_pos = tol.abs_pad + (tol.scale_pad + 8 * tol.rel_pad) * (
-            extent[fr.pair] + np.linalg.norm(p, axis=1) + 1.0)
-        ball = _Ball(L, p, R, rho_max[fr.pair], r_pair[fr.pair], eps_pos, tol)
+        pr = fr.pair
+        eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
+        ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
         if pre is not None:
             sep = pre.separated(fr.pair, ball, tol)
             np.add.at(prefiltered, fr.pair[sep], 1)
