@@ -267,6 +267,23 @@ def _lp_overlap_slack(NA, bA, NB, bB):
     return -res.fun
 
 
+def _sat_penetration_depth(A: ConvexShape, Ra, B: ConvexShape, Rb, d) -> float:
+    """Penetration depth of two overlapping polytopes by the separating-axis theorem
+    (numpy, long double): min over face normals and edge x edge axes of the overlap."""
+    VA = np.asarray(A.points, LD) @ np.asarray(Ra, LD).T
+    VB = np.asarray(B.points, LD) @ np.asarray(Rb, LD).T + np.asarray(d, LD)
+    eA = A.points[A.edges[:, 1]] - A.points[A.edges[:, 0]]
+    eB = B.points[B.edges[:, 1]] - B.points[B.edges[:, 0]]
+    axes = [A.normals @ Ra.T, B.normals @ Rb.T,
+            np.cross((eA @ Ra.T)[:, None, :], (eB @ Rb.T)[None, :, :]).reshape(-1, 3)]
+    n = np.concatenate(axes)
+    n = n[np.linalg.norm(n, axis=1) > 1e-9]
+    n = np.asarray(n / np.linalg.norm(n, axis=1)[:, None], LD)
+    pa_, pb_ = VA @ n.T, VB @ n.T
+    over = np.minimum(pa_.max(axis=0) - pb_.min(axis=0), pb_.max(axis=0) - pa_.min(axis=0))
+    return float(over.min())
+
+
 def test_random_hulls_overlap_sign_vs_lp_and_distance_vs_qp():
     rng = np.random.default_rng(7)
     n_over = n_sep = 0
@@ -289,7 +306,10 @@ def test_random_hulls_overlap_sign_vs_lp_and_distance_vs_qp():
             assert res.upper < 0, (i, slack, res)
             if i % 2 == 0:
                 assert res.upper <= -slack + 1e-9  # the LP ball of radius slack is in both
-            # EPA certifies the penetration depth from both sides
+            # EPA certifies the penetration depth from both sides; the oracle is the
+            # separating-axis theorem over face normals and edge x edge directions
+            pd = _sat_penetration_depth(A, Ra, B, Rb, pb - pa)
+            assert res.lower <= -pd + 1e-12 and -pd - 1e-12 <= res.upper, (i, pd, res)
             assert res.upper - res.lower <= 1e-9 * abs(res.lower) + 1e-11, (i, res)
         elif slack < -1e-7:
             n_sep += 1
