@@ -332,7 +332,7 @@ def _fixed_features(shape, polygon) -> FixedFeatures:
         else:
             loops = [np.asarray(f, np.int64) for f in shape.faces]
             edges, per_loop = _loops_and_edges(V, shape.edges, loops)
-            normals = np.asarray(shape.normals, float) if len(shape.normals) == len(loops) else None
+            normals = None  # Newell normals of the loops (independent of the H-rep row order)
     nf = len(loops)
     kmax = max([len(lp) for lp in loops], default=1)
     f_o, f_n = np.zeros((nf, 3)), np.zeros((nf, 3))
