@@ -474,3 +474,20 @@ def test_check_pairs_nary_mode_equals_pairwise():
             assert x.info["earliest_time"] == pytest.approx(y.info["earliest_time"], abs=1e-9)
         else:
             assert x.clearance == pytest.approx(y.clearance, abs=1e-9)
+
+
+def test_sub_window_and_earliest_off():
+    # motion defined on [0, 4] with breakpoints outside the window [1, 3]
+    times = np.array([0.0, 0.5, 2.0, 3.5, 4.0])
+    oa = np.array([[-6.0, 0, 0], [-5.0, 0, 0], [-2.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0]])
+    p = TranslatingPair(BOX, I3, times, oa, BOX, I3, np.array([0.0, 4.0]), np.zeros((2, 3)))
+    # x_A(t) = -5 + 2 (t - 0.5) on [0.5, 3.5]: faces meet when x_A = -1, t = 2.5
+    out = check_pairs([p], (1.0, 3.0))[0]
+    assert out.verdict == "violation"
+    assert out.info["earliest_time"] == pytest.approx(2.5, abs=1e-9)
+    assert out.info["span"] == [2.0, 3.0]
+    assert check_pairs([p], (1.0, 2.4))[0].verdict == "certified"
+    fast = check_pairs([p], (1.0, 3.0), earliest=False)[0]
+    assert fast.verdict == "violation" and fast.info["earliest_exact"] is False
+    assert 2.5 <= fast.witness_time <= 3.0
+    assert fast.tests < out.tests
