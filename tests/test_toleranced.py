@@ -251,3 +251,12 @@ def test_check_pairs_start_containment_and_clear_motion():
     # without the start test the boundary tests alone would (wrongly) clear the contained ball
     out2 = check_pairs(bm, [(ball, 1, box, 0)], (0.0, 1.0), 0.0, 1e-3, check_start=False)
     assert out2[0].verdict == "certified"
+
+
+def test_overflow_or_nan_never_excludes():
+    a = box_polytope(np.array([0.5, 0.5, 0.5]))
+    pd = prepare_pair(a, a, 0.0)
+    for R in (np.inf, np.nan, 1e300):
+        assert fat_units_fire(pd, np.eye(3), np.array([3.0, 0, 0]), R).all()
+    assert fat_units_fire(pd, np.eye(3), np.array([np.nan, 0, 0]), 1e-3).all()
+    assert not prefilter_separated(pd, np.eye(3), np.array([3.0, 0, 0]), np.nan)

@@ -547,7 +547,7 @@ def _qmax01(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
 
 def _inside2(hn: np.ndarray, hc: np.ndarray, w: np.ndarray, pad: np.ndarray) -> np.ndarray:
     """Point (n, 2) in padded convex polygon (n, k, 2) / (n, k)."""
-    return (np.einsum("nkj,nj->nk", hn, w) <= hc + pad[:, None]).all(axis=1)
+    return ~(np.einsum("nkj,nj->nk", hn, w) > hc + pad[:, None]).any(axis=1)   # NaN -> inside
 
 
 def _apply(L: np.ndarray, p: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -578,7 +578,7 @@ def _kernel_VF(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
     e = ball.eps[it]
     q = ball.R2[it] * C.aqv[a] + ball.Delta[it]
     inside = _inside2(C.bf_hn[b], C.bf_hc[b], w, 4 * e)
-    return inside & (q - h * h >= -_pad2(q + h * h, e, tol.rel_pad))
+    return inside & ~(q - h * h < -_pad2(q + h * h, e, tol.rel_pad))   # NaN -> fire
 
 
 def _kernel_VH(C: _Concat, it, a, pair, ball: _Ball, tol) -> np.ndarray:
@@ -586,7 +586,7 @@ def _kernel_VH(C: _Concat, it, a, pair, ball: _Ball, tol) -> np.ndarray:
     h = _dot(y, C.h_n[pair]) - C.h_off[pair]
     e = ball.eps[it] + tol.pad(0.0) + tol.rel_pad * np.abs(C.h_off[pair])
     q = ball.R2[it] * C.aqv[a] + ball.Delta[it]
-    return (h <= 4 * e) | (q - h * h >= -_pad2(q + h * h, e, tol.rel_pad))
+    return ~((h > 4 * e) & (q - h * h < -_pad2(q + h * h, e, tol.rel_pad)))   # NaN -> fire
 
 
 def _kernel_EE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
@@ -614,7 +614,7 @@ def _kernel_EE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
         _qmax01(a_ss, b_s, c),                       # tau = 0
         _qmax01(a_ss, b_s + a_st, c + a_tt + b_t),   # tau = 1
     ])
-    fire = best >= -pad
+    fire = ~(best < -pad)   # NaN (overflow) -> fire
     det = 4.0 * a_ss * a_tt - a_st * a_st
     band = 1e3 * _U * (4.0 * np.abs(a_ss * a_tt) + a_st * a_st)
     deg = (DD == 0) | (EE == 0)
@@ -645,7 +645,7 @@ def _kernel_FE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
     a11, a12, a22 = Am[:, 0, 0], Am[:, 0, 1], Am[:, 1, 1]
     det = a11 * a22 - a12 * a12
     band = 1e3 * _U * (np.abs(a11 * a22) + a12 * a12)
-    amb = np.abs(det) <= band
+    amb = ~(np.abs(det) > band)   # NaN -> ambiguous -> fire
     pd = (a11 > 0) & (det > band)
     fire = amb.copy()
     if not pd.any():
@@ -695,7 +695,7 @@ def _kernel_FE(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
         tv = -v1 / (2.0 * v2)
     inv = (v2 < 0) & (tv >= lo_c) & (tv <= hi_c)
     best = np.where(inv, np.maximum(best, V(np.where(inv, tv, 0.0))), best)
-    fire[idx] |= ok & (best >= -pad)
+    fire[idx] |= (ok & ~(best < -pad)) | ~np.isfinite(best)
     return fire
 
 
@@ -733,19 +733,9 @@ def _kernel_EF(C: _Concat, it, a, b, ball: _Ball, tol) -> np.ndarray:
     return ~empty & ~empty2
 
 
-def _evaluate(C: _Concat, T: _Tables, unit_item: np.ndarray, unit_id: np.ndarray, ball: _Ball,
-              tol: Tolerances) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Evaluate the rows of the active units (deduplicated per item); returns per-unit fired."""
-    ptr = T.unit_ptr
-    cnt = ptr[unit_id + 1] - ptr[unit_id]
-    rep_item = np.repeat(unit_item, cnt)
-    seg_start = np.repeat(ptr[unit_id] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
-    row_g = T.unit_rows[np.arange(cnt.sum()) + seg_start]
-    key = rep_item * np.int64(T.n_rows) + row_g
-    ukey, inv = np.unique(key, return_inverse=True)
-    u_item = ukey // T.n_rows
-    u_row = ukey % T.n_rows
-    fired = np.zeros(len(ukey), bool)
+def _run_kernels(C: _Concat, T: _Tables, u_item: np.ndarray, u_row: np.ndarray, fired: np.ndarray,
+                 ball: _Ball, tol: Tolerances) -> None:
+    """Evaluate every unique (item, row) by its row type's kernel, writing into ``fired``."""
     for t in _TYPES:
         lo, hi = T.row_start[t], T.row_start[t] + len(T.rows[t]["pair"])
         sel = np.nonzero((u_row >= lo) & (u_row < hi))[0]
@@ -764,6 +754,23 @@ def _evaluate(C: _Concat, T: _Tables, unit_item: np.ndarray, unit_id: np.ndarray
             fired[sel] = _kernel_EF(C, it, cols["a"][r], cols["b"][r], ball, tol)
         else:
             fired[sel] = _kernel_VH(C, it, cols["a"][r], cols["pair"][r], ball, tol)
+
+
+def _evaluate(C: _Concat, T: _Tables, unit_item: np.ndarray, unit_id: np.ndarray, ball: _Ball,
+              tol: Tolerances) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Evaluate the rows of the active units (deduplicated per item); returns per-unit fired."""
+    ptr = T.unit_ptr
+    cnt = ptr[unit_id + 1] - ptr[unit_id]
+    rep_item = np.repeat(unit_item, cnt)
+    seg_start = np.repeat(ptr[unit_id] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
+    row_g = T.unit_rows[np.arange(cnt.sum()) + seg_start]
+    key = rep_item * np.int64(T.n_rows) + row_g
+    ukey, inv = np.unique(key, return_inverse=True)
+    u_item = ukey // T.n_rows
+    u_row = ukey % T.n_rows
+    fired = np.zeros(len(ukey), bool)
+    with np.errstate(over="ignore", invalid="ignore"):   # non-finite values fire (NaN-safe tests)
+        _run_kernels(C, T, u_item, u_row, fired, ball, tol)
     fired_rows = fired[inv]
     seg = np.concatenate([[0], np.cumsum(cnt)[:-1]]).astype(np.int64)
     unit_fired = np.zeros(len(cnt), bool)
