@@ -50,11 +50,12 @@ class Tolerances:
     reported per geom in ``Scene``."""
 
     extrusion_slack: float = 1e-9
-    """Minimum interior slack (metres) that the extrusion LP must find to call a
-    space-time overlap a collision; below it the contact is boundary-only
-    (regularised semantics, touching is not a collision) but is reported as
-    "near" in stats. Set well above LP solver tolerance (HiGHS ~1e-9 relative
-    to the scaled problem), and the decision is re-checked exactly at the witness."""
+    """Interior slack (metres) separating "touching" from "overlapping" in the
+    extrusion checker (regularised semantics: touching is not a collision). A
+    violation needs a float64-verified point strictly inside both shapes; a
+    certificate needs a dual bound of at most this slack. Set well above the LP
+    solver tolerance (HiGHS ~1e-9 relative to the scaled problem); the verdict is
+    exact outside the band between the rounding pad and this slack."""
 
     witness_candidates: int = 9
     """Candidate times per unresolved interval at which exact static tests look

@@ -19,3 +19,16 @@ def load_asset():
         return mujoco.MjModel.from_xml_path(str(ASSETS / name))
 
     return _load
+
+
+def pytest_collection_modifyitems(config, items):
+    """Skip ``@pytest.mark.slow`` tests unless a ``-m`` expression selects markers explicitly.
+
+    ``pytest tests`` then stays CI-sized; ``pytest -m slow`` runs the sweeps.
+    """
+    if config.getoption("-m"):
+        return
+    skip = pytest.mark.skip(reason="slow sweep: run with -m slow (or python -m monitor bench)")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
