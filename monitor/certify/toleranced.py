@@ -87,6 +87,11 @@ between true and projected vertices/edges moves g(x) by <= |L| flat_A and F by <
 R sqrt(lambda_max(J^-1)) flat_A. Both go into the per-item length pad e (``_eps_items``),
 which enters every row as a distance uncertainty.
 
+Pre-filter (``_Prefilter``, design.md): F is convex and g affine, so the orbit of A lies
+in conv{ball(g(v), F(v))}; if it lies strictly outside one face plane of B the item is
+excluded without unit tests. Non-finite values (overflow, NaN poses) never exclude:
+every comparison is written so that NaN fires.
+
 Termination (eq. 11): an item that is not excluded ends as an interval of possible
 violation once R * rho_max < epsilon, or at ``tolerances.max_depth``, or when the
 budget runs out.
@@ -137,7 +142,6 @@ def _plane_frame(pts: np.ndarray, normal: np.ndarray | None = None):
 
 def _halfplanes(w: np.ndarray, kmax: int) -> tuple[np.ndarray, np.ndarray]:
     """Outward half-planes hn . w <= hc of a convex 2D loop (any orientation), padded to kmax."""
-    k = len(w)
     area = 0.5 * np.sum(w[:, 0] * np.roll(w[:, 1], -1) - np.roll(w[:, 0], -1) * w[:, 1])
     if area < 0:
         w = w[::-1]
@@ -151,7 +155,6 @@ def _halfplanes(w: np.ndarray, kmax: int) -> tuple[np.ndarray, np.ndarray]:
     outc = np.ones(kmax)
     outn[: len(hn)] = hn
     outc[: len(hc)] = hc
-    del k
     return outn, outc
 
 
