@@ -567,9 +567,11 @@ class _Ball:
     def __init__(self, L, p, R, rho_max, r, eps_pos, tol: Tolerances):
         self.L, self.p = L, p
         R = np.asarray(R, float)
-        self.R2 = R * R
+        with np.errstate(over="ignore", invalid="ignore"):   # inf/NaN balls fire every row
+            self.R2 = R * R
         ru = r + tol.pad(r) if np.ndim(r) == 0 else r + tol.rel_pad * np.abs(r) + tol.abs_pad
-        self.Delta = ru * ru + 2.0 * ru * R * rho_max
+        with np.errstate(over="ignore", invalid="ignore"):
+            self.Delta = ru * ru + 2.0 * ru * R * rho_max
         self.eps = eps_pos
 
 
