@@ -13,13 +13,14 @@ point over the barycentre; two keep the barycentre in the plane).
 
 The paper reports 173 polygon-vs-fat-polygon tests at max depth 8 (clear) and 9 tests
 at depth 8 (colliding; its Listing 1 returns at the first interval, depth first, while
-we subdivide breadth first and report all intervals, so our colliding count is larger).
+we subdivide breadth first and report all intervals, so our colliding count is larger;
+``first_interval_bezier`` replays Listing 1's order for the comparison).
 """
 
 import numpy as np
 from scipy.optimize import linprog
 
-from monitor.certify.bezier import check_bezier, octagon, paper71_motion
+from monitor.certify.bezier import check_bezier, first_interval_bezier, octagon, paper71_motion
 from monitor.certify.toleranced import fixed_features, moving_features
 
 EPS = 0.02
@@ -86,3 +87,18 @@ def test_colliding_variant_is_not_certified_and_interval_contains_a_collision():
     for t, Li, pi in zip(ts, L, p):
         if _intersect(P @ Li.T + pi, F):
             assert any(a <= t <= b for a, b in res.intervals[0]), t
+
+
+def test_depth_first_order_like_listing_1():
+    """Listing 1 order (depth first, return at the first interval): comparable to the paper's counts."""
+    P, F = octagon(1.0), octagon(1.0)
+    mf, ff = moving_features(polygon=P), fixed_features(polygon=F)
+    iv, tests, depth = first_interval_bezier(paper71_motion(CLEAR_SHIFT), mf, ff, epsilon=EPS)
+    _, _, _, res = _run(CLEAR_SHIFT)
+    assert iv is None and tests == int(res.unit_tests[0])   # a certified run visits the same nodes
+    iv, tests, depth = first_interval_bezier(paper71_motion(COLLIDE_SHIFT), mf, ff, epsilon=EPS)
+    print(f"\n[7.1 colliding, depth first] tests until the first interval: {tests} (paper 9), depth {depth}, "
+          f"interval {iv}")
+    _, _, _, res = _run(COLLIDE_SHIFT)
+    assert iv is not None and any(a <= iv[0] and iv[1] <= b for a, b in res.intervals[0])
+    assert tests <= int(res.unit_tests[0])

@@ -192,6 +192,22 @@ def check_bezier(curve: RationalBezier, moving: list[MovingFeatures], fixed: lis
     return subdivide(pds, prov, 0.0, 1.0, epsilon, tolerances, budget, extra0=H0, prefilter=prefilter)
 
 
+def first_interval_bezier(curve: RationalBezier, moving: MovingFeatures, fixed: FixedFeatures, *,
+                          margin: float = 0.0, epsilon: float = 1e-3,
+                          tolerances: Tolerances = DEFAULT) -> tuple[tuple[float, float] | None, int, int]:
+    """Depth-first, stop-at-first-interval run (the paper's Listing 1 order), for count comparisons.
+
+    Returns:
+        (first interval of possible collision or None, polygon-vs-fat-polygon tests, max depth).
+    """
+    from monitor.certify.toleranced import first_interval_dfs
+
+    r = float(margin) + tolerances.pad(float(margin))
+    pd = _PairData(moving, fixed, r)
+    prov = _BezierBalls([moving.metric], curve.degree)
+    return first_interval_dfs(pd, prov, 0.0, 1.0, epsilon, tolerances, np.asarray(curve.H, float)[None])
+
+
 # ---------------------------------------------------------------------------- SE(3) motions
 
 
@@ -314,5 +330,5 @@ def paper72_case(n: int, kind: str, mass: str = "global") -> dict:
             "epsilon": 0.01 * np.sqrt(2.0)}
 
 
-__all__ = ["RationalBezier", "de_casteljau_half", "check_bezier", "quaternion_motion",
-           "paper71_motion", "octagon", "paper72_case"]
+__all__ = ["RationalBezier", "de_casteljau_half", "check_bezier", "first_interval_bezier",
+           "quaternion_motion", "paper71_motion", "octagon", "paper72_case"]

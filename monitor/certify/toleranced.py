@@ -1020,6 +1020,51 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
                              exhausted, prefiltered)
 
 
+def first_interval_dfs(pd: _PairData, provider: BallProvider, t0: float, t1: float, epsilon: float,
+                       tolerances: Tolerances = DEFAULT, extra0: Any = None
+                       ) -> tuple[tuple[float, float] | None, int, int]:
+    """Depth-first variant of Listing 1 that returns at the FIRST interval of possible collision.
+
+    Only for comparing counts with the paper (its Listing 1 returns after the first
+    branch); the checkers use :func:`subdivide`. Same tests, pruning and termination.
+
+    Returns:
+        (interval or None if the motion is certified, unit tests performed, max depth).
+    """
+    tol = tolerances
+    C = _Concat([pd])
+    T = _build_tables([pd], C)
+    uid0 = T.pair_units[0]
+    sqj = np.array([_sqrt_jinv(pd.A.metric)])
+    z = np.zeros(1, np.int64)
+    stack = [_Frontier(z.copy(), np.array([t0]), np.array([t1]), z.copy(), np.zeros(len(uid0), np.int64),
+                       uid0, extra0)]
+    tests, depth = 0, 0
+    while stack:
+        fr = stack.pop()
+        depth = max(depth, int(fr.depth[0]))
+        L, p, R = provider.balls(fr)
+        R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
+        eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
+                         np.array([pd.B.flat_err]), sqj, L, p, R, tol)
+        ball = _Ball(L, p, R, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
+        uf, *_ = _evaluate(C, T, fr.unit_item, fr.unit_id, ball, tol)
+        tests += len(fr.unit_id)
+        if not uf.any():
+            continue
+        if not (R[0] * pd.A.rho_max < epsilon) and fr.depth[0] < tol.max_depth:
+            extra = provider.split(fr, np.array([0]))
+            mid = 0.5 * (fr.t0[0] + fr.t1[0])
+            ids = fr.unit_id[uf]
+            zi = np.zeros(len(ids), np.int64)
+            for k, (a, b) in ((1, (mid, fr.t1[0])), (0, (fr.t0[0], mid))):   # left child on top
+                ex = None if extra is None else extra[k:k + 1]
+                stack.append(_Frontier(z.copy(), np.array([a]), np.array([b]), fr.depth + 1, zi, ids, ex))
+            continue
+        return (float(fr.t0[0]), float(fr.t1[0])), tests, depth
+    return None, tests, depth
+
+
 def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
     out: list[tuple[float, float]] = []
     for a, b in sorted(iv):
@@ -1174,4 +1219,5 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
 
 
 __all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
-           "subdivide", "check_pairs", "BallProvider", "SubdivisionResult"]
+           "subdivide", "check_pairs", "BallProvider", "SubdivisionResult", "first_interval_dfs",
+           "fat_units_fire", "prefilter_separated"]
