@@ -330,5 +330,30 @@ def paper72_case(n: int, kind: str, mass: str = "global") -> dict:
             "epsilon": 0.01 * np.sqrt(2.0)}
 
 
+def run_paper72(n: int, kind: str, mass: str = "global", *, epsilon: float | None = None,
+                budget: Budget | None = None) -> dict:
+    """Run one section 7.2 configuration (for the benchmark table).
+
+    Returns:
+        dict with ``seconds`` (wall, excluding the setup), ``unit_tests`` (square vs fat
+        square), ``row_tests``, ``max_depth``, ``pairs`` (n^4), ``pairs_not_excluded`` and
+        ``setup_seconds``.
+    """
+    import time
+
+    t = time.perf_counter()
+    case = paper72_case(n, kind, mass)
+    t_setup = time.perf_counter() - t
+    eps = case["epsilon"] if epsilon is None else epsilon
+    t = time.perf_counter()
+    res = check_bezier(case["curve"], case["moving"], case["fixed"], case["pairs"], epsilon=eps,
+                       budget=budget)
+    secs = time.perf_counter() - t
+    return {"n": n, "kind": kind, "mass": mass, "seconds": secs, "setup_seconds": t_setup,
+            "unit_tests": int(res.unit_tests.sum()), "row_tests": int(res.row_tests.sum()),
+            "max_depth": int(res.max_depth.max()), "pairs": len(case["pairs"]),
+            "pairs_not_excluded": int(sum(1 for iv in res.intervals if iv))}
+
+
 __all__ = ["RationalBezier", "de_casteljau_half", "check_bezier", "first_interval_bezier",
-           "quaternion_motion", "paper71_motion", "octagon", "paper72_case"]
+           "quaternion_motion", "paper71_motion", "octagon", "paper72_case", "run_paper72"]
