@@ -102,3 +102,22 @@ def test_depth_first_order_like_listing_1():
     _, _, _, res = _run(COLLIDE_SHIFT)
     assert iv is not None and any(a <= iv[0] and iv[1] <= b for a, b in res.intervals[0])
     assert tests <= int(res.unit_tests[0])
+
+
+def test_paper72_small_n_never_certifies_a_colliding_square_pair():
+    """Section 7.2 setting at n = 2 (16 square pairs, global and per-square masses)."""
+    from monitor.certify.bezier import paper72_case
+
+    for mass in ("global", "per-square"):
+        case = paper72_case(2, "collision", mass)
+        res = check_bezier(case["curve"], case["moving"], case["fixed"], case["pairs"],
+                           epsilon=case["epsilon"])
+        ts = np.linspace(0, 1, 101)
+        L, p = case["curve"].evaluate(ts)
+        hits = 0
+        for k, (i, j) in enumerate(case["pairs"]):
+            A, B = case["moving"][i].verts, case["fixed"][j].verts
+            if any(_intersect(A @ L[t].T + p[t], B) for t in range(0, 101, 2)):
+                hits += 1
+                assert res.intervals[k], (mass, i, j)
+        assert hits >= 1

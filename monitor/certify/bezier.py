@@ -115,45 +115,72 @@ def de_casteljau_half(H: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 class _BezierBalls(BallProvider):
-    """Balls of sub-curves: centre c(1/2), radius = max metric distance to control points."""
+    """Balls of sub-curves: centre c(1/2), radius = max metric distance to control points.
+
+    All items derive from ONE curve, so items with the same (t0, t1) have identical control
+    points: de Casteljau and the radius are computed once per node (and per distinct
+    metric), which makes a global mass distribution as cheap as per-square ones.
+    """
 
     def __init__(self, metrics: list[Metric], degree: int):
-        self.mp_off = np.cumsum([0] + [len(m.points) for m in metrics])
-        self.mp_all = np.concatenate([m.points for m in metrics])
-        self.mw_all = np.concatenate([m.weights for m in metrics])
-        self.mass = np.array([m.mass for m in metrics])
-        self.mext = np.array([np.abs(m.points).max() for m in metrics])
+        uniq: dict[int, int] = {}
+        ms: list[Metric] = []
+        for m in metrics:
+            if id(m) not in uniq:
+                uniq[id(m)] = len(ms)
+                ms.append(m)
+        self.midx = np.array([uniq[id(m)] for m in metrics], np.int64)   # per pair
+        self.nm = len(ms)
+        self.mp_off = np.cumsum([0] + [len(m.points) for m in ms])
+        self.mp_all = np.concatenate([m.points for m in ms])
+        self.mw_all = np.concatenate([m.weights for m in ms])
+        self.mass = np.array([m.mass for m in ms])
+        self.mext = np.array([np.abs(m.points).max() for m in ms])
         self.n = degree
         self._halves = None
+        self._node_inv = None
 
     def balls(self, fr: _Frontier):
-        H = fr.extra                                   # (N, n+1, 13)
+        keys = np.stack([fr.t0, fr.t1], axis=1)
+        _, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        inv = inv.reshape(-1)
+        H = fr.extra[first]                            # (U, n+1, 13) one per node
         left, right, mid = de_casteljau_half(H)
         self._halves = (left, right)
+        self._node_inv = inv
         g = mid[:, 1:] / mid[:, :1]
-        P = H[:, :, 1:] / H[:, :, :1]                  # (N, n+1, 12)
+        P = H[:, :, 1:] / H[:, :, :1]                  # (U, n+1, 12)
         D = P - g[:, None, :]
         DL = D[:, :, :9].reshape(len(H), -1, 3, 3)
         Dp = D[:, :, 9:]
-        cnt = self.mp_off[fr.pair + 1] - self.mp_off[fr.pair]
-        item = np.repeat(np.arange(len(H)), cnt)
-        start = np.repeat(self.mp_off[fr.pair] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
+        # radius per (node, metric) combination present in the frontier
+        combo = inv * self.nm + self.midx[fr.pair]
+        ucombo, cinv = np.unique(combo, return_inverse=True)
+        node, met = ucombo // self.nm, ucombo % self.nm
+        cnt = self.mp_off[met + 1] - self.mp_off[met]
+        row = np.repeat(np.arange(len(ucombo)), cnt)
+        start = np.repeat(self.mp_off[met] - np.cumsum(np.concatenate([[0], cnt[:-1]])), cnt)
         j = np.arange(cnt.sum()) + start
         m, w = self.mp_all[j], self.mw_all[j]
-        img = np.einsum("nkab,nb->nka", DL[item], m) + Dp[item]   # (rows, n+1, 3)
+        img = np.einsum("nkab,nb->nka", DL[node[row]], m) + Dp[node[row]]   # (rows, n+1, 3)
         sq = w[:, None] * np.einsum("nka,nka->nk", img, img)
-        R2 = np.zeros((len(H), self.n + 1))
-        np.add.at(R2, item, sq)
-        R = np.sqrt(R2.max(axis=1))
+        R2 = np.zeros((len(ucombo), self.n + 1))
+        np.add.at(R2, row, sq)
+        Rc = np.sqrt(R2.max(axis=1))
         # de Casteljau rounding (module doc)
         scale = np.abs(H).max(axis=(1, 2)) / H[:, :, 0].min(axis=1)
-        err = 16.0 * (fr.depth + 1) * (self.n + 1) * _U * scale
-        R = R + np.sqrt(self.mass[fr.pair]) * (1.0 + self.mext[fr.pair]) * np.sqrt(12.0) * err
-        return g[:, :9].reshape(-1, 3, 3), g[:, 9:], R
+        depth = np.zeros(len(H))
+        np.maximum.at(depth, inv, fr.depth)
+        err = 16.0 * (depth + 1) * (self.n + 1) * _U * scale
+        Rc = Rc + np.sqrt(self.mass[met]) * (1.0 + self.mext[met]) * np.sqrt(12.0) * err[node]
+        R = Rc[cinv.reshape(-1)]
+        return g[inv, :9].reshape(-1, 3, 3), g[inv, 9:], R
 
     def split(self, fr: _Frontier, keep: np.ndarray):
+        """Children's control points (left halves then right halves) of items ``keep``."""
         left, right = self._halves
-        return np.concatenate([left[keep], right[keep]])
+        k = self._node_inv[keep]
+        return np.concatenate([left[k], right[k]])
 
 
 def check_bezier(curve: RationalBezier, moving: list[MovingFeatures], fixed: list[FixedFeatures],
