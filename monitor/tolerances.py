@@ -18,6 +18,12 @@ class Tolerances:
     enlarged by ``pad(x) = rel_pad * |x| + abs_pad`` (plus the scene scale term),
     so that float64 rounding in the tests can only push a verdict towards
     "not certified", never towards "certified".
+
+    Where each pad is applied: ``monitor/certify/toleranced.py`` and
+    ``monitor/certify/bezier.py`` module docstrings (elementary-test thresholds,
+    ball radii, de Casteljau error), ``monitor/motion/plan.py`` (motion bounds),
+    ``monitor/geometry/distance.py`` (static bounds) and
+    ``monitor/certify/extrusion.py`` (LP slack and witness verification).
     """
 
     quat_norm_tol: float = 1e-6
