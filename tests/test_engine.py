@@ -215,3 +215,27 @@ def test_swept_sphere_gap_is_a_lower_bound_of_the_sampled_distance():
             assert gaps[k] <= up.min() + 1e-12
             checked += np.isfinite(gaps[k])
     assert checked > 20
+
+
+def test_touching_translating_boxes_are_certified_by_extrusion():
+    """Two boxes resting face to face (distance exactly 0, margin 0) while one slides along
+    the shared face: touching is not a collision (regularised semantics). The extrusion
+    checker decides t0 itself, so the engine must not demote the pair to uncertain."""
+    import mujoco
+
+    import monitor
+
+    xml = """<mujoco><worldbody>
+      <body name="base"><geom name="lower" type="box" size="0.5 0.5 0.5" pos="0 0 -0.5"/></body>
+      <body name="slider"><joint name="sx" type="slide" axis="1 0 0"/>
+        <geom name="upper" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/></body>
+    </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    scene = monitor.Scene.from_model(model, pairs="all")
+    plan = monitor.Plan([0.0, 1.0], [[0.0], [0.2]], model=model)
+    cert = monitor.certify(scene, plan, margin=0.0, method="auto")
+    assert cert.verdict == "certified", cert.pairs
+    assert cert.pairs[0].method == "extrusion"
+    # A small margin turns the same motion into a confirmed violation at t0.
+    cert = monitor.certify(scene, plan, margin=1e-3, method="auto")
+    assert cert.verdict == "violation" and cert.witness.time == 0.0
