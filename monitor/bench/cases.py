@@ -12,9 +12,10 @@ geom-frame coordinates coincide for all consumers (MJCF, python-fcl, ipctk,
 ``monitor.geometry``).
 
 Cases come in two groups, ``"translating"`` (no rotation; the extrusion checker
-and the exact LP oracle apply) and ``"rotating"``, and three intents:
-``"collide"`` (paths cross), ``"near"`` (designed minimum clearance ``c``, from
-1e-1 down to 1e-5 m) and ``"clear"`` (about 0.2 m). The intent is only how the
+and the exact LP oracle apply) and ``"rotating"``, and four intents:
+``"collide"`` (paths cross), ``"graze"`` (shallow, brief penetration of depth
+1e-3 / 1e-5 m: the case that time sampling misses), ``"near"`` (designed minimum
+clearance ``c``, from 1e-1 down to 1e-5 m) and ``"clear"`` (about 0.2 m). The intent is only how the
 case was built; the label used for scoring comes from :mod:`monitor.bench.oracle`.
 """
 
@@ -31,6 +32,8 @@ from scipy.spatial.transform import Rotation
 
 NEAR_CLEARANCES_FULL = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 NEAR_CLEARANCES_QUICK = (1e-2, 1e-4)
+GRAZE_DEPTHS_FULL = (1e-3, 1e-5)
+GRAZE_DEPTHS_QUICK = (1e-3,)
 CLEAR_DISTANCE = 0.2
 """Designed minimum clearance (m) of the ``"clear"`` cases."""
 
@@ -359,7 +362,7 @@ def _shifted(case: PairCase, w: np.ndarray, s: float) -> PairCase:
 
 def _place(case: PairCase, w: np.ndarray, target: float, dist) -> PairCase:
     """Shift A's path along ``w`` so that its minimum distance is ``target`` (bisection)."""
-    if target <= 0:
+    if target == 0:
         return case
     case.model  # noqa: B018  compile once; shifted copies share it
     lo, hi = 0.0, case.shapes[0].max_radius + case.shapes[1].max_radius + target + 0.05
@@ -372,7 +375,7 @@ def _place(case: PairCase, w: np.ndarray, target: float, dist) -> PairCase:
         if not lo < s < hi:
             s = 0.5 * (lo + hi)
         f = min_distance(_shifted(case, w, s), dist) - target
-        if abs(f) <= 0.02 * target:
+        if abs(f) <= 0.02 * abs(target):
             break
         if f < 0:
             lo, f_lo = s, f
@@ -407,12 +410,18 @@ def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
     rng = np.random.default_rng(seed)
     combos = [("box", "box"), ("hull", "box"), ("hull", "hull"), ("capsule", "box"), ("sphere", "hull")]
     clearances = NEAR_CLEARANCES_QUICK if quick else NEAR_CLEARANCES_FULL
+    graze = GRAZE_DEPTHS_QUICK if quick else GRAZE_DEPTHS_FULL
     if quick:
         combos = [("box", "box"), ("hull", "box"), ("capsule", "box")]
     cases: list[PairCase] = []
     for group in ("translating", "rotating"):
         for ka, kb in combos:
-            intents = [("collide", -1.0)] + [("near", c) for c in clearances] + [("clear", CLEAR_DISTANCE)]
+            intents = (
+                [("collide", -1.0)]
+                + [("graze", -d) for d in graze]
+                + [("near", c) for c in clearances]
+                + [("clear", CLEAR_DISTANCE)]
+            )
             for k, (intent, c) in enumerate(intents):
                 both = bool(k % 2)
                 shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
@@ -440,7 +449,9 @@ def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
                 for b in range(2):  # shortest arc so that slerp angle < pi
                     if quat[b, 0] @ quat[b, 1] < 0:
                         quat[b, 1] *= -1
-                name = f"{group[:3]}-{ka}-{kb}-{intent}" + (f"-{c:.0e}" if intent == "near" else "")
+                name = f"{group[:3]}-{ka}-{kb}-{intent}" + (
+                    f"-{abs(c):.0e}" if intent in ("near", "graze") else ""
+                )
                 case = PairCase(name, group, intent, c, shapes, pos, quat, (True, both))
                 if intent != "collide":
                     case = _place(case, w, c, dist)

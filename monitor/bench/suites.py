@@ -324,6 +324,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
         "clear_cases",
         "near_cases",
         "errors",
+        "budget_exhausted",
     ]
     md = [
         "Per checker and epsilon on the seeded case set (oracle backend: "
@@ -1132,6 +1133,7 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
                             "bodies": n,
                             "pairs": len(scene.candidate_pairs),
                             "seconds": float(np.median(ts)),
+                            "us_per_pair": 1e6 * float(np.median(ts)) / max(1, len(scene.candidate_pairs)),
                             "scene_seconds": t_scene,
                             "verdict": cert.verdict,
                             "culled": cert.stats.get("pairs_culled"),
@@ -1187,6 +1189,7 @@ def suite_scaling(cfg: BenchConfig) -> dict[str, Any]:
                 "bodies",
                 "pairs",
                 "seconds",
+                "us_per_pair",
                 "scene_seconds",
                 "verdict",
                 "culled",
