@@ -229,15 +229,17 @@ def plot_peers(path: Path, rows: list[dict]) -> None:
         color=["C3" if r["checker"].startswith("ours") else "C0" for r in rr],
     )
     for i, r in enumerate(rr):
+        extra = f", uncertain {r['uncertain']}" if r.get("uncertain") else ""
         ax.text(
             r["us_median"],
             i,
-            f"  misses {r['misses']}/{r['collide_cases']}, false alarms {r['false_alarms']}",
+            f"  misses {r['misses']}/{r['collide_cases']}, false alarms {r['false_alarms']}{extra}",
             va="center",
             fontsize=7,
         )
     ax.set_yticks(range(len(rr)), names, fontsize=7)
     ax.set_xscale("log")
+    ax.set_xlim(min(r["us_median"] for r in rr) * 0.5, max(r["us_median"] for r in rr) * 3000)
     ax.set_xlabel("µs per pair-window query (median over cases)")
     ax.set_title("Ours and peers on the same cases")
     fig.tight_layout()
