@@ -54,19 +54,22 @@ def _geom_xml(kind: str, half: np.ndarray) -> tuple[str, str]:
     return f'<mesh name="mA" vertex="{v}"/>', '<geom name="gA" type="mesh" mesh="mA"/>'
 
 
-def slab_model(half_a, hb: float, kind: str = "box", tilt: float = 0.0, offset=(0.0, 0.0, 0.0)):
+def slab_model(half_a, hb: float, kind: str = "box", tilt: float = 0.0, offset=(0.0, 0.0, 0.0),
+               b_tilt: float = 0.0):
     """MJCF model: free body A (geom gA), static box B (geom gB) at ``offset``."""
     asset, geom = _geom_xml(kind, np.asarray(half_a, float))
     o = " ".join(repr(float(x)) for x in offset)
     xml = (f'<mujoco><compiler inertiafromgeom="false"/><option gravity="0 0 0"/><asset>{asset}</asset>'
            '<worldbody><body name="A"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
            f'{geom}</body>'
-           f'<body name="B" pos="{o}"><geom name="gB" type="box" size="{hb!r} {hb!r} {hb!r}"/></body>'
+           f'<body name="B" pos="{o}" quat="{math.cos(b_tilt / 2)!r} {math.sin(b_tilt / 2)!r} 0 0">'
+           f'<geom name="gB" type="box" size="{hb!r} {hb!r} {hb!r}"/></body>'
            "</worldbody></mujoco>")
     return mujoco.MjModel.from_xml_string(xml)
 
 
-def slab_motion(*, x_travel: float, y_a: float, turns: float = 0.0, tilt: float = 0.0,
+def slab_motion(*, x_travel: float, y_a: float, turns: float = 0.0, tilt: float = 0.0, yaw: float = 0.0,
+                b_tilt: float = 0.0,
                 offset=(0.0, 0.0, 0.0), duration: float = 1.0):
     """BodyMotion of A along x at height ``y_a`` with ``turns`` rotations about y (B static).
 
@@ -83,11 +86,12 @@ def slab_motion(*, x_travel: float, y_a: float, turns: float = 0.0, tilt: float 
     pos[:, 1, 1] = o[1] + y_a
     pos[:, 1, 2] = o[2]
     pos[:, 2] = o
-    th = 2 * np.pi * turns * s
+    th = yaw + 2 * np.pi * turns * s
     q_y = np.stack([np.cos(th / 2), np.zeros(k), np.sin(th / 2), np.zeros(k)], axis=1)
     q_x = np.array([math.cos(tilt / 2), math.sin(tilt / 2), 0.0, 0.0])
     quat = np.zeros((k, 3, 4))
-    quat[:, 0, 0] = quat[:, 2, 0] = 1.0
+    quat[:, 0, 0] = 1.0
+    quat[:, 2] = [math.cos(b_tilt / 2), math.sin(b_tilt / 2), 0.0, 0.0]
     quat[:, 1] = _qmul(q_y, q_x)
     return BodyMotion(duration * s, pos, quat)
 
@@ -99,7 +103,8 @@ def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
                      aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
 
 
-def run_case(*, half_a, hb, gap, kind="box", turns=0.0, tilt=0.0, scale=1.0, offset=(0.0, 0.0, 0.0),
+def run_case(*, half_a, hb, gap, kind="box", turns=0.0, tilt=0.0, yaw=0.0, b_tilt=0.0, scale=1.0,
+             offset=(0.0, 0.0, 0.0),
              travel=None, method="auto", epsilon=None, seconds=3.0):
     """Build and certify one slab case; return (certificate or None, error, truth)."""
     import monitor
@@ -111,11 +116,12 @@ def run_case(*, half_a, hb, gap, kind="box", turns=0.0, tilt=0.0, scale=1.0, off
     offset = np.asarray(offset, float)
     # lowest point of A below its origin (tilt about x by ``tilt``)
     low = half_a[1] * math.cos(tilt) + half_a[2] * math.sin(abs(tilt))
-    y_a = hb + low + gap
+    top = hb * (math.cos(b_tilt) + math.sin(abs(b_tilt)))  # B (a cube) tilted about x
+    y_a = top + low + gap
     travel = (3.0 * (hb + float(half_a.max()))) if travel is None else travel * scale
-    model = slab_model(half_a, hb, kind, tilt, offset)
+    model = slab_model(half_a, hb, kind, tilt, offset, b_tilt)
     scene = monitor.Scene.from_model(model, pairs="all")
-    bm = slab_motion(x_travel=travel, y_a=y_a, turns=turns, tilt=tilt, offset=offset)
+    bm = slab_motion(x_travel=travel, y_a=y_a, turns=turns, tilt=tilt, yaw=yaw, b_tilt=b_tilt, offset=offset)
     eps = epsilon if epsilon is not None else 1e-3 * scale
     # Touching band: a penetration below the documented regularisation band (Tolerances.extrusion_slack,
     # "touching is not a collision") or below the float64 resolution of the input coordinates
@@ -201,6 +207,18 @@ def test_tiny_clearances(engine, gap, method):
 def test_near_parallel_faces(engine, tilt, gap):
     cert, truth = run_case(half_a=(0.1, 0.08, 0.04), hb=0.1, gap=gap, tilt=tilt)
     assert_sound(cert, truth, f"tilt {tilt} gap {gap}")
+
+
+@pytest.mark.parametrize("yaw", [1e-3, 1e-6, 1e-9])
+@pytest.mark.parametrize("gap", [-1e-6, 1e-6])
+def test_near_parallel_edges(engine, yaw, gap):
+    """Edge over edge: A and B are cubes in y-z tilted 45 deg about x, so A's lowest edge and
+    B's top edge both run along x (through the centres' projections); A is yawed by ``yaw``
+    about y (preserves y), so the edges cross in projection at an angle ``yaw`` when A's
+    centre passes x = 0: the minimum distance is exactly the vertical gap."""
+    cert, truth = run_case(half_a=(0.1, 0.08, 0.08), hb=0.1, gap=gap, tilt=math.pi / 4, yaw=yaw,
+                           b_tilt=math.pi / 4)
+    assert_sound(cert, truth, f"edge-edge yaw {yaw} gap {gap}")
 
 
 @pytest.mark.parametrize("kind", ["mesh_duplicates", "mesh_coplanar", "mesh_zero_area"])
