@@ -25,10 +25,11 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", type=Path, default=Path("bench_out"), help="output directory (default bench_out)")
     p.add_argument(
         "--suite",
-        action="append",
+        action="extend",
+        nargs="+",
         choices=SUITES,
         metavar="NAME",
-        help=f"run only this suite (repeatable): {', '.join(SUITES)}",
+        help=f"run only these suites (one or more, repeatable): {', '.join(SUITES)}",
     )
     p.add_argument("--seed", type=int, default=7, help="case-set seed (default 7)")
     p.add_argument("--reps", type=int, default=None, help="timing repetitions (default 3 quick, 5 full)")
