@@ -221,7 +221,11 @@ class QuatTrack:
         of q_{i+1} q_i^* is sin(phi_i / 2) a_i; dividing by sinc keeps tiny angles exact.
         """
         d = quat_mul(self.target[i], self.q[i] * np.array([1.0, -1.0, -1.0, -1.0]))
-        vec = d[:, 1:] * np.sign(d[:, :1] + (d[:, :1] == 0))
+        # ``target`` is sign-aligned with q_i, so d = (cos(phi/2), sin(phi/2) a_i) with
+        # phi in [0, pi]: the vector part already has the right sign. Never re-sign it by
+        # d[0]: at a half turn d[0] ~ 0 and rounding can make it negative, which would
+        # reverse the angular velocity (a false negative found by the red-team tests).
+        vec = d[:, 1:]
         scale = 2.0 / np.sinc(self.phi[i] / (2.0 * np.pi)) / dt
         return vec * scale[:, None]
 
