@@ -148,13 +148,8 @@ def _gate_keeps_arm_off_the_post(steps):
     assert replaced > 0
 
 
-def test_gate_keeps_arm_off_the_post_ci():
-    _gate_keeps_arm_off_the_post(60)  # contact comes at step ~7 without the gate
-
-
-@pytest.mark.slow
 def test_gate_keeps_arm_off_the_post_500_steps():
-    _gate_keeps_arm_off_the_post(500)
+    _gate_keeps_arm_off_the_post(500)  # acceptance figure; contact comes at step ~7 without the gate
 
 
 # ----------------------------------------------------------------------------- AGV and trays

@@ -14,7 +14,7 @@ from monitor.errors import InvalidInputError
 from monitor.gym_gate import SafetyGate
 
 STOCK = ["Pusher-v5", "Reacher-v5", "Ant-v5"]
-CI_STEPS = 40  # 200 steps x 3 envs take ~2 min of wall time on the shared 2-core VM: see the slow variant
+STEPS = 200  # the issue-5 acceptance figure; ~55 s for the three envs on an idle 2-core machine
 
 
 def _run(env_id, steps):
@@ -40,14 +40,8 @@ def _run(env_id, steps):
 
 
 @pytest.mark.parametrize("env_id", STOCK)
-def test_check_env_and_random_steps(env_id):
-    _run(env_id, CI_STEPS)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("env_id", STOCK)
 def test_check_env_and_200_random_steps(env_id):
-    _run(env_id, 200)
+    _run(env_id, STEPS)
 
 
 def test_step_tuple_and_spec_roundtrip():
