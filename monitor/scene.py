@@ -36,10 +36,14 @@ Pair modes:
   ``contact``/``constraint`` disable flags are ignored (the geometry still
   counts for safety).
 * ``"all"``: every non plane-plane pair of geoms on distinct weld groups that
-  are not parent-child (neither being the world, regardless of
-  ``filterparent``) and not both static (``body_weldid == 0``). Mocap bodies
+  are not parent-child and not both static (``body_weldid == 0``). Mocap bodies
   are moving here, so mocap-vs-static pairs are included (MuJoCo skips them).
-  ``contype``/``conaffinity`` and ``<exclude>`` are ignored.
+  ``contype``/``conaffinity`` and ``<exclude>`` are ignored. A body whose parent
+  is the world is a parent-child pair with every world geom; of those, only the
+  pairs in contact in every configuration are dropped (rotational joints whose
+  shared anchor lies in both geoms, e.g. a base and its first link), so that the
+  floor vs a free body or a wall vs a slider stay checked
+  (:func:`_drop_overlapping_world_children`).
 * explicit list of ``(geom_a, geom_b)`` (names or ids), validated.
 """
 
@@ -274,6 +278,8 @@ class Scene:
                 type=_GEOM_TYPES.get(int(types[g]), str(int(types[g]))), shape=shape_B,
                 margin=float(model.geom_margin[g]), static=bool(body_static[b]),
                 mocap=bool(body_mocap[b])))
+        if isinstance(pairs, str) and pairs == "all":
+            pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
         return cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
 
     @staticmethod
@@ -410,6 +416,62 @@ def _filter_pairs(model: Any, mode: str) -> np.ndarray:
         ex = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]]) & (ex[:, 0] != ex[:, 1])]
         sel = np.unique(np.concatenate([sel, ex]), axis=0)
     return sel.reshape(-1, 2)
+
+
+def _drop_overlapping_world_children(model: Any, pair_ids: np.ndarray, geoms: Sequence[GeomInfo],
+                                     tolerances: Tolerances) -> np.ndarray:
+    """``pairs="all"``: drop world-vs-child pairs that are in contact in *every* configuration.
+
+    A body whose parent is the world is literally a parent-child pair with every
+    world geom, but dropping all of those would also drop the floor vs a free
+    body or a wall vs a slider. A pair is dropped only when it is adjacent by
+    design: the child attaches by rotational joints only (hinge/ball) that share
+    one anchor, and that anchor lies in BOTH geoms (rigorous point-in-solid test
+    at ``qpos0``). The anchor is fixed in both frames under such joints, so the
+    pair overlaps for every joint value (Reacher's ``root`` vs ``link0``, a robot
+    base vs its first link): planners' "always in collision" entries.
+    """
+    if not len(pair_ids):
+        return pair_ids
+    weld = np.asarray(model.body_weldid, dtype=np.int64)
+    parent = np.asarray(model.body_parentid, dtype=np.int64)
+    gweld = weld[np.asarray(model.geom_bodyid, dtype=np.int64)]
+    w1, w2 = gweld[pair_ids[:, 0]], gweld[pair_ids[:, 1]]
+    wparent = weld[parent]
+    adjacent = ((w1 == 0) & (w2 != 0) & (wparent[w2] == 0)) | ((w2 == 0) & (w1 != 0) & (wparent[w1] == 0))
+    if not adjacent.any():
+        return pair_ids
+    from monitor.geometry.distance import point_in_shape  # pure geometry; no import cycle
+
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    rotational = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_BALL))
+    anchor_of: dict[int, np.ndarray | None] = {}
+
+    def anchor(w: int) -> np.ndarray | None:
+        """World anchor shared by all joints of weld group ``w`` if all are rotational."""
+        if w not in anchor_of:
+            jnts = np.flatnonzero(np.asarray(model.jnt_bodyid) == w)
+            pts = [np.array(data.xanchor[j]) for j in jnts if int(model.jnt_type[j]) in rotational]
+            ok = len(jnts) > 0 and len(pts) == len(jnts) and all(np.array_equal(p, pts[0]) for p in pts)
+            anchor_of[w] = pts[0] if ok else None
+        return anchor_of[w]
+
+    keep = np.ones(len(pair_ids), dtype=bool)
+    for k in np.flatnonzero(adjacent):
+        a, b = geoms[int(pair_ids[k, 0])], geoms[int(pair_ids[k, 1])]
+        if a.shape is None or b.shape is None:
+            continue
+        child = int(w2[k]) if w1[k] == 0 else int(w1[k])
+        p = anchor(child)
+        if p is None:
+            continue
+        inside = all(point_in_shape(g.shape, (data.xmat[g.body_id].reshape(3, 3).copy(),
+                                               data.xpos[g.body_id].copy()), p, 0.0, tolerances=tolerances)
+                     for g in (a, b))
+        if inside:
+            keep[k] = False
+    return pair_ids[keep]
 
 
 __all__ = ["Scene", "GeomInfo", "model_hash", "FLAT_MESH_THICKNESS"]

@@ -571,3 +571,25 @@ def test_explicit_pair_edge_cases_in_mujoco_mode():
     scene = Scene.from_model(mujoco.MjModel.from_xml_string(xml))
     assert scene.candidate_pairs == (("a", "b"), ("a", "c"), ("c", "d"))
     assert {tuple(p) for p in scene.pair_ids.tolist()} == contact_pairs(xml) - {(4, 4)}
+
+
+def test_all_pairs_drop_only_always_touching_world_children():
+    """pairs="all": a hinge child whose anchor lies in both geoms is always in contact with
+    its world parent (dropped); a slider through a wall at qpos0 and a free body over the
+    floor are real collision candidates (kept)."""
+    import mujoco
+
+    xml = """<mujoco><worldbody>
+      <geom name="floor" type="plane" size="5 5 .1"/>
+      <geom name="root" type="cylinder" size=".05 .02" pos="0 0 .5"/>
+      <body name="arm" pos="0 0 .5"><joint type="hinge" axis="0 0 1"/>
+        <geom name="link" type="capsule" fromto="0 0 0 .3 0 0" size=".02"/></body>
+      <geom name="wall" type="box" size=".01 .5 .5" pos="2 0 .5"/>
+      <body name="slider" pos="2 0 .5"><joint type="slide" axis="1 0 0"/>
+        <geom name="ball" type="sphere" size=".05"/></body>
+      <body name="crate" pos="-2 0 1"><freejoint/><geom name="crate" type="box" size=".1 .1 .1"/></body>
+    </worldbody></mujoco>"""
+    pairs = set(Scene.from_model(mujoco.MjModel.from_xml_string(xml), pairs="all").candidate_pairs)
+    assert ("root", "link") not in pairs  # hinge anchor inside both: always touching
+    assert ("wall", "ball") in pairs      # overlaps at qpos0, but a slider can leave
+    assert ("floor", "crate") in pairs and ("floor", "link") in pairs
