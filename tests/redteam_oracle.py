@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from scipy.optimize import linprog, minimize, minimize_scalar
+from scipy.optimize import linprog, minimize, minimize_scalar, nnls
 from scipy.spatial import ConvexHull
 
 PLANE, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = (
@@ -241,7 +241,7 @@ def project(g: GeomPose, z: np.ndarray) -> np.ndarray:
             v = u
         else:
             lo, hi = 0.0, float(np.linalg.norm(u) * np.max(a)) + 1.0
-            for _ in range(200):
+            for _ in range(80):
                 mid = 0.5 * (lo + hi)
                 if obj(mid) > 0:
                     lo = mid
@@ -253,13 +253,12 @@ def project(g: GeomPose, z: np.ndarray) -> np.ndarray:
                 v = v / f
     elif g.type == MESH:
         V = g.verts
-        # min |V^T lam - u|^2, lam in simplex
-        k = V.shape[0]
-        res = minimize(lambda lam: float(np.sum((lam @ V - u) ** 2)), np.full(k, 1.0 / k),
-                       jac=lambda lam: 2.0 * V @ (lam @ V - u), method="SLSQP",
-                       bounds=[(0, 1)] * k, constraints=[{"type": "eq", "fun": lambda lam: lam.sum() - 1.0}],
-                       options={"ftol": 1e-16, "maxiter": 500})
-        lam = np.clip(res.x, 0, None)
+        # min |V^T lam - u|^2 + (w (sum lam - 1))^2, lam >= 0 (Lawson-Hanson), then renormalise:
+        # the result is an exact convex combination, i.e. a point of the hull.
+        w = 1e4 * (1.0 + float(np.abs(V).max()))
+        A = np.vstack([V.T, w * np.ones((1, V.shape[0]))])
+        lam, _ = nnls(A, np.concatenate([u, [w]]), maxiter=2000)
+        lam = np.clip(lam, 0, None)
         lam /= lam.sum()
         v = lam @ V
     else:
@@ -327,6 +326,49 @@ def _lp_overlap(a: GeomPose, b: GeomPose) -> Witness | None:
     return Witness(-d, z, z)
 
 
+def core(g: GeomPose) -> tuple[np.ndarray, float] | None:
+    """World vertices of the convex core and the radius, for sphere/capsule/box/mesh."""
+    s = g.size
+    if g.type == SPHERE:
+        V, r = np.zeros((1, 3)), s[0]
+    elif g.type == CAPSULE:
+        V, r = np.array([[0.0, 0.0, -s[1]], [0.0, 0.0, s[1]]]), s[0]
+    elif g.type == BOX:
+        V = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float) * s
+        r = 0.0
+    elif g.type == MESH:
+        V, r = g.verts, 0.0
+    else:
+        return None
+    return V @ g.R.T + g.p, float(r)
+
+
+def _core_distance(a: GeomPose, b: GeomPose) -> Witness | None:
+    """Core-core distance by a convex-combination least squares (nnls), minus the radii."""
+    ca, cb = core(a), core(b)
+    if ca is None or cb is None:
+        return None
+    (Va, ra), (Vb, rb) = ca, cb
+    na, nb = len(Va), len(Vb)
+    w = 1e4 * (1.0 + float(max(np.abs(Va).max(), np.abs(Vb).max())))
+    A = np.zeros((5, na + nb))
+    A[:3, :na], A[:3, na:] = Va.T, -Vb.T
+    A[3, :na], A[4, na:] = w, w
+    lam, _ = nnls(A, np.array([0, 0, 0, w, w]), maxiter=5000)
+    la, lb = np.clip(lam[:na], 0, None), np.clip(lam[na:], 0, None)
+    if la.sum() <= 0 or lb.sum() <= 0:
+        return None
+    pa, pb = (la / la.sum()) @ Va, (lb / lb.sum()) @ Vb
+    d = float(np.linalg.norm(pb - pa))
+    if d <= 1e-300:
+        return None
+    u = (pb - pa) / d
+    if d >= ra + rb:
+        return Witness(d - ra - rb, pa + ra * u, pb - rb * u)
+    z = pa + (ra - 0.5 * (ra + rb - d)) * u
+    return Witness(-min(depth(a, z), depth(b, z)), z, z)
+
+
 def upper_distance(a: GeomPose, b: GeomPose, z0: np.ndarray | None = None) -> Witness:
     """Verified upper bound on the signed distance of two geoms (negative: penetration witness)."""
     if a.type == PLANE and b.type == PLANE:
@@ -365,11 +407,15 @@ def upper_distance(a: GeomPose, b: GeomPose, z0: np.ndarray | None = None) -> Wi
     lp = _lp_overlap(a, b)
     if lp is not None and lp.upper < 0:
         return lp
+    cw = _core_distance(a, b)
+    if cw is not None and check_witness(a, b, cw, slack=1e-12) and (cw.upper < 0 or lp is not None
+                                                                     or cw.upper > 0):
+        return cw
     # alternating projections warm start, then a local polish of |x - y| by Nelder-Mead on the
     # midpoint pair; both points are projected onto their sets, so the result is feasible.
     x = centre(a) if z0 is None else np.asarray(z0, float)
     y = project(b, x)
-    for _ in range(200):
+    for _ in range(400):
         x = project(a, y)
         y2 = project(b, x)
         if np.linalg.norm(y2 - y) < 1e-15:
@@ -381,21 +427,7 @@ def upper_distance(a: GeomPose, b: GeomPose, z0: np.ndarray | None = None) -> Wi
         w = _pen_witness(a, b, 0.5 * (x + y))
         if w.upper < 0:
             return w
-    best = Witness(d, x, y)
-    # polish along the segment x-y (convexity: distance from b of points of a) by a 1-D search
-    # on the pair (x, project(b, x)) starting from the current x shifted inside a.
-    for _ in range(3):
-        res = minimize(lambda z: float(np.linalg.norm(project(a, z) - project(b, project(a, z)))),
-                       best.x, method="Nelder-Mead",
-                       options={"xatol": 1e-13, "fatol": 1e-16, "maxiter": 3000})
-        xa = project(a, res.x)
-        yb = project(b, xa)
-        dd = float(np.linalg.norm(xa - yb))
-        if dd < best.upper:
-            best = Witness(dd, xa, yb)
-        else:
-            break
-    return best
+    return Witness(d, x, y)
 
 
 def check_witness(a: GeomPose, b: GeomPose, w: Witness, slack: float = 1e-12) -> bool:
