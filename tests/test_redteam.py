@@ -99,3 +99,122 @@ def test_fn_half_turn_motion_bound_contract():
     pr = np.einsum("tij,j->ti", R[:, 1], ref) + P[:, 1]
     true = float(np.linalg.norm(pr - pr[100], axis=1).max())
     assert true <= mb.trans[0, 1], f"FALSE NEGATIVE source: true displacement {true} > bound {mb.trans[0, 1]}"
+
+
+def test_half_turn_ball_joint():
+    """Half-turn slerp through a ball joint carried by three slides: not fooled (regression)."""
+    probe_xml = ('<mujoco><worldbody>{obs}<body name="c"><inertial pos="0 0 0" mass="1" diaginertia=".1 .1 .1"/><joint name="x" type="slide" axis="1 0 0"/>'
+                 '<joint name="y" type="slide" axis="0 1 0"/><joint name="z" type="slide" axis="0 0 1"/>'
+                 '<body name="b"><joint name="ball" type="ball"/><geom name="s" type="sphere" size=".1" '
+                 'pos="1 0 0"/></body></body></worldbody></mujoco>')
+    qpos = np.array([[*(-0.5 * np.array(_V)), *_Q0], [*(0.5 * np.array(_V)), *_Q1]])
+    probe = _model(probe_xml.format(obs=""))
+    pl = Plan([0.0, 1.0], qpos, probe)
+    t_hit, dt = 0.53, 1e-4
+    pos, rot = pl.body_poses(np.array([t_hit - dt, t_hit, t_hit + dt]))
+    c = np.einsum("tij,j->ti", rot[:, 2], [1.0, 0.0, 0.0]) + pos[:, 2]
+    vel = (c[2] - c[0]) / np.linalg.norm(c[2] - c[0])
+    perp = np.cross(vel, [0.0, 0.0, 1.0])
+    perp /= np.linalg.norm(perp)
+    ob = c[1] + 0.15 * perp
+    obs = f'<geom name="obs" type="sphere" size=".1" pos="{_f(ob[0])} {_f(ob[1])} {_f(ob[2])}"/>'
+    m = _model(probe_xml.format(obs=obs))
+    pl = Plan([0.0, 1.0], qpos, m)
+    a, b = TrajectoryOracle(m, pl).geoms(t_hit, (0, 1))
+    w = upper_distance(a, b)
+    assert check_witness(a, b, w) and w.upper < -0.02
+    cert = certify(Scene.from_model(m, pairs="all"), pl, 0.0, 1e-3, "auto")
+    _assert_not_certified(cert, "half-turn slerp of a ball joint")
+
+
+# --------------------------------------------------------------------------- generic attack harness
+
+
+def _attack(xml: str, times, qpos, margin: float = 0.0, methods=("auto", "toleranced"), *,
+            epsilon: float = 1e-3, window=None, n: int = 200, pairs="all", expect_violation: bool | None = True,
+            budget=None):
+    """Certify with each method and check every verdict contract against the oracle.
+
+    * certified  => the oracle has no verified witness below the margin, and the certified
+      clearance is <= the oracle's verified minimum distance;
+    * violation  => the witness is confirmed by the oracle at witness.time (exact shapes), and
+      earliest_time <= the first sampled time at which the oracle verified a violation.
+    Returns {method: certificate}.
+    """
+    m = _model(xml)
+    scene = Scene.from_model(m, pairs=pairs)
+    times = np.asarray(times, float)
+    qpos = np.asarray(qpos, float)
+    plan = Plan(times, qpos, m)
+    oracle = PlanOracle(m, times, qpos)
+    w0, w1 = window if window is not None else (times[0], times[-1])
+    mins = {}
+    for (na, nb), ids in zip(scene.candidate_pairs, scene.pair_ids):
+        mins[(na, nb)] = (tuple(int(i) for i in ids),
+                          motion_min(oracle, int(ids[0]), int(ids[1]), w0, w1, n=n, threshold=margin))
+    true_min = min(r.upper for _, r in mins.values())
+    if expect_violation is not None:
+        assert (true_min < margin) == expect_violation, f"attack set-up: oracle min {true_min} vs margin {margin}"
+    out = {}
+    for meth in methods:
+        cert = certify(scene, plan, margin, epsilon, meth, window=window, budget=budget)
+        out[meth] = cert
+        if true_min < margin:
+            _assert_not_certified(cert, f"{meth}: oracle min {true_min} < margin {margin}")
+        if cert.verdict == "certified":
+            assert cert.clearance <= true_min + 1e-12, f"{meth}: clearance {cert.clearance} > true min {true_min}"
+        if cert.verdict == "violation":
+            w = cert.witness
+            for (na, nb), (ids, r) in mins.items():
+                if set(w.geoms) != {na, nb}:
+                    continue
+                a, b = oracle.geoms(w.time, ids)
+                ow = upper_distance(a, b)
+                exact = all(int(m.geom_type[i]) not in (4, 5) for i in ids)  # no ellipsoid/cylinder
+                if exact and w.distance < margin - 1e-9:
+                    # the oracle's bound is an upper bound; it must not exceed the margin by much
+                    assert ow.upper < margin + 1e-7, f"{meth}: witness at {w.time} not confirmed: {ow.upper}"
+            firsts = [r.first_below for _, r in mins.values() if r.first_below is not None]
+            if firsts:
+                assert cert.earliest_time <= min(firsts) + 1e-12, (
+                    f"{meth}: earliest_time {cert.earliest_time} later than verified violation {min(firsts)}")
+    return out
+
+
+def _free(x, q=(1.0, 0.0, 0.0, 0.0)):
+    return [*x, *q]
+
+
+_BOX_WALL = ('<mujoco><worldbody><geom name="wall" type="box" size=".005 1 1"/>'
+             '<body name="b"><freejoint/><geom name="mv" type="box" size=".05 .05 .05"/></body></worldbody></mujoco>')
+
+
+def test_thin_wall_tunnelling_translation():
+    """A box crosses a 1 cm wall at 1000 m/s: no sample time inside, extrusion must see it."""
+    _attack(_BOX_WALL, [0.0, 0.01], [_free([-5.0, 0, 0]), _free([5.0, 0, 0])], n=101)
+
+
+def test_thin_wall_tunnelling_rotating():
+    """The same with a rotation (toleranced checker in all methods)."""
+    _attack(_BOX_WALL, [0.0, 0.01], [_free([-5.0, 0, 0]), _free([5.0, 0, 0], (0.0, 0.0, 0.0, 1.0))], n=101)
+
+
+def test_extrusion_sub_window():
+    """Sub-window of a multi-waypoint translation: the collision is inside the sub-window only."""
+    q = [_free([-5.0, 0, 0]), _free([-1.0, 0, 0]), _free([1.0, 0, 0]), _free([5.0, 0, 0])]
+    _attack(_BOX_WALL, [0.0, 1.0, 2.0, 3.0], q, window=(1.2, 1.8), methods=("auto", "extrusion", "toleranced"))
+    _attack(_BOX_WALL, [0.0, 1.0, 2.0, 3.0], q, window=(2.1, 3.0), methods=("auto", "extrusion"),
+            expect_violation=False)
+
+
+def test_tiny_budget_never_certifies():
+    """An exhausted budget may only give 'uncertain' (or a confirmed violation), never 'certified'."""
+    from monitor.certify.common import Budget
+
+    xml = ('<mujoco><worldbody><geom name="blk" type="box" size=".1 .1 .1"/><body name="b">'
+           '<joint name="h" type="hinge" axis="0 0 1"/><geom name="arm" type="box" size=".5 .01 .01" '
+           'pos=".62 0 0"/></body></worldbody></mujoco>')
+    m = _model(xml)
+    plan = Plan([0.0, 1.0], [[0.1], [6.0]], m)
+    cert = certify(Scene.from_model(m, pairs="all"), plan, 0.0, 1e-6, "toleranced", budget=Budget(tests=1))
+    assert cert.verdict in ("uncertain", "violation")
