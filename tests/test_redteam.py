@@ -132,7 +132,7 @@ def test_half_turn_ball_joint():
 
 def _attack(xml: str, times, qpos, margin: float = 0.0, methods=("auto", "toleranced"), *,
             epsilon: float = 1e-3, window=None, n: int = 200, pairs="all", expect_violation: bool | None = True,
-            budget=None):
+            budget=None, known=None):
     """Certify with each method and check every verdict contract against the oracle.
 
     * certified  => the oracle has no verified witness below the margin, and the certified
@@ -152,6 +152,14 @@ def _attack(xml: str, times, qpos, margin: float = 0.0, methods=("auto", "tolera
     for (na, nb), ids in zip(scene.candidate_pairs, scene.pair_ids):
         mins[(na, nb)] = (tuple(int(i) for i in ids),
                           motion_min(oracle, int(ids[0]), int(ids[1]), w0, w1, n=n, threshold=margin))
+    if known is not None:  # (pair ids, MinResult) found by a finer search of the caller
+        for key, (ids, r) in mins.items():
+            if ids == known[0] and known[1].upper < r.upper:
+                first = r.first_below if r.first_below is not None else known[1].time
+                if known[1].upper < margin:
+                    first = min(first, known[1].time)
+                mins[key] = (ids, type(r)(known[1].upper, known[1].time, known[1].witness,
+                                          first if known[1].upper < margin or r.first_below is not None else None))
     true_min = min(r.upper for _, r in mins.values())
     if expect_violation is not None:
         assert (true_min < margin) == expect_violation, f"attack set-up: oracle min {true_min} vs margin {margin}"
@@ -218,3 +226,73 @@ def test_tiny_budget_never_certifies():
     plan = Plan([0.0, 1.0], [[0.1], [6.0]], m)
     cert = certify(Scene.from_model(m, pairs="all"), plan, 0.0, 1e-6, "toleranced", budget=Budget(tests=1))
     assert cert.verdict in ("uncertain", "violation")
+
+
+# --------------------------------------------------------------------------- grazing (margin trick)
+
+
+def _graze(xml: str, times, qpos, deltas=(1e-9, 1e-6), methods=("auto", "toleranced"), n: int = 300,
+           **kw) -> None:
+    """Certify with margin = verified oracle minimum + delta: a violation exists by construction."""
+    m = _model(xml)
+    oracle = PlanOracle(m, np.asarray(times, float), np.asarray(qpos, float))
+    scene = Scene.from_model(m, pairs=kw.get("pairs", "all"))
+    (ga, gb), = [tuple(int(i) for i in ids) for ids in scene.pair_ids]
+    r = motion_min(oracle, ga, gb, float(times[0]), float(times[-1]), n=n, refine=4)
+    for d in deltas:
+        margin = max(r.upper + d, 0.0)
+        _attack(xml, times, qpos, margin, methods, n=n, known=((ga, gb), r), **kw)
+
+
+def test_graze_sphere_box_corner_translation():
+    xml = ('<mujoco><worldbody><geom name="box" type="box" size=".2 .3 .4" euler="12 34 56"/>'
+           '<body name="b"><freejoint/><geom name="s" type="sphere" size=".05"/></body></worldbody></mujoco>')
+    _graze(xml, [0.0, 1.0], [_free([-1.0, 0.3, 0.45]), _free([1.0, 0.31, 0.44])])
+
+
+def test_graze_sphere_box_corner_rotating():
+    xml = ('<mujoco><worldbody><geom name="box" type="box" size=".2 .3 .4" euler="12 34 56"/>'
+           '<body name="b"><joint name="h" type="hinge" axis="0 0 1"/><geom name="s" type="sphere" size=".05" '
+           'pos=".55 0 .3"/></body></worldbody></mujoco>')
+    _graze(xml, [0.0, 1.0], [[-2.0], [2.0]])
+
+
+def test_graze_long_thin_box_several_turns():
+    """A 2 m thin box spinning 3 turns in one window past a small sphere."""
+    xml = ('<mujoco><worldbody><geom name="ball" type="sphere" size=".02" pos="1.5 .3 .0"/>'
+           '<body name="b"><joint name="h" type="hinge" axis="0 0 1"/><geom name="rod" type="box" '
+           'size="1 .005 .005" pos=".9 0 0" euler="0 0 7"/></body></worldbody></mujoco>')
+    _graze(xml, [0.0, 0.1], [[0.0], [6 * np.pi]], n=600)
+
+
+def test_graze_floor_rotating_box_corner():
+    xml = ('<mujoco><worldbody><geom name="floor" type="plane" size="5 5 .1"/>'
+           '<body name="b" pos="0 0 .5"><freejoint/><geom name="bx" type="box" size=".2 .1 .3"/></body>'
+           '</worldbody></mujoco>')
+    q1 = np.array([0.9, 0.3, -0.2, 0.25])
+    q1 /= np.linalg.norm(q1)
+    _graze(xml, [0.0, 1.0], [_free([0, 0, 0.32]), _free([0.4, 0, 0.3], tuple(q1))], n=400)
+
+
+def test_graze_hinge_chain_long_lever():
+    xml = ('<mujoco><worldbody><geom name="post" type="capsule" size=".03 .5" pos="3.9 .4 0"/>'
+           '<body name="l1"><joint name="h1" type="hinge" axis="0 0 1"/><geom name="g1" type="box" size=".1 .1 .1" '
+           'contype="0" conaffinity="0"/><body name="l2" pos="2 0 0"><joint name="h2" type="hinge" axis="0 1 .3"/>'
+           '<geom name="tip" type="box" size="1 .02 .02" pos="1 0 0"/></body></body></worldbody></mujoco>')
+    _graze(xml, [0.0, 0.5, 1.0], [[-0.3, 0.2], [0.4, -0.3], [0.1, 0.5]], pairs=[("post", "tip")])
+
+
+def test_graze_capsule_pierces_box():
+    """Capsule segment crossing the box with both caps outside (MuJoCo 4.0 misses it)."""
+    xml = ('<mujoco><worldbody><geom name="blk" type="box" size=".1 .1 .1"/>'
+           '<body name="b"><freejoint/><geom name="cap" type="capsule" size=".01 1" euler="0 90 0"/></body>'
+           '</worldbody></mujoco>')
+    _graze(xml, [0.0, 1.0], [_free([0, 0.3, 0.3]), _free([0, 0.0, 0.0], tuple(np.array([0.9, 0.1, 0.0, 0.2]) / np.linalg.norm([0.9, 0.1, 0.0, 0.2])))])
+
+
+def test_graze_both_bodies_moving_opposite():
+    xml = ('<mujoco><worldbody><body name="a"><freejoint/><geom name="ga" type="box" size=".1 .2 .05"/></body>'
+           '<body name="b"><freejoint/><geom name="gb" type="capsule" size=".05 .2"/></body></worldbody></mujoco>')
+    qa = [_free([-2, 0.0, 0.0]), _free([2, 0.0, 0.0], (0.8, 0.0, 0.6, 0.0))]
+    qb = [_free([2, 0.31, 0.1]), _free([-2, 0.3, 0.12], (0.6, 0.8, 0.0, 0.0))]
+    _graze(xml, [0.0, 1.0], [qa[0] + qb[0], qa[1] + qb[1]])
