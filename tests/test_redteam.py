@@ -296,3 +296,67 @@ def test_graze_both_bodies_moving_opposite():
     qa = [_free([-2, 0.0, 0.0]), _free([2, 0.0, 0.0], (0.8, 0.0, 0.6, 0.0))]
     qb = [_free([2, 0.31, 0.1]), _free([-2, 0.3, 0.12], (0.6, 0.8, 0.0, 0.0))]
     _graze(xml, [0.0, 1.0], [qa[0] + qb[0], qa[1] + qb[1]])
+
+
+# --------------------------------------------------------------------------- scales, windows, tolerances
+
+
+def _corner_case(offset: float, scale: float) -> str:
+    o, s = offset, scale
+    return (f'<mujoco><worldbody><geom name="box" type="box" size="{.2 * s!r} {.3 * s!r} {.4 * s!r}" '
+            f'pos="{o!r} {o!r} {o!r}" euler="12 34 56"/><body name="b" pos="{o!r} {o!r} {o!r}">'
+            f'<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+            f'<joint name="h" type="hinge" axis="0 0 1"/><geom name="s" type="sphere" size="{.05 * s!r}" '
+            f'pos="{.55 * s!r} 0 {.3 * s!r}"/></body></worldbody></mujoco>')
+
+
+@pytest.mark.parametrize("offset,scale", [(1e4, 1.0), (0.0, 1e-3), (1e3, 1e-3)])
+def test_graze_offsets_and_scales(offset, scale):
+    _graze(_corner_case(offset, scale), [0.0, 1.0], [[-2.0], [2.0]], deltas=(1e-9 * max(scale, 1e-2), 1e-6 * scale))
+
+
+@pytest.mark.parametrize("t0,T", [(0.0, 1e-6), (1e3, 1e-6), (0.0, 1e3)])
+def test_graze_window_lengths(t0, T):
+    _graze(_corner_case(0.0, 1.0), [t0, t0 + T], [[-2.0], [2.0]])
+
+
+@pytest.mark.parametrize("epsilon", [1e-1, 1e-6])
+def test_graze_epsilon(epsilon):
+    _graze(_corner_case(0.0, 1.0), [0.0, 1.0], [[-2.0], [2.0]], epsilon=epsilon)
+
+
+def test_extrusion_shallow_overlap_2e10():
+    """Penetration depth 2e-10 m (below extrusion_slack 1e-9): must not be certified."""
+    xml = ('<mujoco><worldbody><geom name="wall" type="box" size=".5 .5 .5"/><body name="b">'
+           '<joint name="sx" type="slide" axis="1 0 0"/><geom name="mv" type="box" size=".1 .1 .1"/></body>'
+           '</worldbody></mujoco>')
+    _attack(xml, [0.0, 1.0, 2.0], [[2.0], [0.6 - 2e-10], [2.0]], methods=("auto", "extrusion", "toleranced"), n=201)
+
+
+def test_extrusion_margin_shortfall_2e10():
+    """Distance margin - 2e-10 at the closest approach (quadratic path of the extrusion checker)."""
+    xml = ('<mujoco><worldbody><geom name="wall" type="box" size=".5 .5 .5"/><body name="b">'
+           '<joint name="sx" type="slide" axis="1 0 0"/><geom name="mv" type="sphere" size=".1"/></body>'
+           '</worldbody></mujoco>')
+    _attack(xml, [0.0, 1.0, 2.0], [[2.0], [0.61 - 2e-10], [2.0]], margin=0.01,
+            methods=("auto", "extrusion", "toleranced"), n=201)
+
+
+def test_graze_cylinder_and_ellipsoid():
+    """Circumscribed shapes: never certify what the true shape hits."""
+    xml = ('<mujoco><worldbody><geom name="cyl" type="cylinder" size=".2 .3" euler="20 0 10"/>'
+           '<body name="b"><joint name="h" type="hinge" axis="0 0 1"/><geom name="ell" type="ellipsoid" '
+           'size=".05 .1 .07" pos=".5 0 .1"/></body></worldbody></mujoco>')
+    _graze(xml, [0.0, 1.0], [[-1.0], [1.0]], deltas=(1e-6,), n=120)
+
+
+def test_graze_mesh_near_coplanar_faces():
+    """A hull with nearly coplanar faces (bent by 1e-7) grazing a box edge."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 1e-7], [0, 0, .3], [1, 0, .3], [0, 1, .3],
+                  [1, 1, .3 + 1e-7]]) * 0.3
+    verts = " ".join(repr(float(x)) for x in v.ravel())
+    xml = (f'<mujoco><asset><mesh name="m" vertex="{verts}"/></asset><worldbody>'
+           '<geom name="box" type="box" size=".1 .1 .1" euler="45 0 45"/><body name="b">'
+           '<joint name="h" type="hinge" axis="0 1 0"/><geom name="hull" type="mesh" mesh="m" pos=".3 0 0"/>'
+           '</body></worldbody></mujoco>')
+    _graze(xml, [0.0, 1.0], [[-1.5], [1.5]], n=200)
