@@ -4,7 +4,7 @@ The policy alternates between reaching random targets and deliberately aiming
 the stretched arm at a post or the shelf. Every step is certified by
 :class:`monitor.SafetyGate` (``on_violation="block"``); unsafe actions are
 replaced by a hold-position fallback. The run is written to an MCAP log
-(``logs/demo-<time>.mcap`` unless ``--out`` / ``--no-log``) and a summary is printed.
+(``logs/<env-id>-<UTC timestamp>.mcap`` unless ``--out`` / ``--no-log``) and a summary is printed.
 """
 
 from __future__ import annotations
@@ -29,7 +29,8 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--steps", type=int, default=150, help="env steps to run (default 150)")
     p.add_argument("--seed", type=int, default=0, help="seed of env and policy (default 0)")
     p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
-    p.add_argument("--out", type=Path, default=None, help="log path (default logs/demo-<time>.mcap)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="log file, or a folder for logs/<env-id>-<UTC timestamp>.mcap (default: logs/)")
     p.add_argument("--margin", type=float, default=0.005, help="clearance (m) that counts as safe")
 
 
@@ -84,8 +85,14 @@ def run(args: argparse.Namespace) -> int:
         except ImportError as exc:
             print(f"note: MCAP logging unavailable ({exc}); running without a log")
         else:
-            log_path = args.out or Path("logs") / time.strftime("demo-%Y%m%d-%H%M%S.mcap")
-            log_path.parent.mkdir(parents=True, exist_ok=True)
+            from monitor.log.writer import default_path
+
+            out = args.out
+            if out is None or out.is_dir() or out.suffix != ".mcap":
+                log_path = default_path("monitor/Arm-v0", out if out is not None else Path("logs"))
+            else:
+                log_path = out
+                log_path.parent.mkdir(parents=True, exist_ok=True)
 
     env = gym.make("monitor/Arm-v0", max_episode_steps=max(args.steps, 1))
     gated = SafetyGate(env, margin=args.margin, on_violation="block", log=log_path)
