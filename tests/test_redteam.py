@@ -360,3 +360,32 @@ def test_graze_mesh_near_coplanar_faces():
            '<joint name="h" type="hinge" axis="0 1 0"/><geom name="hull" type="mesh" mesh="m" pos=".3 0 0"/>'
            '</body></worldbody></mujoco>')
     _graze(xml, [0.0, 1.0], [[-1.5], [1.5]], n=200)
+
+
+# --------------------------------------------------------------------------- FN 2: BodyMotion moving welded bodies
+
+
+def test_fn_bodymotion_moves_welded_body_explicit_pair():
+    """BodyMotion moves a body that the Scene calls static (welded, no dof) straight through
+    another welded body; the explicitly requested pair is culled as static-static and certified.
+
+    The engine decides the cull from ``scene.body_static`` instead of the trajectory's own
+    ``moving_bodies()``; a BodyMotion may move any non-world body.
+    """
+    from monitor import BodyMotion
+
+    xml = ('<mujoco><worldbody><body name="a"><geom name="ga" type="box" size=".1 .1 .1"/></body>'
+           '<body name="b" pos="1 0 0"><geom name="gb" type="sphere" size=".1"/></body></worldbody></mujoco>')
+    m = _model(xml)
+    pos = np.zeros((2, 3, 3))
+    pos[:, 2] = [[1.0, 0, 0], [-1.0, 0, 0]]
+    quat = np.zeros((2, 3, 4))
+    quat[..., 0] = 1.0
+    bm = BodyMotion([0.0, 1.0], pos, quat)
+    assert bm.moving_bodies()[2]
+    oracle = TrajectoryOracle(m, bm)
+    a, b = oracle.geoms(0.5, (0, 1))  # sphere centre at the box centre
+    w = upper_distance(a, b)
+    assert check_witness(a, b, w) and w.upper < -0.05
+    cert = certify(Scene.from_model(m, pairs=[("ga", "gb")]), bm, 0.0, 1e-3)
+    _assert_not_certified(cert, "BodyMotion moving a welded body through another")
