@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from monitor.certify.broadphase import swept_sphere_gaps
+from monitor.certify.broadphase import halfspace_gaps, sphere_pair_gaps, swept_geom_spheres
 from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
 from monitor.certify.common import Budget, PairOutcome
 from monitor.errors import InvalidInputError, ModelMismatchError
@@ -48,6 +48,8 @@ from monitor.tolerances import DEFAULT, Tolerances
 _METHODS = ("auto", "toleranced", "extrusion")
 _MAX_WITNESS_INTERVALS = 64
 """Intervals per pair searched for a witness (in time order); the rest stay uncertain."""
+_NSUB = 8
+"""Sub-intervals of the broad phase's swept spheres (one pose / bound call for all geoms)."""
 
 
 def _finite(name: str, x: Any) -> float:
@@ -154,7 +156,6 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     moving = np.asarray(plan.moving_bodies(), bool)
     static = np.asarray(scene.body_static, bool)
     results: dict[int, PairResult] = {}
-    gi = [(scene.geoms[int(scene.pair_ids[i][0])], scene.geoms[int(scene.pair_ids[i][1])]) for i in sel]
     mix: dict[str, int] = {}
     tests_total, depth_max = 0, 0
 
@@ -162,27 +163,38 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         results[i] = r
         mix[r.method] = mix.get(r.method, 0) + 1
 
-    # -- 1. cull static-static ---------------------------------------------------------
-    todo = []
-    for i, (ga, gb) in zip(sel, gi):
-        if static[ga.body_id] and static[gb.body_id]:
-            done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "culled",
-                               clearance=float("inf")))
-        else:
-            todo.append((i, ga, gb))
-    # -- 2. swept spheres -------------------------------------------------------------
-    if todo:
-        gaps = swept_sphere_gaps(plan, [t[1].shape for t in todo], np.array([t[1].body_id for t in todo]),
-                                 [t[2].shape for t in todo], np.array([t[2].body_id for t in todo]),
-                                 (t0, t1), tolerances=tol)
-        rest = []
-        for (i, ga, gb), gap in zip(todo, gaps):
-            if gap > margin:
-                done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "culled",
-                                   clearance=float(gap)))
-            else:
-                rest.append((i, ga, gb))
-        todo = rest
+    # -- 1./2. cull (vectorised over all selected pairs; no Python per culled pair) ---------
+    sel_a = np.asarray(sel, np.int64)
+    pid = np.asarray(scene.pair_ids, np.int64).reshape(-1, 2)[sel_a]
+    geom_body = np.array([g.body_id for g in scene.geoms], np.int64)
+    ss = static[geom_body[pid[:, 0]]] & static[geom_body[pid[:, 1]]]
+    cull_clear = np.full(len(sel_a), np.nan)          # clearance of culled pairs (inf: static-static)
+    cull_clear[ss] = np.inf
+    live = np.nonzero(~ss)[0]
+    if len(live):
+        used = np.unique(pid[live].ravel())
+        local = np.full(len(scene.geoms), -1, np.int64)
+        local[used] = np.arange(len(used))
+        shapes = [scene.geoms[int(g)].shape for g in used]
+        sph = swept_geom_spheres(plan, shapes, geom_body[used], (t0, t1), _NSUB, tol)
+        ia, ib = local[pid[live, 0]], local[pid[live, 1]]
+        gaps = sphere_pair_gaps(sph, ia, ib)
+        half_a = np.array([s.kind == "halfspace" for s in shapes])
+        ha, hb = half_a[ia], half_a[ib]
+        one = np.nonzero(ha ^ hb)[0]
+        if len(one):
+            pl = np.where(ha, ia, ib)[one]
+            gaps[one] = halfspace_gaps(plan, sph, [shapes[j] for j in pl], geom_body[used][pl],
+                                       np.where(ha, ib, ia)[one], (t0, t1), _NSUB)
+        culled = gaps > margin
+        cull_clear[live[culled]] = gaps[culled]
+        todo = [(int(sel_a[k]), scene.geoms[int(pid[k, 0])], scene.geoms[int(pid[k, 1])])
+                for k in live[~culled]]
+    else:
+        todo = []
+    n_culled = int(np.count_nonzero(~np.isnan(cull_clear)))
+    if n_culled:
+        mix["culled"] = n_culled
     # -- 3. start pose -----------------------------------------------------------------
     from monitor.geometry.distance import shape_distance
 
@@ -290,23 +302,47 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
                 results[i] = PairResult(r.geoms, r.bodies, r.verdict, r.method, r.tests, r.max_depth,
                                         r.intervals, float(c), r.witness)
     # -- 6. combine -------------------------------------------------------------------------
-    ordered = tuple(results[i] for i in sel)
-    verdict = combine_verdicts([r.verdict for r in ordered])
-    witnesses = [r.witness for r in ordered if r.verdict == "violation" and r.witness is not None]
+    names = [g.name for g in scene.geoms]
+    bnames = [g.body for g in scene.geoms]
+    ordered = tuple(results[int(i)] if np.isnan(cc) else
+                    _culled(names[a], names[b], bnames[a], bnames[b], cc)
+                    for i, cc, (a, b) in zip(sel_a.tolist(), cull_clear.tolist(), pid.tolist()))
+    checked_r = [results[i] for i in sorted(results)]
+    verdict = combine_verdicts([r.verdict for r in checked_r])
+    witnesses = [r.witness for r in checked_r if r.verdict == "violation" and r.witness is not None]
     witness = min(witnesses, key=lambda w: w.time) if witnesses else None
     earliest = None
     if verdict != "certified":
-        starts = [r.intervals[0][0] for r in ordered if r.verdict != "certified" and r.intervals]
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
         starts += [w.time for w in witnesses]
         earliest = float(min(starts)) if starts else t0
-    clears = [r.clearance for r in ordered if not (r.method == "culled" and math.isinf(r.clearance))]
+    finite_cull = cull_clear[np.isfinite(cull_clear)]
+    clears = [r.clearance for r in checked_r] + ([float(finite_cull.min())] if len(finite_cull) else [])
     clearance = float(min(clears)) if clears else float("inf")
-    stats = {"pairs": len(ordered), "pairs_culled": sum(r.method == "culled" for r in ordered),
+    stats = {"pairs": len(ordered), "pairs_culled": n_culled,
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud is not None and bud.exhausted)}
     return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        ordered, stats)
+
+
+_new_pair = object.__new__
+_set = object.__setattr__
+
+
+def _culled(ga: str, gb: str, ba: str, bb: str, clearance: float) -> PairResult:
+    """A culled, certified :class:`PairResult` (same object as the constructor builds).
+
+    Hundreds of thousands of these are made for ``pairs="all"``; the dataclass
+    ``__init__`` of a frozen class costs ~9 ``object.__setattr__`` calls, so the instance
+    dict is filled in one step (all fields, same values and types as the constructor).
+    """
+    r = _new_pair(PairResult)
+    _set(r, "__dict__", {"geoms": (ga, gb), "bodies": (ba, bb), "verdict": "certified", "method": "culled",
+                         "tests": 0, "max_depth": 0, "intervals": (), "clearance": clearance,
+                         "witness": None})
+    return r
 
 
 def _sampled_clearances(plan: Any, geoms: list[tuple[Any, Any]], t0: float, t1: float, tol: Tolerances,
