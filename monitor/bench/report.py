@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from monitor._json import jsonable
+
 
 def machine_info() -> dict[str, Any]:
     """CPU model (``/proc/cpuinfo``), core counts, load, versions and the UTC date."""
@@ -47,20 +49,7 @@ def machine_info() -> dict[str, Any]:
 
 
 def _clean(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _clean(x.tolist())
-    if isinstance(x, (np.bool_,)):
-        return bool(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        x = float(x)
-        return x if math.isfinite(x) else None
-    return x
+    return jsonable(x, "null")
 
 
 def write_json(path: Path, results: dict[str, Any]) -> None:

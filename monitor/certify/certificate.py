@@ -16,12 +16,12 @@ All times are seconds of simulation time; points are world-frame metres.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
+from monitor._json import finite_or, jsonable
 from monitor.errors import InvalidInputError
 
 Verdict = Literal["certified", "violation", "uncertain"]
@@ -31,14 +31,7 @@ _RANK = {"certified": 0, "uncertain": 1, "violation": 2}
 
 def _f(x: float | None) -> float | None:
     """JSON-safe float: NaN -> None, +-inf -> +-1e308 (JSON has no inf)."""
-    if x is None:
-        return None
-    x = float(x)
-    if math.isnan(x):
-        return None
-    if math.isinf(x):
-        return 1e308 if x > 0 else -1e308
-    return x
+    return None if x is None else finite_or(x, "clamp")
 
 
 @dataclass(frozen=True)
@@ -195,17 +188,7 @@ def combine_verdicts(verdicts: list[str] | tuple[str, ...]) -> Verdict:
 
 
 def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    if isinstance(x, (np.floating, float)):
-        return _f(float(x))
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    return x
+    return jsonable(x, "clamp")
 
 
 __all__ = ["Certificate", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts"]

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
+from monitor._json import jsonable
 from monitor.errors import InvalidInputError
 from monitor.log import topics
 
@@ -78,22 +79,7 @@ def default_path(env_id: str | None = None, log_dir: str | os.PathLike[str] = DE
 
 def _jsonable(x: Any) -> Any:
     """Numpy -> Python, non-finite floats -> None (strict JSON)."""
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        if x.dtype.kind == "f" and np.isfinite(x).all():
-            return x.tolist()
-        return _jsonable(x.tolist())
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        f = float(x)
-        return f if math.isfinite(f) else None
-    return x
+    return jsonable(x, "null")
 
 
 def _default(x: Any) -> Any:
