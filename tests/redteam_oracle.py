@@ -374,7 +374,8 @@ def upper_distance(a: GeomPose, b: GeomPose, z0: np.ndarray | None = None) -> Wi
     if a.type == PLANE and b.type == PLANE:
         raise ValueError("plane-plane")
     if b.type == PLANE:
-        a, b = b, a
+        w = upper_distance(b, a, z0)
+        return Witness(w.upper, w.y, w.x)
     if a.type == PLANE:
         # exact: min over b of the height above the plane (support function), closed form per type
         n = a.R[:, 2]
@@ -401,8 +402,9 @@ def upper_distance(a: GeomPose, b: GeomPose, z0: np.ndarray | None = None) -> Wi
         yw = b.R @ low + b.p
         h = float(n @ (yw - a.p))
         xw = yw - max(h, 0.0) * n
-        if h < 0:
-            return Witness(h, yw, yw)
+        if h < 0:  # the lowest point is in both (depth 0 in b): look for a point deep in both
+            w = _pen_witness(a, b, yw + 0.5 * h * n)
+            return w if w.upper < 0 else Witness(0.0, yw, yw)
         return Witness(h, xw, yw)
     lp = _lp_overlap(a, b)
     if lp is not None and lp.upper < 0:

@@ -389,3 +389,31 @@ def test_fn_bodymotion_moves_welded_body_explicit_pair():
     assert check_witness(a, b, w) and w.upper < -0.05
     cert = certify(Scene.from_model(m, pairs=[("ga", "gb")]), bm, 0.0, 1e-3)
     _assert_not_certified(cert, "BodyMotion moving a welded body through another")
+
+
+@pytest.mark.slow
+def test_moving_plane_mocap_bodymotion():
+    """A plane on a mocap body, moved and tilted by a BodyMotion, sweeps into a static box."""
+    from monitor import BodyMotion
+
+    xml = ('<mujoco><worldbody><geom name="bx" type="box" size=".1 .2 .3" pos="0 0 -1" euler="10 20 30"/>'
+           '<body name="p" mocap="true"><geom name="pl" type="plane" size="1 1 .1"/></body></worldbody></mujoco>')
+    m = _model(xml)
+    rng = np.random.default_rng(3)
+    scene = Scene.from_model(m, pairs="all")
+    for k in range(6):
+        q1 = np.array([1.0, *rng.normal(scale=0.3, size=3)])
+        q1 /= np.linalg.norm(q1)
+        pos = np.zeros((2, 2, 3))
+        pos[:, 1] = [[0, 0, 0.0], [0, 0, rng.uniform(-1.2, -0.4)]]
+        quat = np.zeros((2, 2, 4))
+        quat[..., 0] = 1.0
+        quat[1, 1] = q1
+        bm = BodyMotion([0.0, 1.0], pos, quat)
+        oracle = TrajectoryOracle(m, bm)
+        r = motion_min(oracle, 0, 1, 0.0, 1.0, n=200)
+        for d in (1e-9, 1e-6):
+            margin = max(r.upper + d, 0.0)
+            for meth in ("auto", "toleranced"):
+                cert = certify(scene, bm, margin, 1e-3, meth)
+                _assert_not_certified(cert, f"moving plane case {k}, margin {margin}, {meth}")
