@@ -170,6 +170,7 @@ def _attack(xml: str, times, qpos, margin: float = 0.0, methods=("auto", "tolera
         if true_min < margin:
             _assert_not_certified(cert, f"{meth}: oracle min {true_min} < margin {margin}")
         if cert.verdict == "certified":
+            assert cert.clearance >= margin, f"{meth}: certified with clearance {cert.clearance} < margin"
             assert cert.clearance <= true_min + 1e-12, f"{meth}: clearance {cert.clearance} > true min {true_min}"
         if cert.verdict == "violation":
             w = cert.witness
@@ -417,3 +418,70 @@ def test_moving_plane_mocap_bodymotion():
             for meth in ("auto", "toleranced"):
                 cert = certify(scene, bm, margin, 1e-3, meth)
                 _assert_not_certified(cert, f"moving plane case {k}, margin {margin}, {meth}")
+
+
+# --------------------------------------------------------------------------- start pose
+
+
+def test_fn_start_penetration_1e13_extrusion():
+    """Start 1e-13 m inside the box, then leave by translation: extrusion certifies (see FN 3)."""
+    test_start_penetration_moving_away(1e-13, "auto")
+
+
+@pytest.mark.parametrize("pen", [1e-6, 1e-9, 1e-11])
+@pytest.mark.parametrize("method", ["auto", "toleranced"])
+def test_start_penetration_moving_away(pen, method):
+    """The sphere starts pen metres inside the box face and leaves: never 'certified'."""
+    xml = ('<mujoco><worldbody><geom name="box" type="box" size=".5 .5 .5"/><body name="b">'
+           '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+           '<joint name="x" type="slide" axis="1 0 0"/><joint name="h" type="hinge" axis="0 0 1"/>'
+           '<geom name="s" type="sphere" size=".1"/></body></worldbody></mujoco>')
+    x0 = 0.6 - pen
+    assert 0.5 - (x0 - 0.1) > 0  # the sphere's leftmost point is inside the box face at t0
+    q1 = [[x0 + 1.0, 0.0 if method == "auto" else 1.0]]
+    m = _model(xml)
+    plan = Plan([0.0, 1.0], [[x0, 0.0], *q1], m)
+    cert = certify(Scene.from_model(m, pairs="all"), plan, 0.0, 1e-3, method)
+    _assert_not_certified(cert, f"start penetration {pen}")
+
+
+@pytest.mark.parametrize("method", ["auto", "toleranced"])
+def test_start_touching_margin_zero_not_violation(method):
+    """Exactly touching at t0 (distance 0) and moving away: distance 0 is not < margin 0."""
+    xml = ('<mujoco><worldbody><geom name="box" type="box" size=".5 .5 .5"/><body name="b">'
+           '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+           '<joint name="x" type="slide" axis="1 0 0"/><joint name="h" type="hinge" axis="0 0 1"/>'
+           '<geom name="s" type="sphere" size=".125"/></body></worldbody></mujoco>')
+    m = _model(xml)
+    plan = Plan([0.0, 1.0], [[0.625, 0.0], [1.625, 0.0 if method == "auto" else 1.0]], m)
+    cert = certify(Scene.from_model(m, pairs="all"), plan, 0.0, 1e-3, method)
+    assert cert.verdict != "violation", f"touching reported as violation: {cert.witness}"
+
+
+# --------------------------------------------------------------------------- FN 3: extrusion picometre penetration
+
+
+@pytest.mark.parametrize("margin", [0.0, 0.01])
+def test_fn_extrusion_certifies_picometre_shortfall(margin):
+    """A translating sphere reaches distance margin - 1e-12 m from a box (a 1e-12 m penetration at
+    margin 0): the extrusion checker certifies it, with a certificate clearance BELOW the margin
+    (-3.6e-12 at margin 0, 0.0099999999964 at margin 0.01). The toleranced checker says "uncertain".
+
+    Cause (monitor/certify/extrusion*.py): the quadratic path certifies when the core distance is
+    >= r - extrusion_slack / the LP slack <= extrusion_slack, i.e. it accepts shortfalls below the
+    slack instead of returning "unresolved" (which the engine would turn into "uncertain").
+    """
+    xml = ('<mujoco><worldbody><geom name="wall" type="box" size=".5 .5 .5"/><body name="b">'
+           '<joint name="sx" type="slide" axis="1 0 0"/><geom name="mv" type="sphere" size=".1"/></body>'
+           '</worldbody></mujoco>')
+    m = _model(xml)
+    pen = 1e-12
+    plan = Plan([0.0, 1.0, 2.0], [[2.0], [0.6 + margin - pen], [2.0]], m)
+    # verified: at t = 1 the sphere centre is at x_c; the point z is in the box and within
+    # (0.1 + margin) of x_c, i.e. distance(box, sphere) < margin (penetration when margin = 0)
+    x_c = float(plan.body_poses(np.array([1.0]))[0][0, 1, 0])
+    z = 0.5 - 0.25 * pen if margin == 0.0 else 0.5
+    assert 0.5 - abs(z) >= 0.0 and (0.1 + margin) - abs(x_c - z) > 0.25 * pen
+    for method in ("auto", "extrusion"):
+        cert = certify(Scene.from_model(m, pairs="all"), plan, margin, 1e-3, method)
+        _assert_not_certified(cert, f"{method}: shortfall {pen} m below margin {margin}")
