@@ -485,3 +485,9 @@ def test_fn_extrusion_certifies_picometre_shortfall(margin):
     for method in ("auto", "extrusion"):
         cert = certify(Scene.from_model(m, pairs="all"), plan, margin, 1e-3, method)
         _assert_not_certified(cert, f"{method}: shortfall {pen} m below margin {margin}")
+
+
+@pytest.mark.parametrize("q_off", [1e5, -3e6])
+def test_graze_large_hinge_coordinates(q_off):
+    """Hinge coordinates around 1e5..3e6 rad: lerp rounding ~1e-10 rad must be padded."""
+    _graze(_corner_case(0.0, 1.0), [0.0, 1.0], [[q_off - 2.0], [q_off + 2.0]], n=300)
