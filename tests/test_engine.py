@@ -13,6 +13,7 @@ from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.geometry.distance import shape_distance
 from monitor.motion.plan import Plan
 from monitor.scene import Scene
+from monitor.tolerances import Tolerances
 
 XML = """
 <mujoco>
@@ -239,3 +240,69 @@ def test_touching_translating_boxes_are_certified_by_extrusion():
     # A small margin turns the same motion into a confirmed violation at t0.
     cert = monitor.certify(scene, plan, margin=1e-3, method="auto")
     assert cert.verdict == "violation" and cert.witness.time == 0.0
+
+
+# ----------------------------------------------------------------------------- frontier cap
+
+
+def _covered(inner, outer):
+    """Every interval of ``inner`` lies inside one merged interval of ``outer``."""
+    return all(any(a <= lo and hi <= b for a, b in outer) for lo, hi in inner)
+
+
+def test_frontier_over_cap_matches_a_per_pair_reference():
+    from monitor.certify.toleranced import frontier_over_cap
+
+    rng = np.random.default_rng(11)
+    pair = rng.integers(0, 4, 300)
+    t0 = rng.random(300)
+    go = rng.random(300) < 0.7
+    for cap in (0, 1, 5, 40, 1000):
+        got = frontier_over_cap(pair, t0, go, cap)
+        ref = np.zeros(300, bool)
+        if cap > 0:
+            for p in range(4):
+                idx = [i for i in np.argsort(t0, kind="stable") if pair[i] == p and go[i]]
+                ref[idx[cap:]] = True
+        np.testing.assert_array_equal(got, ref)
+
+
+def test_frontier_cap_keeps_every_uncapped_interval_unresolved(scene, model):
+    from monitor.certify import toleranced
+
+    plan = _plan(model, (1.0, 0.5))                  # link and handbox sweep through the table
+    items = []
+    for a, b in (("table", "link"), ("table", "handbox")):
+        ga, gb = scene.geom(a), scene.geom(b)
+        items.append((ga.shape, ga.body_id, gb.shape, gb.body_id))
+    static = ~np.asarray(plan.moving_bodies(), bool)
+    free = toleranced.check_pairs(plan, items, (plan.t0, plan.t1), 0.0, 1e-4,
+                                  Tolerances(max_frontier=0), static=static)
+    capped = toleranced.check_pairs(plan, items, (plan.t0, plan.t1), 0.0, 1e-4,
+                                    Tolerances(max_frontier=2), static=static)
+    assert any(o.info["frontier_capped"] > 0 for o in capped)
+    assert all(o.info["frontier_capped"] == 0 for o in free)
+    for f, c in zip(free, capped):
+        assert f.verdict == "unresolved" and c.verdict == "unresolved"
+        assert _covered(f.intervals, c.intervals)           # the cap only widens what is unresolved
+        assert c.info["items"] <= f.info["items"]
+
+
+def test_frontier_cap_never_certifies(scene, model):
+    # the arm dips towards the table twice (clear by ~6 mm each time): two separate
+    # sub-intervals of the same pairs fire at the deeper levels
+    Q = np.stack([model.qpos0.copy()] * 5)
+    Q[:, 0] = [0.0, 0.65, 0.0, 0.65, 0.0]
+    plan = Plan(np.linspace(0.0, 1.0, 5), Q, model)
+    assert _oracle_min(scene, plan) > 0
+    full = certify(scene, plan, method="toleranced")
+    assert full.verdict == "certified"
+    cut = certify(scene, plan, method="toleranced", tolerances=Tolerances(max_frontier=1))
+    assert cut.verdict == "uncertain"                # no witness exists: the motion is clear
+    bad = [p for p in cut.pairs if p.verdict != "certified"]
+    assert bad and all(p.method == "toleranced" and p.intervals for p in bad)
+    # the earliest items are kept: the first dip is resolved, the rest is left unresolved
+    assert all(p.intervals[0][0] >= 0.25 for p in bad)
+    hit = certify(scene, _plan(model, (1.0, 0.5)), method="toleranced", epsilon=1e-4,
+                  tolerances=Tolerances(max_frontier=1))
+    assert hit.verdict == "violation"

@@ -6,10 +6,12 @@ Pipeline for one window [t0, t1] and the scene's candidate geom pairs:
    non-empty finite window inside the plan, a known method, a plan of the scene's model
    (``plan.model is scene.model`` or equal model hashes; otherwise the body count must
    match), known pair names.
-2. **Cull.** Pairs of two scene-static bodies (welded to the world) are ``"culled"``
-   (MuJoCo never collides them either). Pairs whose swept bounding spheres
-   (:mod:`monitor.certify.broadphase`, 8 sub-intervals) stay further apart than the
-   margin are ``"culled"`` and certified, with the sphere gap as clearance bound.
+2. **Cull.** Pairs of two scene-static bodies (welded to the world) that the plan does
+   not move either are ``"culled"`` (MuJoCo never collides them either; a
+   :class:`monitor.BodyMotion` may move a welded body, and then the pair is checked).
+   Pairs whose swept bounding spheres (:mod:`monitor.certify.broadphase`, 8
+   sub-intervals, all pairs at once in numpy) stay further apart than the margin are
+   ``"culled"`` and certified, with the sphere gap as clearance bound.
 3. **Start pose.** Every remaining pair gets the exact static distance at t0
    (:func:`monitor.geometry.distance.shape_distance`): ``upper < margin`` is a violation
    at t0 (method ``"static"``). If neither that nor clear cores can be proven, the pair can
@@ -167,7 +169,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     sel_a = np.asarray(sel, np.int64)
     pid = np.asarray(scene.pair_ids, np.int64).reshape(-1, 2)[sel_a]
     geom_body = np.array([g.body_id for g in scene.geoms], np.int64)
-    ss = static[geom_body[pid[:, 0]]] & static[geom_body[pid[:, 1]]]
+    # welded to the world AND not moved by the plan (a BodyMotion may move any body)
+    fixed = static & ~moving
+    ss = fixed[geom_body[pid[:, 0]]] & fixed[geom_body[pid[:, 1]]]
     cull_clear = np.full(len(sel_a), np.nan)          # clearance of culled pairs (inf: static-static)
     cull_clear[ss] = np.inf
     live = np.nonzero(~ss)[0]

@@ -94,7 +94,9 @@ every comparison is written so that NaN fires.
 
 Termination (eq. 11): an item that is not excluded ends as an interval of possible
 violation once R * rho_max < epsilon, or at ``tolerances.max_depth``, or when the
-budget runs out.
+budget runs out, or when its pair already splits ``tolerances.max_frontier`` earlier
+items at the same level (memory cap; the item's whole interval stays unresolved, which
+can only make the verdict less certain).
 """
 
 from __future__ import annotations
@@ -930,6 +932,33 @@ class SubdivisionResult:
     items: np.ndarray        # per pair: ball tests (items evaluated)
     exhausted: bool
     prefiltered: np.ndarray | None = None  # per pair: items excluded by the pre-filter
+    capped: np.ndarray | None = None  # per pair: items left unresolved by the frontier cap
+
+
+def frontier_over_cap(pair: np.ndarray, t0: np.ndarray, go: np.ndarray, cap: int) -> np.ndarray:
+    """Items to stop because their pair already splits ``cap`` earlier items at this level.
+
+    Args:
+        pair: (N,) pair index of each frontier item.
+        t0: (N,) item start times (s); earlier items are kept.
+        go: (N,) bool, items that would be split.
+        cap: maximum items split per pair (<= 0: no cap).
+
+    Returns:
+        (N,) bool mask (subset of ``go``) of the items over the cap.
+    """
+    over = np.zeros(len(pair), bool)
+    if cap <= 0:
+        return over
+    idx = np.nonzero(go)[0]
+    if len(idx) <= cap:
+        return over
+    order = idx[np.lexsort((t0[idx], pair[idx]))]
+    sp = pair[order]
+    starts = np.concatenate([[0], np.nonzero(np.diff(sp))[0] + 1])
+    rank = np.arange(len(order)) - np.repeat(starts, np.diff(np.concatenate([starts, [len(order)]])))
+    over[order[rank >= cap]] = True
+    return over
 
 
 def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: float, epsilon: float,
@@ -965,6 +994,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     row_tests = np.zeros(npair, np.int64)
     items_n = np.zeros(npair, np.int64)
     max_depth = np.zeros(npair, np.int64)
+    capped = np.zeros(npair, np.int64)
     exhausted = False
     while len(fr.pair):
         if budget is not None and budget.exhausted:
@@ -1001,6 +1031,11 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         for i in np.nonzero(stop)[0]:
             intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
         go = item_fired & ~stop
+        over = frontier_over_cap(fr.pair, fr.t0, go, int(tol.max_frontier))
+        for i in np.nonzero(over)[0]:
+            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+        np.add.at(capped, fr.pair[over], 1)
+        go &= ~over
         if not go.any():
             break
         keep = np.nonzero(go)[0]
@@ -1017,7 +1052,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     for lst in intervals:
         lst.sort()
     return SubdivisionResult([_merge(x) for x in intervals], unit_tests, row_tests, max_depth, items_n,
-                             exhausted, prefiltered)
+                             exhausted, prefiltered, capped)
 
 
 def first_interval_dfs(pd: _PairData, provider: BallProvider, t0: float, t1: float, epsilon: float,
@@ -1214,10 +1249,11 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
                 info={"unit_tests": int(res.unit_tests[i]), "row_tests": int(res.row_tests[i]),
                       "items": int(res.items[i]), "swapped": bool(swapped[i]),
                       "prefiltered": int(res.prefiltered[i]),
+                      "frontier_capped": int(res.capped[i]),
                       "budget_exhausted": bool(res.exhausted)})
     return outs  # type: ignore[return-value]
 
 
 __all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
            "subdivide", "check_pairs", "BallProvider", "SubdivisionResult", "first_interval_dfs",
-           "fat_units_fire", "prefilter_separated"]
+           "fat_units_fire", "prefilter_separated", "frontier_over_cap"]
