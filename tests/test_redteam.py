@@ -590,3 +590,33 @@ def test_random_sweep_margin_trick():
             for meth in ("auto", "toleranced"):
                 cert = certify(scene, plan, margin, 1e-3, meth, budget=Budget(seconds=3.0))
                 _assert_not_certified(cert, f"seed {seed}, margin {margin}, {meth}")
+
+
+# --------------------------------------------------------------------------- FN 4: maxhullvert
+
+
+def test_fn_mesh_maxhullvert_reduced_hull():
+    """A mesh with maxhullvert="4": Scene takes the 4-vertex hull from mesh_graph, but MuJoCo 4.0
+    still collides the sphere with the full mesh (mj_forward reports a contact, mj_geomDistance
+    -0.031 m) when the sphere crosses the corner outside the reduced hull: certified anyway.
+    """
+    v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [.6, .6, .6],
+                  [-.6, -.6, .6]]) * 0.3
+    verts = " ".join(repr(float(x)) for x in v.ravel())
+    xml = (f'<mujoco><asset><mesh name="m" vertex="{verts}" maxhullvert="4"/></asset><worldbody>'
+           '<geom name="hull" type="mesh" mesh="m"/><body name="b"><freejoint/>'
+           '<geom name="s" type="sphere" size=".02"/></body></worldbody></mujoco>')
+    m = _model(xml)
+    q = np.array([[0.17 - 0.5, 0.17 + 0.5, 0.17, 1, 0, 0, 0], [0.17 + 0.5, 0.17 - 0.5, 0.17, 1, 0, 0, 0]])
+    plan = Plan([0.0, 1.0], q, m)
+    # independent evidence at t = 0.5 (sphere centre at (0.17, 0.17, 0.17)): MuJoCo's own contact ...
+    d = mujoco.MjData(m)
+    d.qpos[:] = [0.17, 0.17, 0.17, 1, 0, 0, 0]
+    mujoco.mj_forward(m, d)
+    assert d.ncon >= 1 and mujoco.mj_geomDistance(m, d, 0, 1, 1.0, np.zeros(6)) < -0.01
+    # ... and the oracle's verified witness against the hull of all mesh vertices
+    a, b = PlanOracle(m, [0.0, 1.0], q).geoms(0.5, (0, 1))
+    w = upper_distance(a, b)
+    assert check_witness(a, b, w) and w.upper < 0
+    cert = certify(Scene.from_model(m, pairs="all"), plan, 0.0, 1e-3)
+    _assert_not_certified(cert, "sphere through the corner of a maxhullvert-reduced mesh hull")
