@@ -461,7 +461,7 @@ def test_start_touching_margin_zero_not_violation(method):
     assert cert.verdict != "violation", f"touching reported as violation: {cert.witness}"
 
 
-# --------------------------------------------------------------------------- FN 3 (passes since the extrusion/engine changes)
+# --------------------------------------------------------------------------- FN 3 (passes since the extrusion
 
 
 @pytest.mark.parametrize("margin", [0.0, 0.01])
@@ -632,3 +632,49 @@ def test_containment_whole_window(small, method):
     q1 = (1.0, 0.0, 0.0, 0.0) if method == "auto" else (0.0, 1.0, 0.0, 0.0)
     out = _attack(xml, [0.0, 1.0], [_free([-0.5, 0, 0]), _free([0.5, 0.2, 0], q1)], methods=(method,), n=60)
     assert out[method].verdict == "violation"
+
+
+def _rot_angle(R: np.ndarray) -> np.ndarray:
+    """Rotation angle, well conditioned for small angles: ||R - I||_F = 2 sqrt(2) sin(angle / 2)."""
+    f = np.linalg.norm(R - np.eye(3), axis=(-2, -1))
+    return 2.0 * np.arcsin(np.clip(f / (2.0 * np.sqrt(2.0)), 0.0, 1.0))
+
+
+@pytest.mark.parametrize("chain", ["free", "hinge_ball"])
+def test_near_half_turn_motion_bound_contract(chain):
+    """Random (near-)orthogonal quaternion pairs (+-1e-17 along q0): the motion-bound contract
+    (reference-point displacement and rotation angle) on sub-intervals, checked by sampling."""
+    xml = {"free": ('<mujoco><worldbody><body name="b"><freejoint/><geom name="s" type="sphere" size=".1" '
+                    'pos="1 0 0"/></body></worldbody></mujoco>'),
+           "hinge_ball": ('<mujoco><worldbody><body name="h"><inertial pos="0 0 0" mass="1" diaginertia=".1 .1 .1"/>'  # noqa: E501
+                          '<joint name="hh" type="hinge" axis="0 0 1"/><body name="c" pos=".5 0 0">'
+                          '<inertial pos="0 0 0" mass="1" diaginertia=".1 .1 .1"/><joint name="ball" type="ball"/>'  # noqa: E501
+                          '<geom name="s" type="sphere" size=".1" pos="1 0 0"/></body></body></worldbody></mujoco>')}[chain]  # noqa: E501
+    m = _model(xml)
+    body = m.nbody - 1
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        q0 = rng.normal(size=4)
+        q0 /= np.linalg.norm(q0)
+        r = rng.normal(size=4)
+        r -= (r @ q0) * q0
+        r /= np.linalg.norm(r)
+        r = r + rng.choice([0.0, 1e-17, -1e-17]) * q0
+        if chain == "free":
+            Q = np.array([[0, 0, 0, *q0], [0, 0, 0, *r]])
+            P, R = Plan([0.0, 1.0], Q, m).body_poses(np.array([0.5 - 1e-6, 0.5, 0.5 + 1e-6]))
+            W = (R[2, body] - R[0, body]) @ R[1, body].T / 2e-6
+            v = np.cross([W[2, 1], W[0, 2], W[1, 0]], R[1, body] @ np.array([1.0, 0, 0]))
+            Q[0, :3], Q[1, :3] = -0.5 * v, 0.5 * v  # translation along omega x (R g): worst case for a sign flip  # noqa: E501
+        else:
+            Q = np.array([[0.0, *q0], [rng.uniform(-2, 2), *r]])
+        pl = Plan([0.0, 1.0], Q, m)
+        ref = pl.ref_points[body]
+        for tm, h in ((0.5, 1e-3), (0.5, 1e-2), (float(rng.uniform(0.1, 0.9)), 1e-4)):
+            mb = pl.motion_bounds(np.array([tm - h]), np.array([tm + h]))
+            ts = np.linspace(tm - h, tm + h, 101)
+            P, R = pl.body_poses(ts)
+            pr = np.einsum("tij,j->ti", R[:, body], ref) + P[:, body]
+            assert np.linalg.norm(pr - pr[50], axis=1).max() <= mb.trans[0, body]
+            ang = _rot_angle(np.einsum("tij,kj->tik", R[:, body], R[50, body]))
+            assert ang.max() <= mb.angle[0, body] + 1e-12
