@@ -218,31 +218,37 @@ def test_swept_sphere_gap_is_a_lower_bound_of_the_sampled_distance():
     assert checked > 20
 
 
-def test_touching_translating_boxes_are_certified_by_extrusion():
+def test_touching_translating_boxes_are_uncertain_not_violation():
     """Two boxes resting face to face (distance exactly 0, margin 0) while one slides along
-    the shared face: touching is not a collision (regularised semantics). The extrusion
-    checker decides t0 itself, so the engine must not demote the pair to uncertain."""
+    the shared face. Touching is not a collision (regularised semantics: never "violation"),
+    and 0 is not > margin, so it cannot be certified either: "uncertain". The start-pose
+    rule does not demote extruded pairs; the engine's stricter extrusion margin does.
+    A clear gap is certified by the extrusion checker, and a margin above the gap is a
+    confirmed violation at t0."""
     import mujoco
 
     import monitor
 
-    xml = """<mujoco><worldbody>
-      <body name="base"><geom name="lower" type="box" size="0.5 0.5 0.5" pos="0 0 -0.5"/></body>
-      <body name="slider"><joint name="sx" type="slide" axis="1 0 0"/>
-        <geom name="upper" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/></body>
-    </worldbody></mujoco>"""
-    model = mujoco.MjModel.from_xml_string(xml)
-    scene = monitor.Scene.from_model(model, pairs="all")
-    plan = monitor.Plan([0.0, 1.0], [[0.0], [0.2]], model=model)
+    def scene_plan(gap):
+        xml = f"""<mujoco><worldbody>
+          <body name="base"><geom name="lower" type="box" size="0.5 0.5 0.5" pos="0 0 -0.5"/></body>
+          <body name="slider"><joint name="sx" type="slide" axis="1 0 0"/>
+            <geom name="upper" type="box" size="0.1 0.1 0.1" pos="0 0 {0.1 + gap!r}"/></body>
+        </worldbody></mujoco>"""
+        model = mujoco.MjModel.from_xml_string(xml)
+        plan = monitor.Plan([0.0, 1.0], [[0.0], [0.2]], model=model)
+        return monitor.Scene.from_model(model, pairs="all"), plan
+
+    scene, plan = scene_plan(0.0)
     cert = monitor.certify(scene, plan, margin=0.0, method="auto")
-    assert cert.verdict == "certified", cert.pairs
-    assert cert.pairs[0].method == "extrusion"
-    # A small margin turns the same motion into a confirmed violation at t0.
+    assert cert.verdict == "uncertain" and cert.pairs[0].method == "extrusion", cert.pairs
+    scene, plan = scene_plan(1e-6)
+    cert = monitor.certify(scene, plan, margin=0.0, method="auto")
+    assert cert.verdict == "certified" and cert.pairs[0].method == "extrusion", cert.pairs
+    assert cert.clearance <= 1e-6 + 1e-12
     cert = monitor.certify(scene, plan, margin=1e-3, method="auto")
     assert cert.verdict == "violation" and cert.witness.time == 0.0
 
-
-# ----------------------------------------------------------------------------- frontier cap
 
 
 def _covered(inner, outer):
