@@ -10,9 +10,9 @@ Geom type -> shape (body frame):
 sphere     point + radius (exact)
 capsule    segment + radius (exact)
 box        polytope (exact)
-mesh       convex hull of the vertices MuJoCo collides: the ``mesh_graph`` hull
-           vertices when the compiler stored a hull (respects ``maxhullvert``),
-           else all ``mesh_vert`` (float32, mesh frame == geom frame) (exact)
+mesh       convex hull of all compiled ``mesh_vert`` (float32, mesh frame == geom
+           frame): exact for MuJoCo's hull; with ``maxhullvert`` a superset of
+           MuJoCo's reduced hull (which MuJoCo itself does not always respect)
 cylinder   circumscribed regular prism (``facets`` sides), reported
 ellipsoid  circumscribed tangent-plane polytope, reported
 plane      half-space ``{z <= 0}`` in the geom frame (exact; MuJoCo planes are
@@ -154,12 +154,11 @@ def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape
     if t == int(mujoco.mjtGeom.mjGEOM_MESH):
         mid = int(model.geom_dataid[g])
         a, n = int(model.mesh_vertadr[mid]), int(model.mesh_vertnum[mid])
+        # All compiled vertices, never the mesh_graph hull: with maxhullvert that hull is
+        # reduced (it lies inside the mesh) and MuJoCo 4.0 still reports contacts with the
+        # full mesh, so certifying against it would be unsound (red-team test
+        # test_fn_mesh_maxhullvert_reduced_hull). The hull of all vertices contains both.
         V = np.asarray(model.mesh_vert[a:a + n], dtype=np.float64)
-        ga = int(model.mesh_graphadr[mid])
-        if ga >= 0:
-            nv = int(model.mesh_graph[ga])
-            vid = np.asarray(model.mesh_graph[ga + 2 + nv: ga + 2 + 2 * nv], dtype=np.int64)
-            V = V[vid]
         try:
             return polytope_from_points(V)
         except InvalidInputError:
