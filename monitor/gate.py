@@ -39,6 +39,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -107,8 +108,8 @@ class Rollout:
         from monitor.motion.plan import Plan
 
         times, qpos = self.states(data, ctrl, nstep)
-        return Plan(times, qpos, model=self.model, mocap_pos=np.array(data.mocap_pos),
-                    mocap_quat=np.array(data.mocap_quat))
+        return Plan._trusted(times, qpos, model=self.model, mocap_pos=np.array(data.mocap_pos),
+                             mocap_quat=np.array(data.mocap_quat))
 
     def brake_tail(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
                    brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
@@ -137,8 +138,8 @@ class Rollout:
             qvel.append(s.qvel.copy())
             if m.nv == 0 or float(np.max(np.abs(s.qvel))) <= vel_tol:
                 break
-        plan = Plan(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
-                    mocap_quat=np.array(data.mocap_quat))
+        plan = Plan._trusted(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
+                             mocap_quat=np.array(data.mocap_quat))
         return plan, brake, np.array(qvel)
 
 
@@ -260,9 +261,11 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         checker = np.full(int(npairs or 0), "", dtype=object)
         mix, wit, earliest, clearance = "", None, inf, inf
     else:
-        checker = np.array([p.method for p in cert.pairs], dtype=object)
-        methods, counts = np.unique(checker.astype(str), return_counts=True)
-        mix = " ".join(f"{m}:{c}" for m, c in zip(methods, counts))
+        names = [str(p.method) for p in cert.pairs]
+        checker = np.empty(len(names), dtype=object)
+        checker[:] = names
+        counts = Counter(names)
+        mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
         clearance = float(cert.clearance)
@@ -595,7 +598,11 @@ class Gate:
         cert, us = self._certify(plan)
         unsafe = self.is_unsafe(cert.verdict)
         brake_verdict, brake_next = "", None
-        if not unsafe and self._brake_active(fallback):
+        if not unsafe and self._brake_active(fallback) and not self.scene.candidate_pairs:
+            # No candidate pairs: every window (the tail's too) certifies trivially and
+            # no proposal can ever be rejected, so the tail and its brake are never used.
+            brake_verdict = "certified"
+        elif not unsafe and self._brake_active(fallback):
             tail, brake_next, tail_qvel = self._rollout.brake_tail(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
             tail_cert, tail_us = self._certify(tail)

@@ -8,8 +8,16 @@ hinge and slide coordinates are lerped; a free joint lerps its position and
 slerps its quaternion (shortest arc, about the body origin); a ball joint slerps
 (shortest arc). Mocap bodies hold ``mocap_pos/mocap_quat`` over the window.
 
-Poses come from ``mujoco.mj_kinematics`` on a private scratch ``MjData``; a live
+Poses come from ``mujoco.mj_kinematics`` on a scratch ``MjData`` private to the
+calling thread (one per thread and model, shared by that thread's plans); a live
 ``MjData`` is never read or written.
+
+Per-step cost. Everything derived from the model alone (joint/body topology, chains,
+reference points, plain-numpy copies of the geometry) is computed once and cached
+under the bytes of the model arrays it reads, so a model edited in place gets a
+fresh structure. The waypoint FK and the rounding scale are computed on first use,
+and small ``motion_bounds`` / ``body_poses`` queries are memoised per plan (pure
+functions of their arguments). None of this changes a computed number.
 
 Derivation of the certified motion bound
 ----------------------------------------
@@ -102,6 +110,8 @@ has no geoms.
 
 from __future__ import annotations
 
+import threading
+
 import mujoco
 import numpy as np
 
@@ -119,16 +129,160 @@ _HINGE = int(mujoco.mjtJoint.mjJNT_HINGE)
 def _ref_points(model: mujoco.MjModel) -> np.ndarray:
     """(nbody, 3) body-frame reference points near each body's geoms."""
     ref = np.array(model.body_ipos, dtype=np.float64)
-    for b in range(model.nbody):
-        g = np.flatnonzero(model.geom_bodyid == b)
-        if g.size == 0:
-            continue
-        r = np.asarray(model.geom_rbound[g])[:, None]
-        p = np.asarray(model.geom_pos[g])
-        lo = (p - r).min(axis=0)
-        hi = (p + r).max(axis=0)
-        ref[b] = 0.5 * (lo + hi)
+    gb = np.asarray(model.geom_bodyid)
+    if gb.size == 0:
+        return ref
+    r = np.asarray(model.geom_rbound, dtype=np.float64)[:, None]
+    p = np.asarray(model.geom_pos, dtype=np.float64)
+    lo = np.full_like(ref, np.inf)
+    hi = np.full_like(ref, -np.inf)
+    np.minimum.at(lo, gb, p - r)
+    np.maximum.at(hi, gb, p + r)
+    has = np.zeros(ref.shape[0], dtype=bool)
+    has[gb] = True
+    ref[has] = 0.5 * (lo[has] + hi[has])
     return ref
+
+
+# Per-model structure (joint/body topology, plain-numpy copies of the geometry),
+# cached under a key made of the bytes of EVERY model array it is derived from:
+# a model edited in place (e.g. domain randomisation of body_pos) gets a new key.
+_STRUCT_FIELDS = ("jnt_type", "jnt_qposadr", "jnt_bodyid", "jnt_pos", "jnt_axis", "qpos0",
+                  "body_parentid", "body_mocapid", "body_jntadr", "body_jntnum", "body_pos",
+                  "body_quat", "body_ipos", "geom_bodyid", "geom_pos", "geom_rbound")
+_STRUCT_CACHE: dict[bytes, _ModelStructure] = {}
+_STRUCT_CACHE_MAX = 16
+
+
+class _ModelStructure:
+    """Everything :class:`Plan` derives from the model alone (read-only, shared)."""
+
+    def __init__(self, model: mujoco.MjModel):
+        nbody = model.nbody
+        jtype = np.asarray(model.jnt_type)
+        jadr = np.asarray(model.jnt_qposadr)
+        self.jtype_list = [int(x) for x in jtype]
+        self.jadr_list = [int(x) for x in jadr]
+        self.njnt = model.njnt
+        self.nq = model.nq
+        self.nbody = nbody
+        self.nmocap = model.nmocap
+        mocap_bodies = np.flatnonzero(np.asarray(model.body_mocapid) >= 0)
+        mocap_bodies = mocap_bodies[np.argsort(np.asarray(model.body_mocapid)[mocap_bodies])]
+        self.mocap_pos0 = np.array(model.body_pos[mocap_bodies], dtype=np.float64).reshape(self.nmocap, 3)
+        self.mocap_quat0 = np.array(model.body_quat[mocap_bodies], dtype=np.float64).reshape(self.nmocap, 4)
+        # (joint, first quaternion column, label) of every ball / free joint.
+        self.quat_joints: list[tuple[int, int, str]] = []
+        for j in range(model.njnt):
+            if jtype[j] in (_BALL, _FREE):
+                a = int(jadr[j]) + (3 if jtype[j] == _FREE else 0)
+                name = model.joint(j).name or f"joint{j}"
+                self.quat_joints.append((j, a, f"qpos (joint {name!r}, qpos columns {a}..{a + 3})"))
+        lin = np.ones(model.nq, dtype=bool)
+        for _, a, _ in self.quat_joints:
+            lin[a:a + 4] = False
+        self.lin = lin
+        self.parent = [int(x) for x in model.body_parentid]
+        self.mocap = [int(x) >= 0 for x in model.body_mocapid]
+        self.jnt_of_body = [
+            list(range(int(model.body_jntadr[b]), int(model.body_jntadr[b]) + int(model.body_jntnum[b])))
+            for b in range(nbody)
+        ]
+        axes = np.array(model.jnt_axis, dtype=np.float64).reshape(-1, 3)
+        self.jnt = {
+            "type": self.jtype_list,
+            "adr": self.jadr_list,
+            "pos": np.array(model.jnt_pos, dtype=np.float64).reshape(-1, 3),
+            "axis": axes,
+            "axis_norm": np.linalg.norm(axes, axis=-1),
+            "qpos0": np.array(model.qpos0, dtype=np.float64),
+        }
+        self.qpos0_mag = float(np.max(np.abs(self.jnt["qpos0"]), initial=0.0))
+        self.body_pos = np.array(model.body_pos, dtype=np.float64)
+        self.body_quat = np.array(model.body_quat, dtype=np.float64)
+        self.body_mat = K.quat_to_mat(self.body_quat)
+        qwidth = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}
+        # Per body, per own joint: (all columns, rotational columns or None).
+        self.body_cols: list[list[tuple[slice, slice | None]]] = []
+        for b in range(nbody):
+            cols = []
+            for j in self.jnt_of_body[b]:
+                typ, a = self.jtype_list[j], self.jadr_list[j]
+                whole = slice(a, a + qwidth[typ])
+                if typ in (_HINGE, _BALL):
+                    rot = whole
+                elif typ == _FREE:
+                    rot = slice(a + 3, a + 7)
+                else:
+                    rot = None
+                cols.append((whole, rot))
+            self.body_cols.append(cols)
+        vkind, vbody = [], []
+        self.first_v: dict[int, int] = {}
+        for j in range(model.njnt):
+            self.first_v[j] = len(vkind)
+            kinds = {_HINGE: [0], _SLIDE: [1], _BALL: [2], _FREE: [3, 4]}[self.jtype_list[j]]
+            for kd in kinds:
+                vkind.append(kd)
+                vbody.append(int(model.jnt_bodyid[j]))
+        self.vkind = np.array(vkind, dtype=np.int64)
+        self.own_v = [[v for v in range(len(vkind)) if vbody[v] == b] for b in range(nbody)]
+        # (nbody, nq) masks of each body's own joint columns / rotational columns.
+        self.own_cols = np.zeros((nbody, model.nq), dtype=bool)
+        self.own_rot_cols = np.zeros((nbody, model.nq), dtype=bool)
+        for b in range(1, nbody):
+            if self.mocap[b]:
+                continue
+            for whole, rot in self.body_cols[b]:
+                self.own_cols[b, whole] = True
+                if rot is not None:
+                    self.own_rot_cols[b, rot] = True
+        # Chains (virtual joints root -> body over the moving bodies) per moving pattern.
+        self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
+        self.ref = _ref_points(model)
+        self.ref.setflags(write=False)
+        self.ref_norm = float(np.max(np.linalg.norm(self.ref, axis=-1), initial=0.0))
+        for arr in (self.mocap_pos0, self.mocap_quat0, self.lin, self.body_pos, self.body_quat,
+                    self.body_mat, self.vkind, *self.jnt.values()):
+            if isinstance(arr, np.ndarray):
+                arr.setflags(write=False)
+
+
+# FK scratch data: one ``MjData`` per (thread, model), shared by that thread's plans of
+# the model. ``_fk`` writes every input of ``mj_kinematics`` (qpos, mocap) before each
+# call and copies the outputs out, so sharing within a thread is exact; no two
+# threads share one (creating an ``MjData`` costs ~0.1-1 ms, more than a small plan).
+_FK_POOL = threading.local()
+_FK_POOL_MAX = 8
+
+
+def _fk_data(model: mujoco.MjModel) -> mujoco.MjData:
+    """The calling thread's scratch ``MjData`` for ``model``."""
+    pool = getattr(_FK_POOL, "data", None)
+    if pool is None:
+        pool = _FK_POOL.data = {}
+    hit = pool.get(id(model))
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    if len(pool) >= _FK_POOL_MAX:
+        pool.pop(next(iter(pool)))
+    d = mujoco.MjData(model)
+    pool[id(model)] = (model, d)  # the model reference keeps id(model) unique
+    return d
+
+
+def _structure(model: mujoco.MjModel) -> _ModelStructure:
+    """The (cached) :class:`_ModelStructure` of ``model``'s current arrays."""
+    key = b"|".join([np.asarray([model.nq, model.nv, model.njnt, model.nbody, model.nmocap,
+                                 model.ngeom]).tobytes()]
+                    + [np.ascontiguousarray(getattr(model, f)).tobytes() for f in _STRUCT_FIELDS])
+    st = _STRUCT_CACHE.get(key)
+    if st is None:
+        st = _ModelStructure(model)
+        if len(_STRUCT_CACHE) >= _STRUCT_CACHE_MAX:
+            _STRUCT_CACHE.pop(next(iter(_STRUCT_CACHE)))
+        _STRUCT_CACHE[key] = st
+    return st
 
 
 class Plan:
@@ -160,8 +314,7 @@ class Plan:
                  tolerances: Tolerances = DEFAULT):
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"model must be a mujoco.MjModel, got {type(model).__name__}")
-        self._model = model
-        self._tol = tolerances
+        st = _structure(model)
         t = K.check_times(times)
         q = K.as_float_array("qpos", qpos)
         if q.ndim != 2 or q.shape[0] != t.shape[0]:
@@ -172,39 +325,62 @@ class Plan:
             raise InvalidInputError(f"qpos has nq = {q.shape[1]} columns, the model has nq = {model.nq}")
         K.check_finite("qpos", q)
 
-        nmocap = model.nmocap
-        mocap_bodies = np.flatnonzero(np.asarray(model.body_mocapid) >= 0)
-        mocap_bodies = mocap_bodies[np.argsort(np.asarray(model.body_mocapid)[mocap_bodies])]
+        nmocap = st.nmocap
         if mocap_pos is None:
-            mp = np.array(model.body_pos[mocap_bodies], dtype=np.float64).reshape(nmocap, 3)
+            mp = st.mocap_pos0.copy()
         else:
             mp = K.as_float_array("mocap_pos", mocap_pos)
             if mp.shape != (nmocap, 3):
                 raise InvalidInputError(f"mocap_pos must have shape ({nmocap}, 3), got {mp.shape}")
             K.check_finite("mocap_pos", mp)
         if mocap_quat is None:
-            mq = np.array(model.body_quat[mocap_bodies], dtype=np.float64).reshape(nmocap, 4)
+            mq = st.mocap_quat0.copy()
         else:
             mq = K.as_float_array("mocap_quat", mocap_quat)
             if mq.shape != (nmocap, 4):
                 raise InvalidInputError(f"mocap_quat must have shape ({nmocap}, 4), got {mq.shape}")
             K.check_finite("mocap_quat", mq)
+        self._setup(model, st, t, q, mp, mq, tolerances)
+
+    @classmethod
+    def _trusted(cls, times: np.ndarray, qpos: np.ndarray, model: mujoco.MjModel, *,
+                 mocap_pos: np.ndarray, mocap_quat: np.ndarray,
+                 tolerances: Tolerances = DEFAULT) -> Plan:
+        """Fast constructor for the gate's own rollouts (internal).
+
+        Skips only the checks that hold by construction for arrays the caller
+        just made: dtype float64, shapes (K,) / (K, nq) / (nmocap, 3|4), fresh
+        (owned, not aliased) arrays. Finiteness, strictly increasing times and the
+        quaternion norms are still checked (a diverging simulation can produce
+        NaN), and the quaternions are normalised exactly as in ``__init__``, so
+        the plan is bit-identical to ``Plan(times, qpos, model, ...)``.
+        """
+        st = _structure(model)
+        self = cls.__new__(cls)
+        if times.shape[0] < 2:
+            raise InvalidInputError(f"a plan needs at least 2 waypoints, got {times.shape[0]}")
+        if not (np.isfinite(times).all() and (times[1:] > times[:-1]).all()):
+            K.check_times(times)  # raises with the precise message
+        K.check_finite("qpos", qpos)
+        K.check_finite("mocap_pos", mocap_pos)
+        K.check_finite("mocap_quat", mocap_quat)
+        self._setup(model, st, times, qpos, mocap_pos, mocap_quat, tolerances)
+        return self
+
+    def _setup(self, model: mujoco.MjModel, st: _ModelStructure, t: np.ndarray, q: np.ndarray,
+               mp: np.ndarray, mq: np.ndarray, tolerances: Tolerances) -> None:
+        """Shared tail of the constructors: validated, owned float64 arrays in."""
+        self._model = model
+        self._tol = tolerances
+        self._st = st
         mq = K.normalize_quats("mocap_quat", mq, tolerances)
 
         # Joint structure.
-        jtype = np.asarray(model.jnt_type)
-        jadr = np.asarray(model.jnt_qposadr)
         self._quat_tracks: dict[int, K.QuatTrack] = {}
-        for j in range(model.njnt):
-            if jtype[j] in (_BALL, _FREE):
-                a = jadr[j] + (3 if jtype[j] == _FREE else 0)
-                name = model.joint(j).name or f"joint{j}"
-                q[:, a:a + 4] = K.normalize_quats(f"qpos (joint {name!r}, qpos columns {a}..{a + 3})",
-                                                  q[:, a:a + 4], tolerances)
-        for j in range(model.njnt):
-            if jtype[j] in (_BALL, _FREE):
-                a = jadr[j] + (3 if jtype[j] == _FREE else 0)
-                self._quat_tracks[j] = K.QuatTrack(q[:, a:a + 4])
+        for _, a, label in st.quat_joints:
+            q[:, a:a + 4] = K.normalize_quats(label, q[:, a:a + 4], tolerances)
+        for j, a, _ in st.quat_joints:
+            self._quat_tracks[j] = K.QuatTrack(q[:, a:a + 4])
 
         self._times = t
         self._qpos = q
@@ -213,60 +389,34 @@ class Plan:
         self._mocap_pos = mp
         self._mocap_quat = mq
         self._seg = K.Segments(t)
-        # Linear columns: every qpos column that is not a quaternion component.
-        lin = np.ones(model.nq, dtype=bool)
-        for j, _ in self._quat_tracks.items():
-            a = jadr[j] + (3 if jtype[j] == _FREE else 0)
-            lin[a:a + 4] = False
-        self._lin = lin
-
-        self._scratch = mujoco.MjData(model)
-        self._ref = _ref_points(model)
-        self._ref.setflags(write=False)
+        self._lin = st.lin
+        self._ref = st.ref
+        self._jnt_of_body = st.jnt_of_body
+        self._jnt = st.jnt
+        self._body_pos = st.body_pos
+        self._body_quat = st.body_quat
+        self._body_mat = st.body_mat
+        self._parent = st.parent
 
         # Which qpos columns change anywhere in the window, per body chain.
         changes = np.any(q != q[0], axis=0)  # (nq,)
-        parent = np.asarray(model.body_parentid)
-        mocapid = np.asarray(model.body_mocapid)
-        nbody = model.nbody
-        self._jnt_of_body = [
-            list(range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]))
-            for b in range(nbody)
-        ]
-        # Plain-numpy copies of the joint and body geometry (MjModel attribute access is slow).
-        axes = np.array(model.jnt_axis, dtype=np.float64).reshape(-1, 3)
-        self._jnt = {
-            "type": [int(x) for x in jtype],
-            "adr": [int(x) for x in jadr],
-            "pos": np.array(model.jnt_pos, dtype=np.float64).reshape(-1, 3),
-            "axis": axes,
-            "axis_norm": np.linalg.norm(axes, axis=-1),
-            "qpos0": np.array(model.qpos0, dtype=np.float64),
-        }
-        self._body_pos = np.array(model.body_pos, dtype=np.float64)
-        self._body_quat = np.array(model.body_quat, dtype=np.float64)
-        self._body_mat = K.quat_to_mat(self._body_quat)
-        self._parent = [int(x) for x in parent]
-        qwidth = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}
-        own_moving = np.zeros(nbody, dtype=bool)
-        own_rot = np.zeros(nbody, dtype=bool)
-        for b in range(nbody):
-            for j in self._jnt_of_body[b]:
-                cols = slice(jadr[j], jadr[j] + qwidth[int(jtype[j])])
-                if changes[cols].any():
-                    own_moving[b] = True
-                    if jtype[j] == _HINGE or jtype[j] == _BALL:
-                        own_rot[b] = True
-                    if jtype[j] == _FREE and changes[jadr[j] + 3:jadr[j] + 7].any():
-                        own_rot[b] = True
+        nbody = st.nbody
+        parent = st.parent
         moving = np.zeros(nbody, dtype=bool)
         rotating = np.zeros(nbody, dtype=bool)
-        for b in range(1, nbody):
-            if mocapid[b] >= 0:
-                continue
-            p = parent[b]
-            moving[b] = own_moving[b] or moving[p]
-            rotating[b] = own_rot[b] or rotating[p]
+        if changes.any():
+            own_moving = (st.own_cols & changes).any(axis=1).tolist()
+            own_rot = (st.own_rot_cols & changes).any(axis=1).tolist()
+            mv = [False] * nbody
+            rt = [False] * nbody
+            for b in range(1, nbody):
+                if st.mocap[b]:
+                    continue
+                p = parent[b]
+                mv[b] = own_moving[b] or mv[p]
+                rt[b] = own_rot[b] or rt[p]
+            moving[:] = mv
+            rotating[:] = rt
         self._moving = moving
         self._rotating = rotating
         self._moving.setflags(write=False)
@@ -275,41 +425,69 @@ class Plan:
         # then rotation about the body origin). kind: 0 hinge, 1 slide, 2 ball,
         # 3 free translation, 4 free rotation. Chains run root -> body over the
         # moving bodies only (a mocap or static ancestor is a constant frame).
-        vkind, vjoint, vbody = [], [], []
-        first_v = {}
-        for j in range(model.njnt):
-            first_v[j] = len(vkind)
-            typ = int(jtype[j])
-            kinds = {_HINGE: [0], _SLIDE: [1], _BALL: [2], _FREE: [3, 4]}[typ]
-            for kd in kinds:
-                vkind.append(kd)
-                vjoint.append(j)
-                vbody.append(int(model.jnt_bodyid[j]))
-        self._vkind = np.array(vkind, dtype=np.int64)
-        self._vjoint = vjoint
-        self._first_v = first_v
-        own_v = [[v for v in range(len(vkind)) if vbody[v] == b] for b in range(nbody)]
-        self._chain_v: list[np.ndarray] = []
-        self._own_count: list[int] = []
-        for b in range(nbody):
-            chain: list[int] = []
-            c = b
-            while c != 0 and moving[c]:
-                chain = own_v[c] + chain
-                c = int(parent[c])
-            self._chain_v.append(np.array(chain, dtype=np.int64))
-            self._own_count.append(len(own_v[b]) if moving[b] else 0)
+        self._vkind = st.vkind
+        self._first_v = st.first_v
+        key = moving.tobytes()
+        chains = st.chains.get(key)
+        if chains is None:
+            own_v = st.own_v
+            chain_v: list[np.ndarray] = []
+            own_count: list[int] = []
+            for b in range(nbody):
+                chain: list[int] = []
+                c = b
+                while c != 0 and moving[c]:
+                    chain = own_v[c] + chain
+                    c = parent[c]
+                arr = np.array(chain, dtype=np.int64)
+                arr.setflags(write=False)
+                chain_v.append(arr)
+                own_count.append(len(own_v[b]) if moving[b] else 0)
+            chains = (chain_v, own_count)
+            if len(st.chains) < 64:
+                st.chains[key] = chains
+        self._chain_v, self._own_count = chains
 
-        # Waypoint poses (for translation segments and the rounding scale).
-        self._wp_pos, self._wp_mat = self._fk(q)
         self._magnitude = {
-            "q": float(np.max(np.abs(q), initial=0.0)) + float(np.max(np.abs(model.qpos0), initial=0.0)),
+            "q": float(np.max(np.abs(q), initial=0.0)) + st.qpos0_mag,
             "path": max((float(tr.cum[-1]) for tr in self._quat_tracks.values()), default=0.0),
         }
-        ref_norm = float(np.max(np.linalg.norm(self._ref, axis=-1), initial=0.0))
-        self._scale = float(np.max(np.linalg.norm(self._wp_pos, axis=-1), initial=0.0)) + ref_norm
-        whole = self._bounds(np.array([t[0]]), np.array([t[-1]]), scale=0.0)
-        self._scale += float(np.max(whole[0], initial=0.0)) + 2.0 * ref_norm
+        # Waypoint poses (for translation segments and the rounding scale) and the
+        # rounding scale are computed on first use (see ``_wp_pos`` / ``_scale``).
+        self._wp_cache: tuple[np.ndarray, np.ndarray] | None = None
+        self._scale_cache: float | None = None
+        self._mb_cache: dict[bytes, MotionBounds] = {}
+        self._pose_cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    @property
+    def _scratch(self) -> mujoco.MjData:
+        """Scratch ``MjData`` for FK (the calling thread's, see ``_fk_data``)."""
+        return _fk_data(self._model)
+
+    @property
+    def _wp_pos(self) -> np.ndarray:
+        """(K, nbody, 3) FK origins at the waypoints (m)."""
+        if self._wp_cache is None:
+            self._wp_cache = self._fk(self._qpos)
+        return self._wp_cache[0]
+
+    @property
+    def _wp_mat(self) -> np.ndarray:
+        """(K, nbody, 3, 3) FK rotations at the waypoints."""
+        if self._wp_cache is None:
+            self._wp_cache = self._fk(self._qpos)
+        return self._wp_cache[1]
+
+    @property
+    def _scale(self) -> float:
+        """Coordinate magnitude of the plan (m), for the rounding pads of the bounds."""
+        if self._scale_cache is None:
+            ref_norm = self._st.ref_norm
+            scale = float(np.max(np.linalg.norm(self._wp_pos, axis=-1), initial=0.0)) + ref_norm
+            whole = self._bounds(self._times[:1].copy(), self._times[-1:].copy(), scale=0.0,
+                                 kinds=Plan._bound_kinds)
+            self._scale_cache = scale + float(np.max(whole[0], initial=0.0)) + 2.0 * ref_norm
+        return self._scale_cache
 
     # ------------------------------------------------------------------ basics
     def __repr__(self) -> str:
@@ -371,11 +549,8 @@ class Plan:
         """Interpolated qpos (T, nq) at validated times (T,)."""
         i, s, at_end = self._seg.locate(t) if loc is None else loc
         out = K.lerp_values(self._qpos, i, s, at_end)
-        jtype = self._model.jnt_type
-        jadr = self._model.jnt_qposadr
-        for j, track in self._quat_tracks.items():
-            a = jadr[j] + (3 if jtype[j] == _FREE else 0)
-            out[:, a:a + 4] = track.interp(i, s, at_end)
+        for j, a, _ in self._st.quat_joints:
+            out[:, a:a + 4] = self._quat_tracks[j].interp(i, s, at_end)
         return out
 
     def qpos_at(self, t: float | np.ndarray) -> np.ndarray:
@@ -409,7 +584,16 @@ class Plan:
             positions (T, nbody, 3) m and rotations R_WB (T, nbody, 3, 3).
         """
         t = K.check_times_in_window(times, self.window)
-        return self._fk(self._qpos_many(t))
+        # Small queries are memoised (several broad-phase stages ask for the same
+        # sub-interval midpoints); the poses are a pure function of the times.
+        key = t.tobytes() if t.shape[0] <= 64 else None
+        hit = self._pose_cache.get(key) if key is not None else None
+        if hit is not None:
+            return hit[0].copy(), hit[1].copy()
+        pos, mat = self._fk(self._qpos_many(t))
+        if key is not None and len(self._pose_cache) < 64:
+            self._pose_cache[key] = (pos.copy(), mat.copy())
+        return pos, mat
 
     # ------------------------------------------------------------------ bounds
     def motion_bounds(self, t0: np.ndarray, t1: np.ndarray) -> MotionBounds:
@@ -423,14 +607,30 @@ class Plan:
             MotionBounds with trans (N, nbody) m and angle (N, nbody) rad.
         """
         a, b = K.check_interval_arrays(t0, t1, self.window)
+        # Small queries (e.g. the whole window, asked by several broad-phase
+        # stages) are memoised; the bounds are a pure function of the intervals.
+        key = (repr(self._bound_kinds).encode() + a.tobytes() + b"|" + b.tobytes()
+               if a.shape[0] <= 64 else None)
+        hit = self._mb_cache.get(key) if key is not None else None
+        if hit is not None:
+            return MotionBounds(t0=a, t1=b, trans=hit.trans.copy(), angle=hit.angle.copy())
         trans = np.empty((a.shape[0], self.nbody))
         angle = np.empty((a.shape[0], self.nbody))
         for sl in K.interval_chunks(self._times, a, b, width=max(self._model.nq, 4)):
             trans[sl], angle[sl] = self._bounds(a[sl], b[sl], scale=self._scale)
-        return MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
+        out = MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
+        if key is not None and len(self._mb_cache) < 64:
+            self._mb_cache[key] = MotionBounds(t0=a.copy(), t1=b.copy(), trans=trans.copy(),
+                                               angle=angle.copy())
+        return out
 
-    def _bounds(self, ta: np.ndarray, tb: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
-        """Bounds (N, nbody) for validated sub-intervals; see the module docstring."""
+    def _bounds(self, ta: np.ndarray, tb: np.ndarray, scale: float,
+                kinds: tuple[str, ...] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds (N, nbody) for validated sub-intervals; see the module docstring.
+
+        ``kinds`` overrides ``_bound_kinds`` (the rounding scale always uses the defaults).
+        """
+        kinds = self._bound_kinds if kinds is None else kinds
         m = self._model
         tol = self._tol
         N = ta.shape[0]
@@ -454,7 +654,7 @@ class Plan:
         # interpolation itself computes; t -> s is monotone in floating point).
         # A sub-interval is "single" when ta and tb lie in the midpoint's segment
         # (tb may be its end waypoint, located in the next segment with s = 0).
-        use_velocity = "velocity" in self._bound_kinds
+        use_velocity = "velocity" in kinds
         seg = iv.loc_m[0]
         b_next = (iv.loc_b[0] == seg + 1) & (iv.loc_b[1] == 0.0)
         single = (iv.loc_a[0] == seg) & ((iv.loc_b[0] == seg) | b_next)
@@ -586,11 +786,11 @@ class Plan:
                 T2, Th2 = self._velocity_bound(kind, rate[ch], D, dist_pt, h, qmag, scale)
                 T2 = np.where(single, T2, np.inf)
                 Th2 = np.where(single, Th2, np.inf)
-                if "chain" not in self._bound_kinds:  # tests: the velocity bound on its own
+                if "chain" not in kinds:  # tests: the velocity bound on its own
                     T, Th = T2, Th2
                 T = np.minimum(T, T2)
                 Th = np.minimum(Th, Th2)
-            elif "chain" not in self._bound_kinds:
+            elif "chain" not in kinds:
                 T = np.full(N, np.inf)
                 Th = np.full(N, np.inf)
             if self._rotating[b]:
