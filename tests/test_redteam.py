@@ -678,3 +678,36 @@ def test_near_half_turn_motion_bound_contract(chain):
             assert np.linalg.norm(pr - pr[50], axis=1).max() <= mb.trans[0, body]
             ang = _rot_angle(np.einsum("tij,kj->tik", R[:, body], R[50, body]))
             assert ang.max() <= mb.angle[0, body] + 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_graze_bodymotion_long_lever_many_waypoints(seed):
+    """BodyMotion, default reference point (body origin) 10 m from the geom, 5 waypoints with
+    rotations, grazing a static box (independent lerp/slerp oracle)."""
+    from redteam_oracle import BodyMotionOracle
+
+    from monitor import BodyMotion
+
+    xml = ('<mujoco><worldbody><geom name="box" type="box" size=".3 .2 .1" pos="10 0 0" euler="5 10 15"/>'
+           '<body name="b" mocap="true"><geom name="cap" type="capsule" size=".05 .3" pos="10 0 0"/></body>'
+           '</worldbody></mujoco>')
+    m = _model(xml)
+    rng = np.random.default_rng(seed)
+    K = 5
+    times = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, K - 2)]))
+    pos = np.zeros((K, 2, 3))
+    pos[:, 1] = rng.normal(scale=0.2, size=(K, 3)) + [0.0, 0.0, 0.5]
+    quat = np.zeros((K, 2, 4))
+    quat[:, 0, 0] = 1.0
+    qs = np.array([1.0, 0, 0, 0]) + rng.normal(scale=0.02, size=(K, 4))
+    quat[:, 1] = qs / np.linalg.norm(qs, axis=1, keepdims=True)
+    bm = BodyMotion(times, pos, quat)
+    oracle = BodyMotionOracle(m, times, pos, quat)
+    r = motion_min(oracle, 0, 1, 0.0, 1.0, n=300, refine=4)
+    scene = Scene.from_model(m, pairs="all")
+    for d in (1e-9, 1e-6):
+        margin = max(r.upper + d, 0.0)
+        for meth in ("auto", "toleranced"):
+            cert = certify(scene, bm, margin, 1e-3, meth)
+            _assert_not_certified(cert, f"BodyMotion lever seed {seed}, margin {margin}, {meth}")
