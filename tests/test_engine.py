@@ -312,3 +312,43 @@ def test_frontier_cap_never_certifies(scene, model):
     hit = certify(scene, _plan(model, (1.0, 0.5)), method="toleranced", epsilon=1e-4,
                   tolerances=Tolerances(max_frontier=1))
     assert hit.verdict == "violation"
+
+
+def test_cylinder_witness_needs_the_true_shape_to_violate():
+    """A sphere 2 mm outside a true cylinder, but overlapping its circumscribed prism (corner
+    8 mm outside at 8 facets): not a confirmed violation at margin 0; a confirmed one at a
+    margin far above the true distance."""
+    import mujoco
+
+    import monitor
+
+    r = 0.1
+    probe = mujoco.MjModel.from_xml_string(
+        f'<mujoco><worldbody><geom name="cyl" type="cylinder" size="{r} 0.2"/></worldbody></mujoco>')
+    prism = monitor.Scene.from_model(probe, pairs="all", facets=8).geom("cyl").shape.points
+    k = int(np.argmax(prism[:, 0] * 0.3 + prism[:, 1]))  # some prism corner
+    u = prism[k] * [1.0, 1.0, 0.0]
+    u /= np.linalg.norm(u)
+    c = (r + 0.002 + 0.01) * u  # sphere (radius 1 cm) surface 2 mm outside the true cylinder
+    xml = f"""<mujoco><worldbody>
+      <geom name="cyl" type="cylinder" size="{r} 0.2"/>
+      <body name="b" pos="{float(c[0])!r} {float(c[1])!r} 0"><joint name="x" type="slide"
+        axis="{float(u[0])!r} {float(u[1])!r} 0"/>
+        <geom name="s" type="sphere" size="0.01"/></body>
+    </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    scene = monitor.Scene.from_model(model, pairs="all", facets=8)
+    assert scene.approximations["cyl"] > 0.006  # the prism corner reaches past the sphere surface
+    plan = monitor.Plan([0.0, 1.0], [[0.0], [1e-3]], model=model)  # moves 1 mm outward
+    cert = monitor.certify(scene, plan, margin=0.0)
+    assert cert.verdict != "violation", cert.witness  # true distance >= 2 mm > margin 0
+    cert = monitor.certify(scene, plan, margin=0.05)  # true distance <= 3 mm << 5 cm - error
+    assert cert.verdict == "violation"
+
+
+def test_no_candidate_pairs_is_certified_with_complete_stats(scene, model):
+    plan = _plan(model, (0.0, 0.0))
+    full = certify(scene, plan)
+    empty = certify(scene, plan, pairs=[])
+    assert empty.verdict == "certified" and empty.pairs == () and empty.clearance == float("inf")
+    assert set(empty.stats) == set(full.stats)

@@ -13,7 +13,7 @@ Pipeline for one window [t0, t1] and the scene's candidate geom pairs:
    sub-intervals, all pairs at once in numpy) stay further apart than the margin are
    ``"culled"`` and certified, with the sphere gap as clearance bound.
 3. **Start pose.** Every remaining pair gets the exact static distance at t0
-   (:func:`monitor.geometry.distance.shape_distance`): ``upper < margin`` is a violation
+   (:func:`monitor.geometry.distance.shape_distance`): ``upper + approx < margin`` is a violation
    at t0 (method ``"static"``). If neither that nor clear cores can be proven, the pair can
    at best be "uncertain" (boundary tests cannot see containment). Pairs whose bodies do
    not move relative to the world in the window are decided by this test alone.
@@ -23,7 +23,8 @@ Pipeline for one window [t0, t1] and the scene's candidate geom pairs:
    force one (extrusion raises InvalidInputError on a non-translating pair).
 5. **Witnesses.** For every interval a checker could not exclude, exact static tests at
    ``Tolerances.witness_candidates`` times (in time order, stopping at the first hit):
-   ``upper < margin`` confirms a violation with a :class:`Witness`; otherwise the pair is
+   ``upper + approx < margin`` confirms a violation with a :class:`Witness` (``approx``:
+   the over-approximation of circumscribed cylinders/ellipsoids); otherwise the pair is
    "uncertain". An extrusion "violation" is re-confirmed the same way at its witness time.
 6. **Combine.** Any violation wins (earliest witness), else any uncertain, else certified.
    ``clearance`` is the minimum of the per-pair certified lower bounds (toleranced
@@ -155,6 +156,11 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
     bud = _make_budget(budget)
     sel = _select(scene, pairs)
+    if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
+        return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
+                           (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
+                                "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
+                                "budget_exhausted": False})
 
     moving = np.asarray(plan.moving_bodies(), bool)
     static = np.asarray(scene.body_static, bool)
@@ -211,8 +217,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         for i, ga, gb in todo:
             d = shape_distance(ga.shape, (rot0[0, ga.body_id], pos0[0, ga.body_id]),
                                gb.shape, (rot0[0, gb.body_id], pos0[0, gb.body_id]), tolerances=tol)
-            if d.upper < margin:
-                w = Witness(t0, (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper))
+            if d.upper + _approx(ga, gb) < margin:
+                w = Witness(t0, (ga.name, gb.name), 0.5 * (d.p_a + d.p_b),
+                            float(d.upper + _approx(ga, gb)))
                 done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "violation", "static",
                                    intervals=((t0, t0),), witness=w))
                 continue
@@ -409,17 +416,32 @@ def _sampled_clearances(plan: Any, geoms: list[tuple[Any, Any]], t0: float, t1: 
     return out
 
 
+def _approx(ga: Any, gb: Any) -> float:
+    """Metres by which the pair's shapes over-approximate the true geoms.
+
+    Circumscribed cylinders/ellipsoids lie within ``approx_error`` of the true geom,
+    so the true distance is at most the shapes' distance plus this: a witness is
+    confirmed only if ``upper + _approx < margin``.
+    """
+    return float(ga.shape.approx_error) + float(gb.shape.approx_error)
+
+
 def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
                   tol: Tolerances) -> Witness | None:
-    """Earliest candidate time whose exact static distance upper bound is below margin."""
+    """Earliest candidate time whose confirmed distance is below margin.
+
+    The exact static upper bound plus the shapes' over-approximation (circumscribed
+    geoms) must be below the margin.
+    """
     from monitor.geometry.distance import shape_distance
 
     pos, rot = plan.body_poses(times)
+    slack = _approx(ga, gb)
     for k, t in enumerate(times):
         d = shape_distance(ga.shape, (rot[k, ga.body_id], pos[k, ga.body_id]),
                            gb.shape, (rot[k, gb.body_id], pos[k, gb.body_id]), tolerances=tol)
-        if d.upper < margin:
-            return Witness(float(t), (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper))
+        if d.upper + slack < margin:
+            return Witness(float(t), (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper + slack))
     return None
 
 
