@@ -95,4 +95,30 @@ class Trajectory(Protocol):
         """
 
 
-__all__ = ["MotionBounds", "Trajectory", "chord"]
+class WindowTimes:
+    """Mixin for trajectories whose waypoint times are stored in ``self._times`` (K,) seconds."""
+
+    _times: np.ndarray
+
+    @property
+    def times(self) -> np.ndarray:
+        """(K,) waypoint times (s), read-only."""
+        return self._times
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """(t0, t1) the time span (s)."""
+        return float(self._times[0]), float(self._times[-1])
+
+    @property
+    def t0(self) -> float:
+        """Window start (s)."""
+        return float(self._times[0])
+
+    @property
+    def t1(self) -> float:
+        """Window end (s)."""
+        return float(self._times[-1])
+
+
+__all__ = ["MotionBounds", "Trajectory", "WindowTimes", "chord"]

@@ -33,11 +33,11 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, chord
+from monitor.motion.base import MotionBounds, WindowTimes, chord
 from monitor.tolerances import DEFAULT, Tolerances
 
 
-class BodyMotion:
+class BodyMotion(WindowTimes):
     """Explicit world poses of every body at waypoint times (Trajectory protocol).
 
     Args:
@@ -105,11 +105,6 @@ class BodyMotion:
                 f"moving bodies={int(self._moving.sum())}/{self.nbody})")
 
     @property
-    def times(self) -> np.ndarray:
-        """(K,) waypoint times (s)."""
-        return self._times
-
-    @property
     def pos(self) -> np.ndarray:
         """(K, nbody, 3) waypoint positions (m)."""
         return self._pos
@@ -118,21 +113,6 @@ class BodyMotion:
     def quat(self) -> np.ndarray:
         """(K, nbody, 4) waypoint quaternions (normalised)."""
         return self._quat
-
-    @property
-    def window(self) -> tuple[float, float]:
-        """(t0, t1) the motion's time span (s)."""
-        return float(self._times[0]), float(self._times[-1])
-
-    @property
-    def t0(self) -> float:
-        """Window start (s)."""
-        return float(self._times[0])
-
-    @property
-    def t1(self) -> float:
-        """Window end (s)."""
-        return float(self._times[-1])
 
     @property
     def nbody(self) -> int:

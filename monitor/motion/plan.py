@@ -117,7 +117,7 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, chord
+from monitor.motion.base import MotionBounds, WindowTimes, chord
 from monitor.tolerances import DEFAULT, Tolerances
 
 _FREE = int(mujoco.mjtJoint.mjJNT_FREE)
@@ -285,7 +285,7 @@ def _structure(model: mujoco.MjModel) -> _ModelStructure:
     return st
 
 
-class Plan:
+class Plan(WindowTimes):
     """Joint waypoints of a MuJoCo model over a time window (Trajectory protocol).
 
     Args:
@@ -500,29 +500,9 @@ class Plan:
         return self._model
 
     @property
-    def times(self) -> np.ndarray:
-        """(K,) waypoint times (s), read-only."""
-        return self._times
-
-    @property
     def qpos(self) -> np.ndarray:
         """(K, nq) waypoint joint positions (quaternions normalised), read-only."""
         return self._qpos
-
-    @property
-    def window(self) -> tuple[float, float]:
-        """(t0, t1) the plan's time span (s)."""
-        return float(self._times[0]), float(self._times[-1])
-
-    @property
-    def t0(self) -> float:
-        """Window start (s)."""
-        return float(self._times[0])
-
-    @property
-    def t1(self) -> float:
-        """Window end (s)."""
-        return float(self._times[-1])
 
     @property
     def nbody(self) -> int:
