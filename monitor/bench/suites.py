@@ -286,17 +286,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     facets = {"skipped": "smoke run"} if cfg.smoke or cfg.shared.get("skip_facets") else _facet_sweep(cfg)
     figs = []
     peer_lines = cfg.shared.get("peer_lines", {})
-    report.plot_time_vs_epsilon(
-        cfg.out / "time_vs_epsilon.png",
-        [r for r in rows if r["group"] != "all" and r["checker"] == "toleranced"]
-        + [
-            dict(r, epsilon=e)
-            for r in rows
-            if r["checker"] == "extrusion" and r["group"] == "translating"
-            for e in eps_list
-        ],
-        peer_lines,
-    )
+    _plot_time_vs_epsilon(cfg, rows, eps_list, peer_lines)
     figs.append("time_vs_epsilon.png")
     report.plot_uncertain(
         cfg.out / "uncertain_vs_clearance.png",
@@ -1273,17 +1263,7 @@ def finalize(cfg: BenchConfig, results: dict[str, Any]) -> None:
     if acc.get("rows") and lines:
         eps_list = EPS_QUICK if cfg.quick else EPS_FULL
         rows = acc["rows"]
-        report.plot_time_vs_epsilon(
-            cfg.out / "time_vs_epsilon.png",
-            [r for r in rows if r["group"] != "all" and r["checker"] == "toleranced"]
-            + [
-                dict(r, epsilon=e)
-                for r in rows
-                if r["checker"] == "extrusion" and r["group"] == "translating"
-                for e in eps_list
-            ],
-            lines,
-        )
+        _plot_time_vs_epsilon(cfg, rows, eps_list, lines)
 
 
 SUITE_FUNCS = {
@@ -1293,6 +1273,21 @@ SUITE_FUNCS = {
     "gate": suite_gate,
     "scaling": suite_scaling,
 }
+
+
+def _plot_time_vs_epsilon(cfg: Any, rows: list[dict], eps_list: Any, peer_lines: Any) -> None:
+    """Write time_vs_epsilon.png.
+
+    Toleranced rows per epsilon; extrusion (epsilon-free) repeated across the sweep so it
+    plots as a flat line; peers as horizontal lines.
+    """
+    report.plot_time_vs_epsilon(
+        cfg.out / "time_vs_epsilon.png",
+        [r for r in rows if r["group"] != "all" and r["checker"] == "toleranced"]
+        + [dict(r, epsilon=e) for r in rows
+           if r["checker"] == "extrusion" and r["group"] == "translating" for e in eps_list],
+        peer_lines,
+    )
 
 __all__ = [
     "BenchConfig",

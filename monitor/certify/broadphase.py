@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from monitor.geometry.shapes import ConvexShape
-from monitor.motion.base import Trajectory, chord
+from monitor.motion.base import MotionBounds, Trajectory, chord
 from monitor.tolerances import DEFAULT, Tolerances
 
 
@@ -42,6 +42,25 @@ class SweptSpheres(NamedTuple):
     centres: np.ndarray
     radii: np.ndarray
     pad: float
+
+
+def subinterval_bounds(traj: Trajectory, t0: float, t1: float,
+                       n: int) -> tuple[np.ndarray, np.ndarray, MotionBounds, np.ndarray, np.ndarray]:
+    """Poses at the midpoints of n equal sub-intervals of [t0, t1] and their motion bounds.
+
+    One ``body_poses`` and one ``motion_bounds`` call (the contract of
+    :mod:`monitor.motion.base`), shared by the broad phase and the engine's clearance bound.
+
+    Returns:
+        pos (n, nbody, 3) m and rot (n, nbody, 3, 3) at the midpoints, the
+        :class:`~monitor.motion.base.MotionBounds`, ref_points (nbody, 3) body frame,
+        and chord(angle) (n, nbody).
+    """
+    edges = np.linspace(t0, t1, n + 1)
+    ta, tb = edges[:-1], edges[1:]
+    pos, rot = traj.body_poses(0.5 * (ta + tb))
+    mb = traj.motion_bounds(ta, tb)
+    return pos, rot, mb, np.asarray(traj.ref_points, float), chord(mb.angle)
 
 
 def swept_geom_spheres(traj: Trajectory, shapes: Sequence[ConvexShape], bodies: np.ndarray,
@@ -67,13 +86,7 @@ def swept_geom_spheres(traj: Trajectory, shapes: Sequence[ConvexShape], bodies: 
     bodies = np.asarray(bodies, np.int64).reshape(-1)
     G = len(bodies)
     t0, t1 = float(window[0]), float(window[1])
-    edges = np.linspace(t0, t1, nsub + 1)
-    ta, tb = edges[:-1], edges[1:]
-    mids = 0.5 * (ta + tb)
-    pos, rot = traj.body_poses(mids)
-    mb = traj.motion_bounds(ta, tb)
-    ref = np.asarray(traj.ref_points, float)
-    ch = chord(mb.angle)                                     # (T, nbody)
+    pos, rot, mb, ref, ch = subinterval_bounds(traj, t0, t1, nsub)
     grow_f = 1.0 + 8 * tolerances.rel_pad
     c = np.zeros((G, 3))
     rad = np.full(G, np.inf)

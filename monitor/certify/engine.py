@@ -387,16 +387,10 @@ def _sampled_clearances(plan: Any, geoms: list[tuple[Any, Any]], t0: float, t1: 
     trans + chord(angle) * max_p |p - ref| from its pose at m (motion-bound contract), so
     the distance stays >= lower(m) - delta_A - delta_B. Half-spaces on a moving body: -inf.
     """
+    from monitor.certify.broadphase import subinterval_bounds
     from monitor.geometry.distance import shape_distance_batch
-    from monitor.motion.base import chord
 
-    e = np.linspace(t0, t1, n + 1)
-    a, b = e[:-1], e[1:]
-    m = 0.5 * (a + b)
-    pos, rot = plan.body_poses(m)
-    mb = plan.motion_bounds(a, b)
-    ref = np.asarray(plan.ref_points, float)
-    ch = chord(mb.angle)
+    pos, rot, mb, ref, ch = subinterval_bounds(plan, t0, t1, n)
     out = []
     for ga, gb in geoms:
         dev = np.zeros(n)
