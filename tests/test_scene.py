@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 from conftest import ASSETS
+from test_polytope import volume as _polytope_volume
 
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.scene import GeomInfo, Scene
@@ -414,15 +415,6 @@ def test_shapes_contain_true_geoms_in_body_frame(path):
                 above = pts_B + 0.3 * n_B
                 assert (inside_excess(info.shape, below) < 0).all()
                 assert (inside_excess(info.shape, above) > 0).all()
-
-
-def _polytope_volume(shape):
-    vol = 0.0
-    for loop in shape.faces:
-        v = shape.points[loop]
-        for k in range(1, len(v) - 1):
-            vol += np.dot(v[0], np.cross(v[k], v[k + 1])) / 6.0
-    return vol
 
 
 def test_mesh_hull_volume_matches_trimesh(load_asset):

@@ -130,6 +130,16 @@ def _plt():
     return plt
 
 
+def _finish(plt, fig, ax, path: Path) -> None:
+    """Legend and log grid (when ``ax`` is given), tight layout, save at 110 dpi, close."""
+    if ax is not None:
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def plot_time_vs_epsilon(path: Path, rows: list[dict], peer_lines: dict[str, float]) -> None:
     """Median µs per pair-window against epsilon, per checker and group (log-log)."""
     plt = _plt()
@@ -168,11 +178,7 @@ def plot_time_vs_epsilon(path: Path, rows: list[dict], peer_lines: dict[str, flo
     ax.set_xlabel("epsilon (m)")
     ax.set_ylabel("µs per pair-window (median; bar: p95)")
     ax.set_title("Run time against error tolerance")
-    ax.legend(fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _finish(plt, fig, ax, path)
 
 
 def plot_uncertain(path: Path, points: list[dict]) -> None:
@@ -199,11 +205,7 @@ def plot_uncertain(path: Path, points: list[dict]) -> None:
     ax.set_ylabel("fraction not certified (clear cases)")
     ax.set_ylim(-0.05, 1.05)
     ax.set_title("Uncertain fraction against clearance / epsilon")
-    ax.legend(fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _finish(plt, fig, ax, path)
 
 
 def plot_peers(path: Path, rows: list[dict]) -> None:
@@ -231,9 +233,7 @@ def plot_peers(path: Path, rows: list[dict]) -> None:
     ax.set_xlim(min(r["us_median"] for r in rr) * 0.5, max(r["us_median"] for r in rr) * 3000)
     ax.set_xlabel("µs per pair-window query (median over cases)")
     ax.set_title("Ours and peers on the same cases")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _finish(plt, fig, None, path)
 
 
 def plot_scaling(path: Path, rows: list[dict]) -> None:
@@ -254,11 +254,7 @@ def plot_scaling(path: Path, rows: list[dict]) -> None:
     ax.set_xlabel("moving bodies")
     ax.set_ylabel("seconds per window (median)")
     ax.set_title("Scaling with the number of moving bodies")
-    ax.legend(fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _finish(plt, fig, ax, path)
 
 
 __all__ = [
