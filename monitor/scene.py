@@ -45,6 +45,26 @@ Pair modes:
   floor vs a free body or a wall vs a slider stay checked
   (:func:`_drop_overlapping_world_children`).
 * explicit list of ``(geom_a, geom_b)`` (names or ids), validated.
+
+Model edits. A ``Scene`` keeps the ``MjModel`` and a snapshot of every model array it,
+its pair policy or the motion bounds of a :class:`monitor.Plan` read (:data:`SYNC_FIELDS`,
+plus the counts and ``opt.disableflags``). :meth:`Scene.sync` compares the live arrays
+with the snapshot (raw bytes through views kept at construction: a few microseconds plus
+a memory compare of the mesh vertices) and rebuilds the shapes and pairs after an
+in-place edit (domain randomisation of ``geom_size``/``geom_pos``, tuning), bumping
+:attr:`Scene.version`. :func:`monitor.certify` calls it first, so a certificate is
+always about the model as it is when ``certify`` runs.
+
+Flex bodies (``model.nflex > 0``) are not represented by any shape: construction raises
+:class:`~monitor.errors.UnsupportedGeometryError` naming the flex rather than certifying
+a scene that silently ignores it.
+
+MuJoCo's per-geom ``margin`` (``geom_margin``) is recorded in :attr:`GeomInfo.margin` but
+NOT added to the certified clearance: ``geom_margin`` tells MuJoCo's solver when to
+start generating contacts (a physics setting, often tuned together with ``gap``), not how
+close a geom may safely come. The certified clearance is the ``margin`` argument of
+:func:`monitor.certify` / ``Gate``; pass ``margin=max(geom_margin)`` there to be at
+least as strict as MuJoCo's contact activation.
 """
 
 from __future__ import annotations
@@ -58,7 +78,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from monitor.errors import InvalidInputError, UnsupportedGeometryError
+from monitor.errors import InvalidInputError, ModelMismatchError, UnsupportedGeometryError
 from monitor.geometry.polytope import (
     box_polytope,
     capsule_shape,
@@ -83,6 +103,51 @@ _HFIELD = int(mujoco.mjtGeom.mjGEOM_HFIELD)
 _SDF = int(mujoco.mjtGeom.mjGEOM_SDF)
 _UNSUPPORTED = (_HFIELD, _SDF)
 _CHUNK = 1 << 20  # geom pairs per vectorised filter block
+
+SYNC_FIELDS: tuple[str, ...] = (
+    # geometry of the shapes (body frame)
+    "geom_type", "geom_size", "geom_pos", "geom_quat", "geom_dataid", "geom_bodyid", "geom_margin",
+    "mesh_vertadr", "mesh_vertnum", "mesh_vert",
+    # pair policy ("mujoco": masks, exclusions, <pair>; "all": weld groups and the anchor test)
+    "geom_contype", "geom_conaffinity", "body_weldid", "body_parentid", "body_dofnum", "body_mocapid",
+    "exclude_signature", "pair_geom1", "pair_geom2",
+    # kinematics: the world-children anchor test of pairs="all" and the motion bounds of a Plan
+    "jnt_type", "jnt_qposadr", "jnt_bodyid", "jnt_pos", "jnt_axis", "qpos0", "body_pos", "body_quat",
+    "body_jntadr", "body_jntnum", "body_ipos", "geom_rbound",
+)
+"""``MjModel`` arrays that :meth:`Scene.sync` watches for in-place edits."""
+class _Snapshot:
+    """Raw bytes of the watched model arrays, read through views kept from construction.
+
+    ``MjModel`` array attributes are views into the model's own buffers (assignment copies
+    into them), so the views stay valid and a comparison costs one ``tobytes`` per field.
+    Array sizes (``nbody``, ``ngeom``, ...) cannot change in place: an ``MjModel``'s
+    buffers are allocated once, so only contents and ``opt.disableflags`` are compared.
+    """
+
+    def __init__(self, model: Any):
+        self._bind(model)
+        self.saved = [v.tobytes() for _, v in self.views]
+        self.disableflags = int(self.opt.disableflags)
+
+    def _bind(self, model: Any) -> None:
+        self.model = model
+        self.views = [(f, getattr(model, f)) for f in SYNC_FIELDS]
+        self.opt = model.opt  # a live view of mjOption
+
+    def __getstate__(self) -> dict[str, Any]:  # views are not picklable; rebound on load
+        return {"model": self.model, "saved": self.saved, "disableflags": self.disableflags}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self._bind(state["model"])
+        self.saved, self.disableflags = state["saved"], state["disableflags"]
+
+    def changed(self) -> list[str]:
+        """Names of the watched fields whose contents differ from the snapshot."""
+        out = [f for (f, v), b in zip(self.views, self.saved) if v.tobytes() != b]
+        if int(self.opt.disableflags) != self.disableflags:
+            out.append("opt.disableflags")
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -183,6 +248,8 @@ class Scene:
         approximations: {geom name: approx_error (m)} for circumscribed shapes.
         facets: facet count used for cylinders and ellipsoids.
         tolerances: the :class:`Tolerances` used.
+        version: 0 at construction, +1 each time :meth:`sync` rebuilt the scene after an
+            in-place edit of the model.
     """
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
@@ -200,6 +267,51 @@ class Scene:
         self.approximations = {g.name: float(g.shape.approx_error) for g in geoms
                                if g.shape is not None and g.shape.approx_error > 0.0}
         self._by_name = {g.name: g for g in geoms}
+        self.version = 0
+        self._pairs_spec: Any = "mujoco"  # set by from_model: the pairs argument, for rebuilds
+        self._snapshot = _Snapshot(model)
+
+    # ------------------------------------------------------------------ model edits
+
+    def sync(self) -> bool:
+        """Rebuild the scene if the model was edited in place since the last build.
+
+        Compares every watched array (:data:`SYNC_FIELDS`), the counts and
+        ``opt.disableflags`` against the snapshot taken at the last build. On a change
+        the shapes and candidate pairs are rebuilt from the live model with the same
+        ``pairs`` argument, facets and tolerances, and :attr:`version` is incremented.
+
+        Returns:
+            True if the scene was rebuilt, False if nothing watched had changed.
+
+        Raises:
+            ModelMismatchError: the edit makes a rebuild impossible (e.g. an explicit pair
+                or a pair of ``pairs="mujoco"`` now names an hfield geom, or two explicitly
+                paired geoms became planes); the message names the changed fields. The
+                snapshot is kept, so every later call raises again instead of certifying a
+                stale scene.
+        """
+        changed = self._snapshot.changed()
+        if not changed:
+            return False
+        what = ", ".join(changed)
+        try:
+            fresh = Scene.from_model(self.model, pairs=self._pairs_spec, facets=self.facets,
+                                     tolerances=self.tolerances)
+        except (InvalidInputError, UnsupportedGeometryError) as exc:
+            raise ModelMismatchError(f"the scene's MjModel was edited in place ({what}) and the scene "
+                                     f"cannot be rebuilt: {exc}") from exc
+        self.geoms = fresh.geoms
+        self.pair_ids = fresh.pair_ids
+        self.body_names = fresh.body_names
+        self.body_static = fresh.body_static
+        self.approximations = fresh.approximations
+        self._by_name = fresh._by_name
+        self._snapshot = fresh._snapshot
+        for cached in ("candidate_pairs", "model_hash"):
+            self.__dict__.pop(cached, None)
+        self.version += 1
+        return True
 
     # ------------------------------------------------------------------ construction
 
@@ -223,10 +335,23 @@ class Scene:
         Raises:
             InvalidInputError: unknown pairs mode, unknown geom in a pair, a geom
                 paired with itself, a plane-plane pair, bad ``facets``.
-            UnsupportedGeometryError: an hfield/sdf geom in a candidate pair.
+            UnsupportedGeometryError: an hfield/sdf geom in a candidate pair, or any flex
+                (``model.nflex > 0``: deformable bodies have no convex shape here).
         """
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"model must be a mujoco.MjModel, got {type(model).__name__}")
+        if int(model.nflex) > 0:
+            fname = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_FLEX, 0) or "flex0"
+            raise UnsupportedGeometryError(
+                f"the model has {int(model.nflex)} flex object(s) (first: {fname!r}); deformable "
+                "flex bodies cannot be certified by this monitor, and ignoring them would certify "
+                "motions that collide with them")
+        if not isinstance(pairs, str):
+            try:  # keep the explicit list (a one-shot iterator too) for rebuilds after model edits
+                pairs = list(pairs)
+            except TypeError:
+                raise InvalidInputError(f"pairs must be 'mujoco', 'all' or a list of geom pairs, "
+                                        f"got {type(pairs).__name__}") from None
         nf = tolerances.facets if facets is None else facets
         if isinstance(nf, bool) or not isinstance(nf, int | np.integer) or nf < 3:
             raise InvalidInputError(f"facets must be an integer >= 3, got {facets!r}")
@@ -279,7 +404,9 @@ class Scene:
                 mocap=bool(body_mocap[b])))
         if isinstance(pairs, str) and pairs == "all":
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
-        return cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene._pairs_spec = pairs
+        return scene
 
     @staticmethod
     def _select_pairs(model: Any, pairs: Any, names: Sequence[str]) -> np.ndarray:
@@ -473,4 +600,4 @@ def _drop_overlapping_world_children(model: Any, pair_ids: np.ndarray, geoms: Se
     return pair_ids[keep]
 
 
-__all__ = ["Scene", "GeomInfo", "model_hash", "FLAT_MESH_THICKNESS"]
+__all__ = ["Scene", "GeomInfo", "model_hash", "FLAT_MESH_THICKNESS", "SYNC_FIELDS"]

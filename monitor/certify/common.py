@@ -7,7 +7,11 @@ test at the witness time (``monitor.geometry.distance``) before reporting it.
 
 from __future__ import annotations
 
+import math
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -48,18 +52,61 @@ class PairOutcome:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+DEFAULT_BUDGET_SECONDS = 60.0
+"""Wall-clock budget (s) of a ``certify`` call made with ``budget=None``.
+
+Every call is bounded: a plan with absurd motion (a joint jumping 1e8 rad in one window)
+or a huge chain ends "uncertain" after about this long instead of running for minutes.
+Pass an explicit :class:`Budget` to choose another limit (``Budget()`` with both fields
+None is unlimited, at the caller's risk)."""
+
+
+class BudgetExhausted(Exception):  # noqa: N818 - a control-flow signal, not an error
+    """Raised inside a certify stage when the active budget runs out (internal).
+
+    The engine catches it and reports every unfinished pair "uncertain"; it never leaves
+    ``monitor.certify``.
+    """
+
+
 @dataclass
 class Budget:
     """Work limit per ``certify`` call: wall seconds and/or elementary tests.
 
     An exhausted budget turns every unfinished pair into "uncertain", never into
-    "certified". ``None`` fields are unlimited.
+    "certified". ``None`` fields are unlimited. The clock starts when the Budget is
+    created (a dict budget or the default one is created when ``certify`` starts).
+    ``monitor.certify`` checks it inside every stage (motion bounds, broad phase, start
+    pose, checkers, witness search); the worst overrun measured is in
+    ``docs/notes/issue-11-model.md``.
+
+    Raises:
+        InvalidInputError: ``seconds`` not a finite number >= 0, or ``tests`` not an
+            integer >= 0 (the message names the field).
     """
 
     seconds: float | None = None
     tests: int | None = None
     _start: float = field(default_factory=time.perf_counter, repr=False)
     _used_tests: int = field(default=0, repr=False)
+
+    def __post_init__(self) -> None:
+        from monitor.errors import InvalidInputError
+
+        if self.seconds is not None:
+            s = self.seconds
+            if isinstance(s, bool) or not isinstance(s, int | float | np.integer | np.floating):
+                raise InvalidInputError(f"budget seconds must be a number or None, got {s!r}")
+            if not math.isfinite(float(s)) or float(s) < 0:
+                raise InvalidInputError(f"budget seconds must be finite and >= 0, got {s!r}")
+            self.seconds = float(s)
+        if self.tests is not None:
+            n = self.tests
+            if isinstance(n, bool) or not isinstance(n, int | np.integer):
+                raise InvalidInputError(f"budget tests must be an integer or None, got {n!r}")
+            if int(n) < 0:
+                raise InvalidInputError(f"budget tests must be >= 0, got {n!r}")
+            self.tests = int(n)
 
     def charge(self, tests: int) -> None:
         """Record ``tests`` more elementary tests."""
@@ -72,5 +119,36 @@ class Budget:
             return True
         return self.seconds is not None and time.perf_counter() - self._start >= self.seconds
 
+    def check(self) -> None:
+        """Raise :class:`BudgetExhausted` if the budget is exhausted."""
+        if self.exhausted:
+            raise BudgetExhausted
 
-__all__ = ["PairOutcome", "Budget", "Outcome"]
+
+_ACTIVE = threading.local()
+
+
+@contextmanager
+def active_budget(budget: Budget | None) -> Iterator[None]:
+    """Make ``budget`` the calling thread's active budget inside the ``with`` block.
+
+    Work that cannot take a budget argument (``Trajectory.motion_bounds`` /
+    ``body_poses`` of the motion protocol) polls it with :func:`check_active_budget`.
+    """
+    prev = getattr(_ACTIVE, "budget", None)
+    _ACTIVE.budget = budget
+    try:
+        yield
+    finally:
+        _ACTIVE.budget = prev
+
+
+def check_active_budget() -> None:
+    """Raise :class:`BudgetExhausted` if the thread's active budget is exhausted (cheap)."""
+    b = getattr(_ACTIVE, "budget", None)
+    if b is not None and b.exhausted:
+        raise BudgetExhausted
+
+
+__all__ = ["PairOutcome", "Budget", "Outcome", "BudgetExhausted", "DEFAULT_BUDGET_SECONDS",
+           "active_budget", "check_active_budget"]

@@ -45,7 +45,13 @@ import numpy as np
 
 from monitor.certify.broadphase import halfspace_gaps, sphere_pair_gaps, swept_geom_spheres
 from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
-from monitor.certify.common import Budget, PairOutcome
+from monitor.certify.common import (
+    DEFAULT_BUDGET_SECONDS,
+    Budget,
+    BudgetExhausted,
+    PairOutcome,
+    active_budget,
+)
 from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -66,7 +72,18 @@ def _finite(name: str, x: Any) -> float:
     return v
 
 
-def _check_model(scene: Any, plan: Any) -> None:
+def _check_model(scene: Any, plan: Any) -> Any:
+    """Sync the scene with its (possibly edited) model and return the plan to certify.
+
+    ``scene.sync()`` rebuilds shapes and pairs after an in-place model edit. A plan whose
+    frozen joint frames no longer match its live model (built before the edit) is
+    replaced by the same waypoints rebuilt on the live model: the certificate is about
+    the motion the simulation will now produce. The ``plan.model is scene.model`` fast
+    path skips only the hash comparison, never these checks.
+    """
+    sync = getattr(scene, "sync", None)
+    if sync is not None:
+        sync()
     pm = getattr(plan, "model", None)
     if pm is not None and pm is not scene.model:
         try:
@@ -79,6 +96,10 @@ def _check_model(scene: Any, plan: Any) -> None:
                                      "(model objects differ and their hashes differ)")
     if int(plan.nbody) != len(scene.body_names):
         raise ModelMismatchError(f"plan has {plan.nbody} bodies, scene has {len(scene.body_names)}")
+    current = getattr(plan, "is_current", None)
+    if current is not None and not current():
+        plan = plan.refreshed()
+    return plan
 
 
 def _select(scene: Any, pairs: Any) -> list[int]:
@@ -100,10 +121,16 @@ def _select(scene: Any, pairs: Any) -> list[int]:
     return sorted(set(out))
 
 
-def _make_budget(budget: Any) -> Budget | None:
-    if budget is None or isinstance(budget, Budget):
+def _make_budget(budget: Any) -> Budget:
+    """The call's budget: ``None`` -> :data:`DEFAULT_BUDGET_SECONDS`; a dict is validated."""
+    if budget is None:
+        return Budget(seconds=DEFAULT_BUDGET_SECONDS)
+    if isinstance(budget, Budget):
         return budget
     if isinstance(budget, dict):
+        unknown = sorted(set(budget) - {"seconds", "tests"}, key=str)
+        if unknown:
+            raise InvalidInputError(f"budget has unknown field(s) {unknown}; expected 'seconds', 'tests'")
         return Budget(seconds=budget.get("seconds"), tests=budget.get("tests"))
     raise InvalidInputError(f"budget must be None, a Budget or a dict, got {type(budget).__name__}")
 
@@ -120,16 +147,29 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         epsilon: termination tolerance (m of body motion), R * max rho < epsilon.
         method: "auto" | "toleranced" | "extrusion".
         window: (t0, t1) sub-window (s); default the plan's span.
-        budget: None, a :class:`Budget`, or {"seconds": .., "tests": ..}.
+        budget: None (a default :class:`Budget` of
+            :data:`~monitor.certify.common.DEFAULT_BUDGET_SECONDS` wall seconds), a
+            :class:`Budget`, or {"seconds": .., "tests": ..}. Checked inside every stage
+            (motion bounds, broad phase, start pose, checkers, witness search); pairs
+            left unfinished are "uncertain" (method ``"budget"`` when no checker ran).
         tolerances: numerical tolerances.
         pairs: optional subset of candidate pairs (geom-name pairs) to certify.
 
     Returns:
-        The :class:`Certificate`.
+        The :class:`Certificate`. ``stats["pairs"] == 0`` together with
+        ``stats["nothing_checked"] is True`` means the scene has no candidate pair:
+        the verdict is "certified" only because there is nothing to check.
 
     Raises:
-        InvalidInputError: bad margin / epsilon / window / method / pairs (NaN, ranges).
-        ModelMismatchError: the plan belongs to a different model.
+        InvalidInputError: bad margin / epsilon / window / method / pairs / budget
+            (NaN, ranges, field types).
+        ModelMismatchError: the plan belongs to a different model, or the scene's model
+            was edited in place in a way the scene cannot be rebuilt for.
+
+    The scene is synced with its model first (:meth:`monitor.Scene.sync`), and a
+    :class:`monitor.Plan` built before an in-place model edit is rebuilt on the live
+    model, so the certificate is about the model as it is now. MuJoCo's per-geom
+    ``margin`` is not added (see :mod:`monitor.scene`): pass ``margin`` explicitly.
     """
     wall0 = time.perf_counter()
     tol = tolerances
@@ -141,7 +181,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         raise InvalidInputError(f"epsilon must be > 0, got {epsilon}")
     if method not in _METHODS:
         raise InvalidInputError(f"method must be one of {_METHODS}, got {method!r}")
-    _check_model(scene, plan)
+    plan = _check_model(scene, plan)
     pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
     if window is None:
         t0, t1 = pt0, pt1
@@ -160,8 +200,18 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
-                                "budget_exhausted": False})
+                                "budget_exhausted": False, "nothing_checked": True})
+    with active_budget(bud):
+        return _certify(scene, plan, margin, epsilon, method, t0, t1, bud, tol, sel, wall0)
 
+
+def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
+             bud: Budget, tol: Tolerances, sel: list[int], wall0: float) -> Certificate:
+    """The pipeline of :func:`certify` on validated arguments (``bud`` is the active budget).
+
+    Every stage may end early with :class:`BudgetExhausted` (raised by the motion, polled
+    between pairs): the pairs it had not decided become "uncertain".
+    """
     moving = np.asarray(plan.moving_bodies(), bool)
     static = np.asarray(scene.body_static, bool)
     results: dict[int, PairResult] = {}
@@ -182,27 +232,15 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     cull_clear = np.full(len(sel_a), np.nan)          # clearance of culled pairs (inf: static-static)
     cull_clear[ss] = np.inf
     live = np.nonzero(~ss)[0]
-    if len(live):
-        used = np.unique(pid[live].ravel())
-        local = np.full(len(scene.geoms), -1, np.int64)
-        local[used] = np.arange(len(used))
-        shapes = [scene.geoms[int(g)].shape for g in used]
-        sph = swept_geom_spheres(plan, shapes, geom_body[used], (t0, t1), _NSUB, tol)
-        ia, ib = local[pid[live, 0]], local[pid[live, 1]]
-        gaps = sphere_pair_gaps(sph, ia, ib)
-        half_a = np.array([s.kind == "halfspace" for s in shapes])
-        ha, hb = half_a[ia], half_a[ib]
-        one = np.nonzero(ha ^ hb)[0]
-        if len(one):
-            pl = np.where(ha, ia, ib)[one]
-            gaps[one] = halfspace_gaps(plan, sph, [shapes[j] for j in pl], geom_body[used][pl],
-                                       np.where(ha, ib, ia)[one], (t0, t1), _NSUB)
-        culled = gaps > margin
-        cull_clear[live[culled]] = gaps[culled]
-        todo = [(int(sel_a[k]), scene.geoms[int(pid[k, 0])], scene.geoms[int(pid[k, 1])])
-                for k in live[~culled]]
-    else:
-        todo = []
+    todo: list[tuple[int, Any, Any]] = []
+    unfinished: list[tuple[int, Any, Any]] = []  # pairs a stage could not decide within the budget
+    try:
+        bud.check()
+        todo = _broad_phase(scene, plan, margin, tol, t0, t1, sel_a, pid, geom_body, live, cull_clear)
+    except BudgetExhausted:
+        cull_clear[live] = np.nan
+        unfinished = [(int(sel_a[k]), scene.geoms[int(pid[k, 0])], scene.geoms[int(pid[k, 1])])
+                      for k in live]
     n_culled = int(np.count_nonzero(~np.isnan(cull_clear)))
     if n_culled:
         mix["culled"] = n_culled
@@ -212,9 +250,12 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     witness_of: dict[int, Witness] = {}
     start_unproven: set[int] = set()
     checked = []
-    if todo:
-        pos0, rot0 = plan.body_poses(np.array([t0]))
+    try:
+        if todo:
+            bud.check()
+            pos0, rot0 = plan.body_poses(np.array([t0]))
         for i, ga, gb in todo:
+            bud.check()
             d = shape_distance(ga.shape, (rot0[0, ga.body_id], pos0[0, ga.body_id]),
                                gb.shape, (rot0[0, gb.body_id], pos0[0, gb.body_id]), tolerances=tol)
             if d.upper + _approx(ga, gb) < margin:
@@ -235,61 +276,50 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
                                        intervals=((t0, t1),)))
                 continue
             checked.append((i, ga, gb))
+    except BudgetExhausted:
+        unfinished += [it for it in todo if it[0] not in results]
+        checked = []
     # -- 4. dispatch ---------------------------------------------------------------------
     ext_items, tol_items = [], []
-    for i, ga, gb in checked:
-        trans = None
-        if method in ("auto", "extrusion"):
-            sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
-            if sa is not None and sb is not None:
-                trans = (sa, sb)
-            elif method == "extrusion":
-                raise InvalidInputError(f"method='extrusion' but pair ({ga.name!r}, {gb.name!r}) does not "
-                                        "translate with piecewise-constant velocity")
-        if trans is not None:
-            ext_items.append((i, ga, gb, trans))
-        else:
-            tol_items.append((i, ga, gb))
+    try:
+        for i, ga, gb in checked:
+            trans = None
+            if method in ("auto", "extrusion"):
+                sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
+                if sa is not None and sb is not None:
+                    trans = (sa, sb)
+                elif method == "extrusion":
+                    raise InvalidInputError(f"method='extrusion' but pair ({ga.name!r}, {gb.name!r}) "
+                                            "does not translate with piecewise-constant velocity")
+            if trans is not None:
+                ext_items.append((i, ga, gb, trans))
+            else:
+                tol_items.append((i, ga, gb))
+    except BudgetExhausted:
+        unfinished += checked
+        checked, ext_items, tol_items = [], [], []
     outcomes: dict[int, tuple[str, PairOutcome]] = {}
     if ext_items:
-        from monitor.certify import extrusion
-        posr, rotr = plan.body_poses(np.array([t0]))
-        eps_pairs = []
-        for _i, ga, gb, ((ta, oa), (tb, ob)) in ext_items:
-            eps_pairs.append(extrusion.TranslatingPair(
-                ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
-                gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
-                name=(ga.name, gb.name)))
-        # The extrusion checker is exact up to Tolerances.extrusion_slack with Cameron's
-        # regularised semantics (touching is not a collision). The engine's contract is
-        # stricter (certified => clearance > margin, rounding included), so it asks the
-        # checker the stronger question: a certificate at margin + slack + pad implies
-        # clearance > margin. Exact touching (or a sub-slack shortfall) then ends as
-        # "uncertain" (never "certified", and "violation" only if a witness confirms it).
-        # Pairs that fail the stronger question are re-run at the true margin for a
-        # witness deep enough to confirm (with margin > 0 the checker caps its depth at
-        # the margin it is given); "certified" there means the sub-slack band: unresolved.
-        ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
-        outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud)
-        redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
-        if redo:
-            again = extrusion.check_pairs([eps_pairs[k] for k in redo], (t0, t1), margin, tol, bud)
-            for k, o2 in zip(redo, again):
-                if o2.verdict == "violation":
-                    o2.tests += outs[k].tests
-                    outs[k] = o2
-                elif outs[k].verdict == "violation":  # band case: never a confirmed witness time
-                    o1 = outs[k]
-                    o1.verdict, o1.witness_time = "unresolved", None
+        try:
+            outs = _run_extrusion(plan, ext_items, margin, tol, bud, t0, t1)
+        except BudgetExhausted:
+            outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in ext_items]
         for (i, _ga, _gb, _), o in zip(ext_items, outs):
             outcomes[i] = ("extrusion", o)
     if tol_items:
         from monitor.certify import toleranced
         items = [(ga.shape, ga.body_id, gb.shape, gb.body_id) for _i, ga, gb in tol_items]
-        outs = toleranced.check_pairs(plan, items, (t0, t1), margin, epsilon, tol, bud,
-                                      static=~moving, check_start=False)
+        try:
+            outs = toleranced.check_pairs(plan, items, (t0, t1), margin, epsilon, tol, bud,
+                                          static=~moving, check_start=False)
+        except BudgetExhausted:
+            outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in tol_items]
         for (i, _ga, _gb), o in zip(tol_items, outs):
             outcomes[i] = ("toleranced", o)
+    for i, ga, gb in unfinished:
+        if i not in results:
+            done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "uncertain", "budget",
+                               intervals=((t0, t1),)))
     # -- 5. witnesses ---------------------------------------------------------------------
     by_i = {i: (ga, gb) for i, ga, gb in checked}
     refine: list[int] = []
@@ -318,7 +348,12 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
             k = 1 if b <= a else max(2, tol.witness_candidates)
             cands += list(np.linspace(a, b, k))
-        w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol) if cands else None
+        w = None
+        if cands:
+            try:  # a budget that runs out here leaves the pair "uncertain" (no witness)
+                w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol, bud)
+            except BudgetExhausted:
+                w = None
         if w is not None:
             witness_of[i] = w
             done(i, PairResult(names, bodies, "violation", meth, o.tests, o.max_depth,
@@ -326,8 +361,13 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         else:
             done(i, PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
                                tuple(intervals) if intervals else ((t0, t1),), float("-inf")))
-    if refine:  # better clearance bounds for toleranced-certified pairs (one pose/bound call)
-        cl = _sampled_clearances(plan, [by_i[i] for i in refine], t0, t1, tol)
+    cl = []
+    if refine and not bud.exhausted:  # better clearance bounds for toleranced-certified pairs
+        try:
+            cl = _sampled_clearances(plan, [by_i[i] for i in refine], t0, t1, tol)
+        except BudgetExhausted:  # optional refinement: the checker's bound (margin) stands
+            cl = []
+    if cl:
         for i, c in zip(refine, cl):
             r = results[i]
             if c > r.clearance:
@@ -353,9 +393,77 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     stats = {"pairs": len(ordered), "pairs_culled": n_culled,
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud is not None and bud.exhausted)}
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
     return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        ordered, stats)
+
+
+def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: float, t1: float,
+                 sel_a: np.ndarray, pid: np.ndarray, geom_body: np.ndarray, live: np.ndarray,
+                 cull_clear: np.ndarray) -> list[tuple[int, Any, Any]]:
+    """Swept-sphere cull of the ``live`` pairs; fills ``cull_clear`` and returns the pairs left.
+
+    May raise :class:`BudgetExhausted` (from the motion); ``cull_clear`` is then partial.
+    """
+    if not len(live):
+        return []
+    used = np.unique(pid[live].ravel())
+    local = np.full(len(scene.geoms), -1, np.int64)
+    local[used] = np.arange(len(used))
+    shapes = [scene.geoms[int(g)].shape for g in used]
+    sph = swept_geom_spheres(plan, shapes, geom_body[used], (t0, t1), _NSUB, tol)
+    ia, ib = local[pid[live, 0]], local[pid[live, 1]]
+    gaps = sphere_pair_gaps(sph, ia, ib)
+    half_a = np.array([s.kind == "halfspace" for s in shapes])
+    ha, hb = half_a[ia], half_a[ib]
+    one = np.nonzero(ha ^ hb)[0]
+    if len(one):
+        pl = np.where(ha, ia, ib)[one]
+        gaps[one] = halfspace_gaps(plan, sph, [shapes[j] for j in pl], geom_body[used][pl],
+                                   np.where(ha, ib, ia)[one], (t0, t1), _NSUB)
+    culled = gaps > margin
+    cull_clear[live[culled]] = gaps[culled]
+    return [(int(sel_a[k]), scene.geoms[int(pid[k, 0])], scene.geoms[int(pid[k, 1])])
+            for k in live[~culled]]
+
+
+def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, bud: Budget,
+                   t0: float, t1: float) -> list[PairOutcome]:
+    """Extrusion checker on the translating pairs (see the comment inside)."""
+    from monitor.certify import extrusion
+    posr, rotr = plan.body_poses(np.array([t0]))
+    eps_pairs = []
+    for _i, ga, gb, ((ta, oa), (tb, ob)) in ext_items:
+        eps_pairs.append(extrusion.TranslatingPair(
+            ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
+            gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
+            name=(ga.name, gb.name)))
+    # The extrusion checker is exact up to Tolerances.extrusion_slack with Cameron's
+    # regularised semantics (touching is not a collision). The engine's contract is
+    # stricter (certified => clearance > margin, rounding included), so it asks the
+    # checker the stronger question: a certificate at margin + slack + pad implies
+    # clearance > margin. Exact touching (or a sub-slack shortfall) then ends as
+    # "uncertain" (never "certified", and "violation" only if a witness confirms it).
+    # Pairs that fail the stronger question are re-run at the true margin for a
+    # witness deep enough to confirm (with margin > 0 the checker caps its depth at
+    # the margin it is given); "certified" there means the sub-slack band: unresolved.
+    ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
+    outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud)
+    redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
+    if redo and not bud.exhausted:
+        again = extrusion.check_pairs([eps_pairs[k] for k in redo], (t0, t1), margin, tol, bud)
+        for k, o2 in zip(redo, again):
+            if o2.verdict == "violation":
+                o2.tests += outs[k].tests
+                outs[k] = o2
+            elif outs[k].verdict == "violation":  # band case: never a confirmed witness time
+                o1 = outs[k]
+                o1.verdict, o1.witness_time = "unresolved", None
+    else:
+        for k in redo:
+            if outs[k].verdict == "violation":  # not re-run: never a confirmed witness time
+                outs[k].verdict, outs[k].witness_time = "unresolved", None
+    return outs
 
 
 def _build_ordered(sel: list[int], cull_clear: list[float], ga: list[int], gb: list[int],
@@ -421,17 +529,19 @@ def _approx(ga: Any, gb: Any) -> float:
 
 
 def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
-                  tol: Tolerances) -> Witness | None:
+                  tol: Tolerances, budget: Budget | None = None) -> Witness | None:
     """Earliest candidate time whose confirmed distance is below margin.
 
     The exact static upper bound plus the shapes' over-approximation (circumscribed
-    geoms) must be below the margin.
+    geoms) must be below the margin. Stops (None) when ``budget`` runs out.
     """
     from monitor.geometry.distance import shape_distance
 
     pos, rot = plan.body_poses(times)
     slack = _approx(ga, gb)
     for k, t in enumerate(times):
+        if budget is not None and budget.exhausted:
+            return None
         d = shape_distance(ga.shape, (rot[k, ga.body_id], pos[k, ga.body_id]),
                            gb.shape, (rot[k, gb.body_id], pos[k, gb.body_id]), tolerances=tol)
         if d.upper + slack < margin:

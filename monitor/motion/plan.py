@@ -115,6 +115,7 @@ import threading
 import mujoco
 import numpy as np
 
+from monitor.certify.common import check_active_budget
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
 from monitor.motion.base import MotionBounds, WindowTimes, chord
@@ -156,6 +157,9 @@ _STRUCT_CACHE_MAX = 16
 
 class _ModelStructure:
     """Everything :class:`Plan` derives from the model alone (read-only, shared)."""
+
+    key: bytes = b""
+    """:func:`_structure_key` of the arrays this structure was built from."""
 
     def __init__(self, model: mujoco.MjModel):
         nbody = model.nbody
@@ -271,14 +275,20 @@ def _fk_data(model: mujoco.MjModel) -> mujoco.MjData:
     return d
 
 
+def _structure_key(model: mujoco.MjModel) -> bytes:
+    """Bytes of every model array :class:`_ModelStructure` reads (its cache key)."""
+    return b"|".join([np.asarray([model.nq, model.nv, model.njnt, model.nbody, model.nmocap,
+                                  model.ngeom]).tobytes()]
+                     + [np.ascontiguousarray(getattr(model, f)).tobytes() for f in _STRUCT_FIELDS])
+
+
 def _structure(model: mujoco.MjModel) -> _ModelStructure:
     """The (cached) :class:`_ModelStructure` of ``model``'s current arrays."""
-    key = b"|".join([np.asarray([model.nq, model.nv, model.njnt, model.nbody, model.nmocap,
-                                 model.ngeom]).tobytes()]
-                    + [np.ascontiguousarray(getattr(model, f)).tobytes() for f in _STRUCT_FIELDS])
+    key = _structure_key(model)
     st = _STRUCT_CACHE.get(key)
     if st is None:
         st = _ModelStructure(model)
+        st.key = key
         if len(_STRUCT_CACHE) >= _STRUCT_CACHE_MAX:
             _STRUCT_CACHE.pop(next(iter(_STRUCT_CACHE)))
         _STRUCT_CACHE[key] = st
@@ -499,6 +509,22 @@ class Plan(WindowTimes):
         """The MuJoCo model of the plan."""
         return self._model
 
+    def is_current(self) -> bool:
+        """True if the model arrays frozen at construction still equal the live model's.
+
+        The motion bounds use joint frames, body offsets and reference points copied from
+        the model when the plan was built, while the poses come from ``mj_kinematics`` on
+        the live model; after an in-place edit of those arrays (``body_pos``, ``jnt_axis``,
+        ``geom_pos``, ...) the two disagree. :func:`monitor.certify` then certifies
+        :meth:`refreshed` instead.
+        """
+        return _structure_key(self._model) == self._st.key
+
+    def refreshed(self) -> Plan:
+        """The same waypoints (times, qpos, held mocap poses) rebuilt on the live model."""
+        return Plan(self._times.copy(), self._qpos.copy(), self._model, mocap_pos=self._mocap_pos.copy(),
+                    mocap_quat=self._mocap_quat.copy(), tolerances=self._tol)
+
     @property
     def qpos(self) -> np.ndarray:
         """(K, nq) waypoint joint positions (quaternions normalised), read-only."""
@@ -551,6 +577,8 @@ class Plan(WindowTimes):
             d.mocap_pos[:] = self._mocap_pos
             d.mocap_quat[:] = self._mocap_quat
         for k in range(T):
+            if not k % 16:
+                check_active_budget()
             d.qpos[:] = Q[k]
             mujoco.mj_kinematics(m, d)
             pos[k] = d.xpos
@@ -670,6 +698,7 @@ class Plan(WindowTimes):
         for b in range(1, nbody):
             if not self._moving[b]:
                 continue
+            check_active_budget()  # a certify budget bounds this stage too (1000-link chains)
             js = self._jnt_of_body[b]
             if js and jtype[js[0]] == _FREE:
                 j = js[0]
@@ -737,6 +766,7 @@ class Plan(WindowTimes):
         for b in range(1, nbody):
             if not self._moving[b]:
                 continue
+            check_active_budget()
             ch = self._chain_v[b]
             kind = vk[ch]
             own = self._own_count[b]
