@@ -7,7 +7,17 @@ Lengths are metres, angles radians, times seconds.
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass
+
+
+def _is_real(v: object) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _is_integer(v: object) -> bool:
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
 
 
 @dataclass(frozen=True)
@@ -75,7 +85,38 @@ class Tolerances:
     small epsilon doubles its frontier per level (one pair grew a process to 3.7 GB at
     epsilon 1e-5). Measured on the bench's colliding box pair at epsilon 1e-5: peak RSS
     3.4 GB (no cap, 20 s budget exhausted) vs 0.89 GB (4096) vs 0.38 GB (1024, 2.7 s,
-    violation confirmed). 1024 = 10 full levels of one window. 0 = no cap."""
+    violation confirmed). 1024 = 10 full levels of one window. 0 = no cap (memory is then
+    bounded only by ``max_depth`` and the budget)."""
+
+    def __post_init__(self) -> None:
+        """Validate every field (a negative pad or a NaN would certify collisions).
+
+        Raises:
+            InvalidInputError: naming the field: floats must be finite real numbers
+                (``quat_norm_tol`` in (0, 1e-2], pads and ``extrusion_slack`` >= 0); ints
+                must be integers (not bool) with ``max_depth`` >= 1, ``facets`` >= 3,
+                ``witness_candidates`` >= 1 and ``max_frontier`` >= 0 (0 = no cap).
+        """
+        from monitor.errors import InvalidInputError  # leaf module: imported lazily
+
+        for name in ("quat_norm_tol", "rel_pad", "abs_pad", "scale_pad", "extrusion_slack"):
+            v = getattr(self, name)
+            if not _is_real(v) or not math.isfinite(float(v)):
+                raise InvalidInputError(f"Tolerances.{name} must be a finite real number, got {v!r}")
+            v = float(v)
+            if v < 0:
+                raise InvalidInputError(f"Tolerances.{name} must be >= 0, got {v!r}")
+            object.__setattr__(self, name, v)
+        if not 0.0 < self.quat_norm_tol <= 1e-2:
+            raise InvalidInputError(f"Tolerances.quat_norm_tol must be in (0, 1e-2] (a quaternion this far "
+                                    f"from unit norm is a mistake, not rounding), got {self.quat_norm_tol!r}")
+        for name, lo in (("max_depth", 1), ("facets", 3), ("witness_candidates", 1), ("max_frontier", 0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not _is_integer(v):
+                raise InvalidInputError(f"Tolerances.{name} must be an integer, got {v!r}")
+            if int(v) < lo:
+                raise InvalidInputError(f"Tolerances.{name} must be >= {lo}, got {v!r}")
+            object.__setattr__(self, name, int(v))
 
     def pad(self, magnitude: float) -> float:
         """Rounding pad for a quantity of the given magnitude (metres)."""

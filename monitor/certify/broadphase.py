@@ -25,6 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from monitor.certify.common import check_active_budget
 from monitor.geometry.shapes import ConvexShape
 from monitor.motion.base import MotionBounds, Trajectory, chord
 from monitor.tolerances import DEFAULT, Tolerances
@@ -122,6 +123,7 @@ def sphere_pair_gaps(spheres: SweptSpheres, ia: np.ndarray, ib: np.ndarray,
     out = np.empty(len(ia))
     C, R = spheres.centres, spheres.radii
     for s in range(0, len(ia), chunk):
+        check_active_budget()  # hundreds of thousands of pairs: a certify budget bounds this
         a, b = ia[s:s + chunk], ib[s:s + chunk]
         d = np.linalg.norm(C[:, a] - C[:, b], axis=2) - R[:, a] - R[:, b]          # (T, n)
         g = d.min(axis=0) - spheres.pad

@@ -52,7 +52,7 @@ class PairOutcome:
     info: dict[str, Any] = field(default_factory=dict)
 
 
-DEFAULT_BUDGET_SECONDS = 60.0
+DEFAULT_BUDGET_SECONDS = 10.0
 """Wall-clock budget (s) of a ``certify`` call made with ``budget=None``.
 
 Every call is bounded: a plan with absurd motion (a joint jumping 1e8 rad in one window)

@@ -58,6 +58,11 @@ from monitor.tolerances import DEFAULT, Tolerances
 _METHODS = ("auto", "toleranced", "extrusion")
 _MAX_WITNESS_INTERVALS = 64
 """Intervals per pair searched for a witness (in time order); the rest stay uncertain."""
+_FINALISE_SECONDS_PER_PAIR = [8e-6]
+"""Cost (s) per selected pair of assembling the certificate (one PairResult each, plus the
+garbage collector's first pass over them): 2-8 us measured on a loaded 2-core machine.
+Reserved from a seconds budget (at most half of it) so the stages stop early enough; the
+value tracks the largest cost measured in this process (one-element list: mutable)."""
 _NSUB = 8
 """Sub-intervals of the broad phase's swept spheres (one pose / bound call for all geoms)."""
 
@@ -104,7 +109,7 @@ def _check_model(scene: Any, plan: Any) -> Any:
 
 def _select(scene: Any, pairs: Any) -> list[int]:
     if pairs is None:
-        return list(range(len(scene.candidate_pairs)))
+        return list(range(len(scene.pair_ids)))
     index = {}
     for i, (a, b) in enumerate(scene.candidate_pairs):
         index[(a, b)] = i
@@ -119,6 +124,22 @@ def _select(scene: Any, pairs: Any) -> list[int]:
             raise InvalidInputError(f"pairs[{k}] = ({a!r}, {b!r}) is not a candidate pair of the scene")
         out.append(index[(a, b)])
     return sorted(set(out))
+
+
+def _stage_budget(bud: Budget, npairs: int) -> Budget:
+    """The budget the stages work against: ``bud`` minus the time to assemble the certificate.
+
+    After the stages, one :class:`PairResult` per selected pair is built (about
+    :data:`_FINALISE_SECONDS_PER_PAIR` each); for 500 000 pairs that is a second or more,
+    which would otherwise come on top of an exhausted budget. Same clock as ``bud``.
+    """
+    if bud.seconds is None:
+        return bud
+    reserve = min(0.5 * bud.seconds, _FINALISE_SECONDS_PER_PAIR[0] * npairs)
+    stage = Budget(seconds=bud.seconds - reserve, tests=bud.tests)
+    stage._start = bud._start
+    stage._used_tests = bud._used_tests
+    return stage
 
 
 def _make_budget(budget: Any) -> Budget:
@@ -201,8 +222,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
                                 "budget_exhausted": False, "nothing_checked": True})
-    with active_budget(bud):
-        return _certify(scene, plan, margin, epsilon, method, t0, t1, bud, tol, sel, wall0)
+    stage = _stage_budget(bud, len(sel))
+    with active_budget(stage):
+        return _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0)
 
 
 def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
@@ -233,14 +255,21 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     cull_clear[ss] = np.inf
     live = np.nonzero(~ss)[0]
     todo: list[tuple[int, Any, Any]] = []
-    unfinished: list[tuple[int, Any, Any]] = []  # pairs a stage could not decide within the budget
+    # Pairs a stage could not decide within the budget ("uncertain", method "budget"), as a
+    # mask over the selected pairs: hundreds of thousands of them cost no Python per pair.
+    unfin = np.zeros(len(sel_a), bool)
+
+    def unfinished(items: list) -> None:
+        ks = np.searchsorted(sel_a, np.fromiter((it[0] for it in items if it[0] not in results),
+                                                np.int64))
+        unfin[ks] = True
+
     try:
         bud.check()
         todo = _broad_phase(scene, plan, margin, tol, t0, t1, sel_a, pid, geom_body, live, cull_clear)
     except BudgetExhausted:
         cull_clear[live] = np.nan
-        unfinished = [(int(sel_a[k]), scene.geoms[int(pid[k, 0])], scene.geoms[int(pid[k, 1])])
-                      for k in live]
+        unfin[live] = True
     n_culled = int(np.count_nonzero(~np.isnan(cull_clear)))
     if n_culled:
         mix["culled"] = n_culled
@@ -277,7 +306,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
                 continue
             checked.append((i, ga, gb))
     except BudgetExhausted:
-        unfinished += [it for it in todo if it[0] not in results]
+        unfinished(todo)
         checked = []
     # -- 4. dispatch ---------------------------------------------------------------------
     ext_items, tol_items = [], []
@@ -296,7 +325,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             else:
                 tol_items.append((i, ga, gb))
     except BudgetExhausted:
-        unfinished += checked
+        unfinished(checked)
         checked, ext_items, tol_items = [], [], []
     outcomes: dict[int, tuple[str, PairOutcome]] = {}
     if ext_items:
@@ -316,10 +345,9 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in tol_items]
         for (i, _ga, _gb), o in zip(tol_items, outs):
             outcomes[i] = ("toleranced", o)
-    for i, ga, gb in unfinished:
-        if i not in results:
-            done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "uncertain", "budget",
-                               intervals=((t0, t1),)))
+    n_unfin = int(np.count_nonzero(unfin))
+    if n_unfin:
+        mix["budget"] = n_unfin
     # -- 5. witnesses ---------------------------------------------------------------------
     by_i = {i: (ga, gb) for i, ga, gb in checked}
     refine: list[int] = []
@@ -376,26 +404,34 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     # -- 6. combine -------------------------------------------------------------------------
     names = [g.name for g in scene.geoms]
     bnames = [g.body for g in scene.geoms]
-    ordered = _build_ordered(sel_a.tolist(), cull_clear.tolist(), pid[:, 0].tolist(), pid[:, 1].tolist(),
+    fin0 = time.perf_counter()
+    ordered = _build_ordered(sel_a.tolist(), cull_clear.tolist(), unfin.tolist(), (t0, t1),
+                             pid[:, 0].tolist(), pid[:, 1].tolist(),
                              results, names, bnames)
     checked_r = [results[i] for i in sorted(results)]
-    verdict = combine_verdicts([r.verdict for r in checked_r])
+    verdict = combine_verdicts([r.verdict for r in checked_r] + (["uncertain"] if n_unfin else []))
     witnesses = [r.witness for r in checked_r if r.verdict == "violation" and r.witness is not None]
     witness = min(witnesses, key=lambda w: w.time) if witnesses else None
     earliest = None
     if verdict != "certified":
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
-        starts += [w.time for w in witnesses]
+        starts += [w.time for w in witnesses] + ([t0] if n_unfin else [])
         earliest = float(min(starts)) if starts else t0
     finite_cull = cull_clear[np.isfinite(cull_clear)]
     clears = [r.clearance for r in checked_r] + ([float(finite_cull.min())] if len(finite_cull) else [])
+    if n_unfin:
+        clears.append(float("-inf"))
     clearance = float(min(clears)) if clears else float("inf")
     stats = {"pairs": len(ordered), "pairs_culled": n_culled,
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
-    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
+    cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        ordered, stats)
+    if len(ordered) >= 10_000:  # learn the assembly cost on big scenes (small ones are noise)
+        per_pair = (time.perf_counter() - fin0) / len(ordered)
+        _FINALISE_SECONDS_PER_PAIR[0] = max(_FINALISE_SECONDS_PER_PAIR[0], min(per_pair, 1e-4))
+    return cert
 
 
 def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: float, t1: float,
@@ -466,22 +502,37 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     return outs
 
 
-def _build_ordered(sel: list[int], cull_clear: list[float], ga: list[int], gb: list[int],
-                   results: dict[int, PairResult], names: list[str], bnames: list[str]) -> tuple:
-    """One PairResult per selected pair, in order; culled ones are built here from arrays.
+def _build_ordered(sel: list[int], cull_clear: list[float], unfin: list[bool], window: tuple[float, float],
+                   ga: list[int], gb: list[int], results: dict[int, PairResult], names: list[str],
+                   bnames: list[str]) -> tuple:
+    """One PairResult per selected pair, in order; culled and budget-unfinished ones are built here.
 
     ``pairs="all"`` makes hundreds of thousands of culled results; the cyclic garbage
     collector would re-scan the growing tuple at every generation-0 threshold (about half
     of the build time), so it is paused while building (the objects hold no cycles) and
-    restored to its previous state afterwards.
+    restored to its previous state afterwards. ``unfin[k]``: the budget ran out before any
+    stage decided pair k ("uncertain", method ``"budget"``, the whole window).
     """
     was = gc.isenabled()
     gc.disable()
+    inf = float("-inf")
+    budget_iv = (tuple(window),)
+    new = object.__new__
+
+    def quick(a: int, b: int, verdict: str, method: str, intervals: tuple, clearance: float) -> PairResult:
+        # Field-for-field the same PairResult as the constructor makes (frozen dataclass,
+        # no __post_init__), at a third of the cost: these are built per culled pair.
+        r = new(PairResult)
+        r.__dict__.update(geoms=(names[a], names[b]), bodies=(bnames[a], bnames[b]), verdict=verdict,
+                          method=method, tests=0, max_depth=0, intervals=intervals, clearance=clearance,
+                          witness=None)
+        return r
+
     try:
-        return tuple(results[i] if cc != cc else  # NaN: not culled
-                     PairResult((names[a], names[b]), (bnames[a], bnames[b]), "certified", "culled",
-                                0, 0, (), cc, None)
-                     for i, cc, a, b in zip(sel, cull_clear, ga, gb))
+        return tuple(quick(a, b, "uncertain", "budget", budget_iv, inf) if u else
+                     results[i] if cc != cc else  # NaN: not culled
+                     quick(a, b, "certified", "culled", (), cc)
+                     for i, cc, u, a, b in zip(sel, cull_clear, unfin, ga, gb))
     finally:
         if was:
             gc.enable()

@@ -107,7 +107,7 @@ from typing import Any
 
 import numpy as np
 
-from monitor.certify.common import Budget, PairOutcome
+from monitor.certify.common import Budget, BudgetExhausted, PairOutcome, check_active_budget
 from monitor.geometry.shapes import ConvexShape
 from monitor.motion.base import Trajectory, chord
 from monitor.motion.metric import Metric, edge_coefficients, face_coefficients, shape_metric
@@ -490,7 +490,10 @@ def _template(A: MovingFeatures, B: FixedFeatures) -> _Template:
 
 def _build_tables(pairs: list[_PairData], C: _Concat) -> _Tables:
     """Concatenate the cached templates of all pairs into global row and unit tables."""
-    tpls = [_template(pd.A, pd.B) for pd in pairs]
+    tpls = []
+    for pd in pairs:
+        check_active_budget()  # templates of big meshes take a while: the budget bounds them
+        tpls.append(_template(pd.A, pd.B))
     counts = np.array([[len(tp.cols[t]) for t in _TYPES] for tp in tpls], np.int64).reshape(-1, len(_TYPES))
     type_off = np.cumsum(np.vstack([np.zeros((1, len(_TYPES)), np.int64), counts]), axis=0)[:-1]
     totals = counts.sum(axis=0)
@@ -744,6 +747,7 @@ def _run_kernels(C: _Concat, T: _Tables, u_item: np.ndarray, u_row: np.ndarray, 
                  ball: _Ball, tol: Tolerances) -> None:
     """Evaluate every unique (item, row) by its row type's kernel, writing into ``fired``."""
     for t in _TYPES:
+        check_active_budget()  # one kernel call at a time: bounds a long level's overrun
         lo, hi = T.row_start[t], T.row_start[t] + len(T.rows[t]["pair"])
         sel = np.nonzero((u_row >= lo) & (u_row < hi))[0]
         if not len(sel):
@@ -1004,19 +1008,26 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
             break
         N = len(fr.pair)
         np.maximum.at(max_depth, fr.pair, fr.depth)
-        L, p, R = provider.balls(fr)
-        R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
-        pr = fr.pair
-        eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
-        ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
+        try:  # the motion bounds and the kernels poll the certify budget (one level can be long)
+            L, p, R = provider.balls(fr)
+            R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
+            pr = fr.pair
+            eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
+            ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
+            if pre is not None:
+                sep = pre.separated(fr.pair, ball, tol)
+                live = np.nonzero(~sep[fr.unit_item])[0]
+            else:
+                live = np.arange(len(fr.unit_item))
+            uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
+        except BudgetExhausted:  # this level's frontier stays unresolved, as at the check above
+            exhausted = True
+            for i in range(len(fr.pair)):
+                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            break
         if pre is not None:
-            sep = pre.separated(fr.pair, ball, tol)
             np.add.at(prefiltered, fr.pair[sep], 1)
-            live = np.nonzero(~sep[fr.unit_item])[0]
-        else:
-            live = np.arange(len(fr.unit_item))
         unit_fired = np.zeros(len(fr.unit_item), bool)
-        uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
         unit_fired[live] = uf_live
         np.add.at(row_tests, fr.pair[u_item], 1)
         np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
@@ -1214,6 +1225,8 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
     t0, t1 = float(window[0]), float(window[1])
     pds, ba, bb, swapped = [], [], [], []
     for sa, a, sb, b in items:
+        if budget is not None:
+            budget.check()  # BudgetExhausted: the engine reports these pairs uncertain
         sw = _orient(sa, a, sb, b, static)
         if sw:
             sa, a, sb, b = sb, b, sa, a
