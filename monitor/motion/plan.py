@@ -160,6 +160,8 @@ class _ModelStructure:
 
     key: bytes = b""
     """:func:`_structure_key` of the arrays this structure was built from."""
+    field_bytes: list[bytes] = []
+    """Raw bytes of each ``_STRUCT_FIELDS`` array it was built from (for ``Plan.is_current``)."""
 
     def __init__(self, model: mujoco.MjModel):
         nbody = model.nbody
@@ -282,6 +284,25 @@ def _structure_key(model: mujoco.MjModel) -> bytes:
                      + [np.ascontiguousarray(getattr(model, f)).tobytes() for f in _STRUCT_FIELDS])
 
 
+_VIEWS: dict[int, tuple[mujoco.MjModel, list[np.ndarray]]] = {}
+_VIEWS_MAX = 16
+
+
+def _field_views(model: mujoco.MjModel) -> list[np.ndarray]:
+    """Views of ``model``'s ``_STRUCT_FIELDS`` arrays, cached per model object.
+
+    Attribute access on an MjModel builds a new view each time; the buffers never move.
+    """
+    hit = _VIEWS.get(id(model))
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    if len(_VIEWS) >= _VIEWS_MAX:
+        _VIEWS.pop(next(iter(_VIEWS)))
+    views = [getattr(model, f) for f in _STRUCT_FIELDS]
+    _VIEWS[id(model)] = (model, views)  # the model reference keeps id(model) unique
+    return views
+
+
 def _structure(model: mujoco.MjModel) -> _ModelStructure:
     """The (cached) :class:`_ModelStructure` of ``model``'s current arrays."""
     key = _structure_key(model)
@@ -289,6 +310,7 @@ def _structure(model: mujoco.MjModel) -> _ModelStructure:
     if st is None:
         st = _ModelStructure(model)
         st.key = key
+        st.field_bytes = [v.tobytes() for v in _field_views(model)]
         if len(_STRUCT_CACHE) >= _STRUCT_CACHE_MAX:
             _STRUCT_CACHE.pop(next(iter(_STRUCT_CACHE)))
         _STRUCT_CACHE[key] = st
@@ -518,7 +540,7 @@ class Plan(WindowTimes):
         ``geom_pos``, ...) the two disagree. :func:`monitor.certify` then certifies
         :meth:`refreshed` instead.
         """
-        return _structure_key(self._model) == self._st.key
+        return all(v.tobytes() == b for v, b in zip(_field_views(self._model), self._st.field_bytes))
 
     def refreshed(self) -> Plan:
         """The same waypoints (times, qpos, held mocap poses) rebuilt on the live model."""
