@@ -219,3 +219,49 @@ def test_flex_is_refused_by_name():
     assert m.nflex == 1
     with pytest.raises(UnsupportedGeometryError, match="cloth"):
         monitor.Scene.from_model(m, pairs="all")
+
+
+def _model_with_everything():
+    """A model where every watched array is non-empty (mesh, exclude, pair, joints)."""
+    xml = """<mujoco><asset><mesh name="m" vertex="0 0 0  .1 0 0  0 .1 0  0 0 .1"/></asset>
+      <worldbody><geom name="floor" type="plane" size="1 1 .1"/>
+      <body name="a" pos="0 0 .5"><joint name="ja" type="hinge" axis="0 0 1"/>
+        <geom name="ga" type="mesh" mesh="m"/>
+        <body name="b" pos=".2 0 0"><joint name="jb" type="slide" axis="1 0 0"/>
+          <geom name="gb" type="box" size=".05 .05 .05"/></body></body>
+      <body name="c" pos="0 .5 .5"><freejoint/><geom name="gc" type="sphere" size=".05"/></body>
+      </worldbody><contact><exclude body1="a" body2="c"/><pair geom1="gb" geom2="gc"/></contact>
+    </mujoco>"""
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def test_every_watched_field_is_seen_through_the_snapshot():
+    """Each SYNC_FIELDS array edited in place (through a fresh attribute view, as users do)
+    is reported by the snapshot; restoring it makes the snapshot clean again. This guards
+    against a field whose attribute returns a copy instead of a view of the model buffer."""
+    from monitor.scene import SYNC_FIELDS
+
+    m = _model_with_everything()
+    scene = monitor.Scene.from_model(m, pairs="mujoco")
+    for f in SYNC_FIELDS:
+        arr = getattr(m, f)
+        assert arr.size, f
+        old = arr.flat[0].copy()
+        getattr(m, f).flat[0] = old + 1
+        assert scene._snapshot.changed() == [f], f
+        getattr(m, f).flat[0] = old
+        assert scene._snapshot.changed() == [], f
+
+
+def test_every_plan_field_is_seen_by_is_current():
+    from monitor.motion.plan import _STRUCT_FIELDS
+
+    m = _model_with_everything()
+    plan = monitor.Plan([0.0, 1.0], [m.qpos0, m.qpos0], m)
+    for f in _STRUCT_FIELDS:
+        arr = getattr(m, f)
+        old = arr.flat[0].copy()
+        getattr(m, f).flat[0] = old + 1
+        assert not plan.is_current(), f
+        getattr(m, f).flat[0] = old
+        assert plan.is_current(), f
