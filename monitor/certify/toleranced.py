@@ -1225,8 +1225,9 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
     t0, t1 = float(window[0]), float(window[1])
     pds, ba, bb, swapped = [], [], [], []
     for sa, a, sb, b in items:
-        if budget is not None:
-            budget.check()  # BudgetExhausted: the engine reports these pairs uncertain
+        if budget is not None and budget.exhausted:  # feature sets of big meshes take a while
+            return [PairOutcome("unresolved", intervals=[(t0, t1)], info={"budget_exhausted": True})
+                    for _ in items]
         sw = _orient(sa, a, sb, b, static)
         if sw:
             sa, a, sb, b = sb, b, sa, a
