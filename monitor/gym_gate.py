@@ -9,8 +9,24 @@ decision into an ``env.step`` call, and reports in ``info``:
 * ``info["cost"]``: 1.0 when the proposed action's window has a confirmed
   violation, else 0.0 (safety-gymnasium's convention in the 5-tuple API).
 
-The action is assumed to be written to ``data.ctrl`` by the env (what
-gymnasium's ``MujocoEnv.do_simulation`` does) when ``predictor="rollout"``.
+Wrappers between the gate and the MuJoCo env. The gate predicts the control the
+env will actually apply: it walks the chain from the wrapped env down to
+``env.unwrapped`` and composes every ``gymnasium.ActionWrapper.action`` transform
+(outermost first; e.g. ``RescaleAction``, ``ClipAction``, a user's action wrapper),
+so the rollout writes ``T(action)`` to the scratch ``ctrl``, as
+``MujocoEnv.do_simulation`` will. Wrappers known to pass the action through
+unchanged (``TimeLimit``, ``OrderEnforcing``, ``PassiveEnvChecker``,
+``RecordEpisodeStatistics``, observation and reward wrappers, render/record
+wrappers, any wrapper that does not override ``step``) are skipped. Any other
+wrapper in between (one that overrides ``step``, ``RepeatAction``, ``StickyAction``,
+``Autoreset``, ...) could change the motion, and the gate refuses it at
+construction (:class:`InvalidInputError` naming the wrapper class). After every
+step of the rollout predictor the gate checks that ``data.ctrl`` equals the control
+it certified and raises :class:`InvalidInputError` otherwise (e.g. an action
+wrapper that is not a function of the action), so a difference is never silent.
+With action wrappers present the default fallback is the zero action (the gate's
+hold-position control is a control, not an action) and the braking-tail check is
+off.
 """
 
 from __future__ import annotations
@@ -24,6 +40,52 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.gate import Gate, StepReport, safety_info
+
+_W = gymnasium.wrappers
+_PASS_THROUGH_STEPS = frozenset({
+    gymnasium.Wrapper.step, gymnasium.ObservationWrapper.step, gymnasium.RewardWrapper.step,
+    _W.TimeLimit.step, _W.OrderEnforcing.step, _W.PassiveEnvChecker.step, _W.RecordEpisodeStatistics.step,
+    _W.RecordVideo.step, _W.RenderCollection.step, _W.HumanRendering.step, _W.NormalizeReward.step,
+    _W.FrameStackObservation.step, _W.TimeAwareObservation.step,
+})
+"""``step`` methods that hand the action to the inner env unchanged and step it once."""
+_STATEFUL_ACTION_WRAPPERS = (_W.StickyAction,)
+"""Action wrappers whose ``action`` depends on more than the action (state, RNG): refused."""
+
+
+def action_wrappers(env: gymnasium.Env) -> list[gymnasium.ActionWrapper]:
+    """The action transforms between ``env`` and ``env.unwrapped``, outermost first.
+
+    Args:
+        env: the env the gate wraps (it may itself be the unwrapped env).
+
+    Returns:
+        the ``ActionWrapper`` instances whose ``action`` maps the gate's action, in the
+        order the actions pass through them.
+
+    Raises:
+        InvalidInputError: naming the class of a wrapper that could change the action or the
+            motion in a way the gate cannot predict.
+    """
+    chain: list[gymnasium.ActionWrapper] = []
+    w, inner = env, env.unwrapped
+    while w is not inner:
+        cls = type(w)
+        if isinstance(w, gymnasium.ActionWrapper) and not isinstance(w, _STATEFUL_ACTION_WRAPPERS) \
+                and cls.step is gymnasium.ActionWrapper.step:
+            chain.append(w)
+        elif not isinstance(w, gymnasium.ActionWrapper) and cls.step in _PASS_THROUGH_STEPS:
+            pass
+        else:
+            raise InvalidInputError(
+                f"SafetyGate cannot predict the control through the wrapper "
+                f"{cls.__module__}.{cls.__qualname__} between it and the MuJoCo env: it may change the "
+                "action or the motion (it overrides step, repeats steps or keeps state). Put SafetyGate "
+                "below it, or make it a gymnasium.ActionWrapper whose action() is a function of the action.")
+        w = getattr(w, "env", None)
+        if w is None:
+            raise InvalidInputError(f"env: {cls.__qualname__} has no .env, cannot reach env.unwrapped")
+    return chain
 
 
 class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
@@ -78,23 +140,27 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{type(u).__name__} has none")
         if not isinstance(env.action_space, gymnasium.spaces.Box):
             raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
-        action_is_ctrl = tuple(env.action_space.shape) == (model.nu,)
-        if predictor == "rollout" and not action_is_ctrl:
+        self.action_chain = action_wrappers(env)
+        inner_shape = tuple(u.action_space.shape) if self.action_chain else tuple(env.action_space.shape)
+        action_is_ctrl = not self.action_chain and inner_shape == (model.nu,)
+        if predictor == "rollout" and inner_shape != (model.nu,):
             raise InvalidInputError(
                 f"predictor='rollout' writes the action to data.ctrl, but the action shape "
-                f"{env.action_space.shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
+                f"{inner_shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
         self.predictor_mode = predictor
         self.user_fallback = fallback
         self.timing = bool(timing)
         if fallback is None and not action_is_ctrl:
             # the action is not data.ctrl: "hold position" is unknown, use the zero action
             fallback = np.zeros(env.action_space.shape)
+        if not action_is_ctrl:
             brake = False  # the braking tail needs the action to be the control
-        gate_fallback = None if fallback is None or callable(fallback) else np.asarray(fallback, float)
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
-                         fallback=gate_fallback, brake=brake,
-                         frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env))
+                         fallback=None if callable(fallback) else fallback, brake=brake,
+                         frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
+                         action_shape=tuple(env.action_space.shape))
+        self._predicted: list[tuple[Any, np.ndarray]] = []
         self._obs: Any = None
 
     # ----------------------------------------------------------------- helpers
@@ -113,13 +179,42 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         space = self.env.action_space
         return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
 
+    def to_ctrl(self, action: Any) -> Any:
+        """The action as the MuJoCo env receives it: every action wrapper's ``action()``, outermost first."""
+        for w in self.action_chain:
+            action = w.action(action)
+        return action
+
     def _predict_fn(self) -> Callable[[Any], Any] | None:
         u, mode = self.env.unwrapped, self.predictor_mode
         if mode == "rollout":
-            return None
+            if not self.action_chain:
+                return None  # the gate's own rollout with ctrl = action
+
+            def rollout(a: Any) -> Any:
+                ctrl = np.asarray(self.to_ctrl(a))
+                self._predicted.append((a, ctrl))
+                return self.gate.predict(u.data, ctrl)
+            return rollout
         if mode == "plan":
-            return u.planned_trajectory
+            if not self.action_chain:
+                return u.planned_trajectory
+            return lambda a: u.planned_trajectory(self.to_ctrl(a))
         return lambda a: mode(self.env, self._obs, a)
+
+    def _check_applied_ctrl(self, applied: Any) -> None:
+        """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
+        if self.predictor_mode != "rollout":
+            return
+        expected = next((c for a, c in self._predicted if a is applied), applied)
+        expected = np.asarray(expected, dtype=np.float64)
+        ctrl = self.env.unwrapped.data.ctrl
+        if not np.array_equal(ctrl, expected):
+            raise InvalidInputError(
+                f"env: after the step data.ctrl = {np.array2string(ctrl)} but the gate certified ctrl = "
+                f"{np.array2string(expected)}: something between SafetyGate and "
+                f"{type(self.env.unwrapped).__name__}, or its step, changed the action in a way the gate "
+                "cannot predict; the window that ran was not certified")
 
     def _fallback_fn(self) -> Callable[[], np.ndarray] | None:
         fb = self.user_fallback
@@ -131,10 +226,27 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
 
     # ----------------------------------------------------------------- gymnasium API
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        """Certify the window of ``action``, gate it, then step the wrapped env."""
+        """Certify the window of ``action``, gate it, then step the wrapped env.
+
+        Raises:
+            InvalidInputError: ``action`` is not a finite numeric array of the action space's
+                shape, or (rollout predictor) the env applied a control other than the certified one.
+        """
+        shape = tuple(self.env.action_space.shape)
+        try:
+            arr = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise InvalidInputError(f"action must be a numeric array of shape {shape}, got {action!r}") from e
+        if arr.shape != shape:
+            raise InvalidInputError(f"action must have shape {shape} (the action space's), got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise InvalidInputError(f"action contains NaN or inf: {arr}")
+        self._predicted.clear()
         report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
                                               fallback=self._fallback_fn(), cast=self._as_action)
         obs, reward, terminated, truncated, info = self.env.step(report.applied_ctrl)
+        self._check_applied_ctrl(report.applied_ctrl)
+        self._predicted.clear()
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)
