@@ -195,7 +195,6 @@ def test_step_rejects_bad_ctrl():
 
 # ----------------------------------------------------------------------------- with the real engine
 def _agv_env():
-    pytest.importorskip("monitor.certify.extrusion_scenes")
     try:
         scene_path("agv_trays")
     except FileNotFoundError:
@@ -258,8 +257,7 @@ def test_block_on_tunnel_reuses_the_committed_tail():
 
 
 def test_log_has_one_window_per_step(tmp_path):
-    reader = pytest.importorskip("monitor.log.reader")
-    from monitor.log import topics
+    from monitor.log import reader, topics
 
     m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
     d = mujoco.MjData(m)
