@@ -472,6 +472,7 @@ class Gate:
         self.brake_vel_tol = float(brake_vel_tol)
         self._committed: np.ndarray | None = None
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
+        self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
         self.tolerances = tolerances
         self._rollout = Rollout(model)
@@ -677,10 +678,12 @@ class Gate:
 
         That is the case when the live state equals a tail waypoint bit for bit
         (time, qpos, qvel, mocap) and the window ends inside the tail: the
-        committed brake then reproduces the tail exactly. Else None.
+        committed brake then reproduces the tail exactly, and margin, epsilon,
+        tolerances and the scene version are those the tail was certified under.
+        Else None.
         """
-        if self._tail is None:
-            return None
+        if self._tail is None or self._tail_context != self._reuse_context():
+            return None  # no tail, or certified under other settings / geometry
         plan, cert, qvel = self._tail
         if not cert.certified:
             return None
@@ -786,6 +789,7 @@ class Gate:
         elif not unsafe:
             self._committed = brake_next
             self._tail = None if brake_next is None else (tail, tail_cert, tail_qvel)
+            self._tail_context = self._reuse_context()
         report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
                             applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
         self._account(report)

@@ -368,3 +368,17 @@ def test_zero_candidate_pairs_warn_once_at_construction():
     d = mujoco.MjData(m)
     report = gate.step(d, np.zeros(0))
     assert report.verdict == "certified" and report.info()["monitored_pairs"] == 0
+
+
+def test_committed_tail_is_not_reused_after_a_setting_changed():
+    """The committed brake's tail was certified at margin 0; at margin 0.5 (the wall is ~0.3 m away)
+    the brake window must be re-certified, not taken from that tail."""
+    m, d = _tunnel()
+    gate = Gate(m)
+    assert gate.step(d, np.array([1.0])).verdict == "certified"  # commits a brake and its tail
+    assert gate._tail is not None
+    gate.margin = 0.5
+    r = gate.step(d, np.array([1.0]))
+    assert r.replaced and r.verdict == "violation"
+    assert r.applied_verdict == "violation" and not r.fallback_certified
+    assert gate.stats["tail_reused"] == 0
