@@ -161,6 +161,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
                          action_shape=tuple(env.action_space.shape))
         self._predicted: list[tuple[Any, np.ndarray]] = []
+        self._action_shape = tuple(env.action_space.shape)
+        self._unwrapped = u
         self._obs: Any = None
 
     # ----------------------------------------------------------------- helpers
@@ -206,10 +208,13 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
         if self.predictor_mode != "rollout":
             return
-        expected = next((c for a, c in self._predicted if a is applied), applied)
+        expected = applied
+        for a, c in self._predicted:
+            if a is applied:
+                expected = c
         expected = np.asarray(expected, dtype=np.float64)
-        ctrl = self.env.unwrapped.data.ctrl
-        if not np.array_equal(ctrl, expected):
+        ctrl = self._unwrapped.data.ctrl
+        if ctrl.shape != expected.shape or not (ctrl == expected).all():
             raise InvalidInputError(
                 f"env: after the step data.ctrl = {np.array2string(ctrl)} but the gate certified ctrl = "
                 f"{np.array2string(expected)}: something between SafetyGate and "
@@ -232,14 +237,14 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             InvalidInputError: ``action`` is not a finite numeric array of the action space's
                 shape, or (rollout predictor) the env applied a control other than the certified one.
         """
-        shape = tuple(self.env.action_space.shape)
+        shape = self._action_shape
         try:
             arr = np.asarray(action, dtype=np.float64)
         except (TypeError, ValueError) as e:
             raise InvalidInputError(f"action must be a numeric array of shape {shape}, got {action!r}") from e
         if arr.shape != shape:
             raise InvalidInputError(f"action must have shape {shape} (the action space's), got {arr.shape}")
-        if not np.all(np.isfinite(arr)):
+        if not np.isfinite(arr).all():
             raise InvalidInputError(f"action contains NaN or inf: {arr}")
         self._predicted.clear()
         report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
