@@ -462,8 +462,8 @@ class Gate:
         self.predictor = predictor
         self.on_violation = on_violation
         self.unsafe = unsafe
-        fallback_shape = (model.nu,) if action_shape is None else tuple(action_shape)
-        self.fallback = _check_fallback(fallback, fallback_shape)
+        self._fallback_shape = (model.nu,) if action_shape is None else tuple(action_shape)
+        self.fallback = _check_fallback(fallback, self._fallback_shape)
         self.budget = budget
         self.frame_skip = int(frame_skip)
         self.reuse = bool(reuse)
@@ -665,7 +665,7 @@ class Gate:
         if fb is None:
             return hold_ctrl(self.model, data)
         if callable(fb):
-            return np.asarray(fb(data), dtype=np.float64)
+            return _check_fallback(fb(data), self._fallback_shape)  # typed error on a bad return value
         return np.asarray(fb, dtype=np.float64)
 
     def reset(self) -> None:

@@ -105,7 +105,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             action, clipped to the action space, when the action is not ``data.ctrl``),
             an action array, or a callable ``fallback(env, obs) -> action``.
         budget: per-step work limit (seconds float, tests int, dict or Budget).
-        log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`.
+        log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`. A path is claimed
+            exclusively (``fcntl.flock``); when another live gate writes it (e.g. the sub-envs
+            of ``gym.make_vec(..., wrappers=[partial(SafetyGate, log="x.mcap")])``) this gate
+            writes the first free ``x.1.mcap``, ``x.2.mcap``, ... (``gate.log_path``), never
+            the same file.
         unsafe: ``"uncertain"`` (default: anything not certified is unsafe) or ``"violation"``.
         timing: add ``info["safety"]["certify_us"]`` (wall time, µs). Off by default
             because a wall time differs between identical runs, which fails
@@ -114,7 +118,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         brake: recoverability check with a committed brake (see :class:`monitor.Gate`).
 
     Raises:
-        InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data or an option is invalid.
+        InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data, an option is invalid,
+            or a wrapper between the gate and the MuJoCo env could change the action in a way
+            the gate cannot predict (see the module docstring).
     """
 
     def __init__(self, env: gymnasium.Env, *, predictor: str | Callable[..., Any] = "rollout",
@@ -178,8 +184,16 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         return opts
 
     def _as_action(self, a: Any) -> np.ndarray:
+        """A gate-made or fallback action, clipped to the action space and cast to its dtype."""
         space = self.env.action_space
-        return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
+        try:
+            arr = np.asarray(a, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise InvalidInputError(f"fallback must give a numeric action, got {a!r}") from e
+        if arr.shape not in ((), self._action_shape) or not np.isfinite(arr).all():
+            raise InvalidInputError(f"fallback must give a finite action of shape {self._action_shape}, "
+                                    f"got {arr!r}")
+        return np.asarray(np.clip(arr, space.low, space.high), dtype=space.dtype)
 
     def to_ctrl(self, action: Any) -> Any:
         """The action as the MuJoCo env receives it: every action wrapper's ``action()``, outermost first."""

@@ -382,3 +382,10 @@ def test_committed_tail_is_not_reused_after_a_setting_changed():
     assert r.replaced and r.verdict == "violation"
     assert r.applied_verdict == "violation" and not r.fallback_certified
     assert gate.stats["tail_reused"] == 0
+
+
+def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
+    m, d = _tunnel()
+    gate = Gate(m, margin=0.5, fallback=lambda data: [0.0, 0.0])  # the wall is within 0.5 m: blocked
+    with pytest.raises(InvalidInputError, match="fallback"):
+        gate.step(d, np.array([1.0]))

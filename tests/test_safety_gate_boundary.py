@@ -97,3 +97,10 @@ def test_second_gate_on_a_claimed_path_writes_a_sibling(tmp_path):
     c.step(mujoco.MjData(m), np.zeros(1))
     assert c.log_path == path
     c.close()
+
+
+def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
+    env = SafetyGate(gym.make("monitor/Tunnel-v0"), margin=0.5, fallback=lambda env, obs: [0.0, 0.0])
+    env.reset(seed=0)
+    with pytest.raises(InvalidInputError, match="fallback"):
+        env.step(np.array([1.0]))
