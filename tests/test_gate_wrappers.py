@@ -157,3 +157,8 @@ def test_gym_make_chain_and_observation_wrappers_pass():
         RecordEpisodeStatistics(gym.make("monitor/Tunnel-v0")), lambda o: o, None))
     env.reset(seed=0)
     assert env.step(np.array([0.0]))[4]["safety"]["verdict"] == "certified"
+
+
+def test_gate_over_a_gate_is_refused():
+    with pytest.raises(InvalidInputError, match=r"wrapper monitor\.gym_gate\.SafetyGate"):
+        SafetyGate(SafetyGate(gym.make("monitor/Tunnel-v0")))
