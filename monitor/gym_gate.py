@@ -12,21 +12,24 @@ decision into an ``env.step`` call, and reports in ``info``:
 Wrappers between the gate and the MuJoCo env. The gate predicts the control the
 env will actually apply: it walks the chain from the wrapped env down to
 ``env.unwrapped`` and composes every ``gymnasium.ActionWrapper.action`` transform
-(outermost first; e.g. ``RescaleAction``, ``ClipAction``, a user's action wrapper),
-so the rollout writes ``T(action)`` to the scratch ``ctrl``, as
-``MujocoEnv.do_simulation`` will. Wrappers known to pass the action through
-unchanged (``TimeLimit``, ``OrderEnforcing``, ``PassiveEnvChecker``,
+(outermost first; e.g. ``RescaleAction``, ``ClipAction``, a user's action wrapper)
+into ``T``. Each step evaluates ``c = T(action)`` exactly once; the gate decides in
+the env's own action space (for the rollout predictor: ``c`` is the control,
+written to the scratch ``ctrl``), then steps the wrapper chain with the action
+transforms bypassed for that call, so that ``MujocoEnv.do_simulation`` receives
+exactly the certified ``c`` (or the fallback the gate chose instead). Wrappers
+known to pass the action through unchanged (``TimeLimit``, ``OrderEnforcing``, ``PassiveEnvChecker``,
 ``RecordEpisodeStatistics``, observation and reward wrappers, render/record
 wrappers, any wrapper that does not override ``step``) are skipped. Any other
 wrapper in between (one that overrides ``step``, ``RepeatAction``, ``StickyAction``,
 ``Autoreset``, ...) could change the motion, and the gate refuses it at
 construction (:class:`InvalidInputError` naming the wrapper class). After every
 step of the rollout predictor the gate checks that ``data.ctrl`` equals the control
-it certified and raises :class:`InvalidInputError` otherwise (e.g. an action
-wrapper that is not a function of the action), so a difference is never silent.
-With action wrappers present the default fallback is the zero action (the gate's
-hold-position control is a control, not an action) and the braking-tail check is
-off.
+it certified and raises :class:`InvalidInputError` otherwise (e.g. an env whose
+``step`` changes the action before ``do_simulation``), so a difference is never
+silent. A user fallback (array or callable) is an action of the gate's own action
+space and goes through ``T`` like a proposal; the default fallback (hold position)
+and the braking-tail check work in the env's control space, as without wrappers.
 """
 
 from __future__ import annotations
@@ -51,6 +54,11 @@ _PASS_THROUGH_STEPS = frozenset({
 """``step`` methods that hand the action to the inner env unchanged and step it once."""
 _STATEFUL_ACTION_WRAPPERS = (_W.StickyAction,)
 """Action wrappers whose ``action`` depends on more than the action (state, RNG): refused."""
+_MISSING = object()
+
+
+def _identity(action: Any) -> Any:
+    return action
 
 
 def action_wrappers(env: gymnasium.Env) -> list[gymnasium.ActionWrapper]:
@@ -96,7 +104,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             ``data`` (MjData), e.g. any ``MujocoEnv``.
         predictor: ``"rollout"`` (scratch rollout of ``frame_skip`` substeps with
             ``ctrl = action``), ``"plan"`` (``env.unwrapped.planned_trajectory(action)``)
-            or a callable ``predictor(env, obs, action) -> Plan``.
+            or a callable ``predictor(env, obs, action) -> Plan``. With action wrappers
+            between the gate and the MuJoCo env, ``action`` here is the action the MuJoCo
+            env receives (after the wrappers' transforms).
         pairs: candidate pairs (``"mujoco"``, ``"all"`` or geom-name pairs).
         margin: clearance (m) that counts as safe.
         epsilon: certification tolerance (m).
@@ -147,27 +157,34 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         if not isinstance(env.action_space, gymnasium.spaces.Box):
             raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
         self.action_chain = action_wrappers(env)
-        inner_shape = tuple(u.action_space.shape) if self.action_chain else tuple(env.action_space.shape)
-        action_is_ctrl = not self.action_chain and inner_shape == (model.nu,)
-        if predictor == "rollout" and inner_shape != (model.nu,):
+        self._action_shape = tuple(env.action_space.shape)
+        inner_space = u.action_space if self.action_chain else env.action_space
+        if not isinstance(inner_space, gymnasium.spaces.Box):
+            raise InvalidInputError(f"SafetyGate needs a Box action space in {type(u).__name__}, "
+                                    f"got {inner_space}")
+        self._inner_space = inner_space
+        inner_shape = tuple(inner_space.shape)
+        action_is_ctrl = inner_shape == (model.nu,)
+        if predictor == "rollout" and not action_is_ctrl:
             raise InvalidInputError(
                 f"predictor='rollout' writes the action to data.ctrl, but the action shape "
                 f"{inner_shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
         self.predictor_mode = predictor
         self.user_fallback = fallback
         self.timing = bool(timing)
+        gate_fallback = None if callable(fallback) else fallback
+        if gate_fallback is not None and self.action_chain:  # an action: the env receives T(fallback)
+            gate_fallback = self._inner_action(self.to_ctrl(self._as_action(gate_fallback)), "fallback")
         if fallback is None and not action_is_ctrl:
             # the action is not data.ctrl: "hold position" is unknown, use the zero action
-            fallback = np.zeros(env.action_space.shape)
+            gate_fallback = self._as_inner(np.zeros(inner_shape))
         if not action_is_ctrl:
             brake = False  # the braking tail needs the action to be the control
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
-                         fallback=None if callable(fallback) else fallback, brake=brake,
+                         fallback=gate_fallback, brake=brake,
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
-                         action_shape=tuple(env.action_space.shape))
-        self._predicted: list[tuple[Any, np.ndarray]] = []
-        self._action_shape = tuple(env.action_space.shape)
+                         action_shape=inner_shape)
         self._unwrapped = u
         self._obs: Any = None
 
@@ -195,38 +212,63 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                                     f"got {arr!r}")
         return np.asarray(np.clip(arr, space.low, space.high), dtype=space.dtype)
 
+    def _as_inner(self, a: Any) -> np.ndarray:
+        """A gate-made action of the env's own action space (hold, brake), clipped to it and cast."""
+        space = self._inner_space
+        return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
+
+    def _inner_action(self, c: Any, what: str) -> np.ndarray:
+        """``c = T(action)`` checked: a finite numeric array of the env's own action shape."""
+        shape = tuple(self._inner_space.shape)
+        try:
+            arr = np.asarray(c)
+            ok = arr.shape == shape and np.isfinite(np.asarray(arr, dtype=np.float64)).all()
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise InvalidInputError(f"{what}: the action wrappers map it to {c!r}, not a finite array of "
+                                    f"shape {shape} for {type(self.env.unwrapped).__name__}")
+        return arr
+
     def to_ctrl(self, action: Any) -> Any:
         """The action as the MuJoCo env receives it: every action wrapper's ``action()``, outermost first."""
         for w in self.action_chain:
             action = w.action(action)
         return action
 
+    def _step_env(self, inner_action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Step the wrapped env so that the MuJoCo env receives exactly ``inner_action``.
+
+        The action wrappers' transforms were applied by the gate already (once); for this
+        call each ``ActionWrapper.action`` is the identity. Every other wrapper steps as usual.
+        """
+        if not self.action_chain:
+            return self.env.step(inner_action)
+        saved = [w.__dict__.get("action", _MISSING) for w in self.action_chain]
+        for w in self.action_chain:
+            w.action = _identity  # instance attribute: shadows the class's transform for this call
+        try:
+            return self.env.step(inner_action)
+        finally:
+            for w, old in zip(self.action_chain, saved):
+                if old is _MISSING:
+                    del w.action
+                else:
+                    w.action = old
+
     def _predict_fn(self) -> Callable[[Any], Any] | None:
         u, mode = self.env.unwrapped, self.predictor_mode
         if mode == "rollout":
-            if not self.action_chain:
-                return None  # the gate's own rollout with ctrl = action
-
-            def rollout(a: Any) -> Any:
-                ctrl = np.asarray(self.to_ctrl(a))
-                self._predicted.append((a, ctrl))
-                return self.gate.predict(u.data, ctrl)
-            return rollout
+            return None  # the gate's own rollout with ctrl = the env's action
         if mode == "plan":
-            if not self.action_chain:
-                return u.planned_trajectory
-            return lambda a: u.planned_trajectory(self.to_ctrl(a))
+            return u.planned_trajectory
         return lambda a: mode(self.env, self._obs, a)
 
     def _check_applied_ctrl(self, applied: Any) -> None:
         """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
         if self.predictor_mode != "rollout":
             return
-        expected = applied
-        for a, c in self._predicted:
-            if a is applied:
-                expected = c
-        expected = np.asarray(expected, dtype=np.float64)
+        expected = np.asarray(applied, dtype=np.float64)
         ctrl = self._unwrapped.data.ctrl
         if ctrl.shape != expected.shape or not (ctrl == expected).all():
             raise InvalidInputError(
@@ -240,7 +282,10 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         if fb is None:
             return None  # the gate's default: committed brake, else hold position
         if callable(fb):
-            return lambda: self._as_action(fb(self.env, self._obs))
+            if not self.action_chain:
+                return lambda: self._as_action(fb(self.env, self._obs))
+            return lambda: self._inner_action(self.to_ctrl(self._as_action(fb(self.env, self._obs))),
+                                              "fallback")
         return None  # an array fallback is the gate's own (cast on use)
 
     # ----------------------------------------------------------------- gymnasium API
@@ -260,12 +305,12 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             raise InvalidInputError(f"action must have shape {shape} (the action space's), got {arr.shape}")
         if not np.isfinite(arr).all():
             raise InvalidInputError(f"action contains NaN or inf: {arr}")
-        self._predicted.clear()
-        report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
-                                              fallback=self._fallback_fn(), cast=self._as_action)
-        obs, reward, terminated, truncated, info = self.env.step(report.applied_ctrl)
+        if self.action_chain:
+            action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
+        report: StepReport = self.gate.decide(self._unwrapped.data, action, predict=self._predict_fn(),
+                                              fallback=self._fallback_fn(), cast=self._as_inner)
+        obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
         self._check_applied_ctrl(report.applied_ctrl)
-        self._predicted.clear()
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)

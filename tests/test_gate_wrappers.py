@@ -116,10 +116,11 @@ def test_wrapper_that_may_change_the_action_is_refused(wrap):
         SafetyGate(env)
 
 
-def test_unpredictable_control_is_detected_after_the_step():
-    """An action wrapper that is not a function of the action: the post-step check raises."""
+def test_action_transform_is_evaluated_once_per_step():
+    """An action wrapper that is not a function of the action (a counter): the gate evaluates it once
+    per step and the env receives exactly the control that was certified."""
 
-    class Noisy(gym.ActionWrapper):
+    class Counting(gym.ActionWrapper):
         def __init__(self, env):
             super().__init__(env)
             self.k = 0
@@ -128,10 +129,55 @@ def test_unpredictable_control_is_detected_after_the_step():
             self.k += 1
             return np.asarray(action) + 1e-3 * self.k
 
-    env = SafetyGate(Noisy(gym.make("monitor/Tunnel-v0")), on_violation="warn")
+    wrapper = Counting(gym.make("monitor/Tunnel-v0"))
+    env = SafetyGate(wrapper, on_violation="warn")
+    env.reset(seed=0)
+    for k in range(1, 4):
+        env.step(np.array([0.5]))
+        assert wrapper.k == k
+        assert np.array_equal(env.unwrapped.data.ctrl, env.gate.last_report.applied_ctrl)
+        assert np.array_equal(env.unwrapped.data.ctrl, [0.5 + 1e-3 * k])
+    assert "action" not in wrapper.__dict__  # the bypass is undone after the step
+
+
+def test_env_step_that_changes_the_control_is_detected():
+    """A MuJoCo env whose step doubles the action: the post-step check raises, never silent."""
+    from envs.tunnel_v0 import TunnelEnv
+
+    class Doubling(TunnelEnv):
+        def step(self, action):
+            return super().step(2.0 * np.asarray(action))
+
+    env = SafetyGate(Doubling(), on_violation="warn")
     env.reset(seed=0)
     with pytest.raises(InvalidInputError, match="ctrl"):
         env.step(np.array([0.5]))
+
+
+def test_brake_and_hold_fallback_work_through_rescale_action():
+    """With RescaleAction the gate still commits a brake (control space) and applies it exactly."""
+    env = SafetyGate(RescaleAction(gym.make("monitor/Tunnel-v0"), -1.0, 1.0))
+    env.reset(seed=0)
+    rows = []
+    for _ in range(30):
+        x0 = float(env.unwrapped.data.qpos[0])
+        info = env.step(np.array([5.0 / 6.0]))[4]  # 5 m/s: would tunnel in two steps
+        rows.append((x0, float(env.unwrapped.data.qpos[0]), str(info["safety"]["applied_verdict"])))
+        assert info["safety"]["fallback_certified"]
+    _assert_sound(rows)
+    assert all(x1 < -BAND for _, x1, _ in rows)
+    s = env.gate.summary()
+    assert s["replaced"] > 0 and s["tail_reused"] > 0 and s["fallback_uncertified"] == 0
+
+
+def test_array_fallback_is_an_action_through_the_wrappers():
+    """fallback=[0.0] under RescaleAction(0, 1): the env receives -6 m/s (away from the wall)."""
+    env = SafetyGate(RescaleAction(gym.make("monitor/Tunnel-v0"), 0.0, 1.0), fallback=np.array([0.0]),
+                     margin=0.5)  # the wall is within 0.5 m: every proposal is blocked
+    env.reset(seed=0)
+    info = env.step(np.array([1.0]))[4]
+    assert info["safety"]["replaced"]
+    assert np.allclose(env.unwrapped.data.ctrl, [-6.0])
 
 
 @pytest.mark.parametrize("clamp", [True, False])
