@@ -425,7 +425,7 @@ class Gate:
 
     ``margin``, ``epsilon`` and ``tolerances`` may be reassigned (validated; the reuse
     cache is keyed on them). The scene is built at construction; a gate with no
-    candidate pairs warns (``UserWarning``) once, then, since it checks nothing.
+    candidate pairs warns (``UserWarning``) once, at construction, since it checks nothing.
 
     Raises:
         InvalidInputError: on an unknown option, a bad ``log``, ``fallback``, ``budget`` or
