@@ -195,10 +195,6 @@ def test_step_rejects_bad_ctrl():
 
 # ----------------------------------------------------------------------------- with the real engine
 def _agv_env():
-    try:
-        scene_path("agv_trays")
-    except FileNotFoundError:
-        pytest.skip("models/agv_trays not available")
     env = gym.make("monitor/AGV-v0", schedule="weaving").unwrapped
     env.reset(seed=0)
     return env
