@@ -355,7 +355,11 @@ def _budget_tests(tests: Any) -> int | None:
 
 def _check_log(log: Any) -> None:
     """``log`` must be None, a path or an object with ``write_window`` (a MonitorLog)."""
-    if log is None or isinstance(log, (str, os.PathLike)) or callable(getattr(log, "write_window", None)):
+    if isinstance(log, (str, os.PathLike)):
+        if not Path(log).parent.is_dir():
+            raise InvalidInputError(f"log: the directory of {str(log)!r} does not exist")
+        return
+    if log is None or callable(getattr(log, "write_window", None)):
         return
     raise InvalidInputError(f"log must be None, an .mcap path or a monitor.log.MonitorLog, got "
                             f"{type(log).__name__} {log!r}")

@@ -286,6 +286,7 @@ def test_step_with_non_numeric_ctrl_is_a_typed_error():
 @pytest.mark.parametrize(("kwargs", "name"), [
     ({"log": 123}, "log"),
     ({"log": object()}, "log"),
+    ({"log": "/nonexistent-dir-h11b/x.mcap"}, "log"),
     ({"fallback": [1, 2, 3]}, "fallback"),  # the tunnel has one actuator
     ({"fallback": [np.nan]}, "fallback"),
     ({"fallback": "stop"}, "fallback"),
