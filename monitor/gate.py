@@ -29,7 +29,17 @@ Certificate reuse. Pairs whose two bodies do not move in the window and whose
 poses equal those of an earlier certified window are not re-certified; only
 the other pairs go to :func:`monitor.certify` (its ``pairs=`` argument). The
 reused results are exact: a pair of fixed bodies at identical poses has the
-same clearance.
+same clearance. The cache is keyed on everything a pair result depends on:
+the two bodies' poses, ``margin``, ``epsilon``, ``tolerances`` and the scene's
+geometry version (``Scene.version``, bumped by ``Scene.sync()`` when the live
+model was edited; the gate syncs before every window). Changing any of these
+empties the cache.
+
+Logs. ``log="x.mcap"`` claims the path with an exclusive ``fcntl.flock`` for as
+long as the gate writes it. A path already claimed by another live gate (in
+this or another process, e.g. the sub-envs of a vector env built with one
+``log=`` argument) is never overwritten: the gate writes ``x.1.mcap``,
+``x.2.mcap``, ... instead (the first free one; see :attr:`Gate.log_path`).
 
 This module imports mujoco and monitor only (no gymnasium, no mcap).
 """
@@ -38,7 +48,9 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import time
+import warnings
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -240,7 +252,8 @@ class StepReport:
             of str, one per candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
             witness_time (float s), witness_geoms ((2,) object array of str), witness_point ((3,) m),
             earliest_time (float s), clearance (float m), replaced (bool),
-            fallback_certified (bool), terminated (bool), time (float s)
+            fallback_certified (bool), terminated (bool), time (float s), monitored_pairs (int:
+            candidate pairs checked, 0 when the gate monitors nothing)
             and, if ``timing``, certify_us (float µs).
         """
         return safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
@@ -284,6 +297,7 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         "fallback_certified": bool(fallback_certified),
         "terminated": bool(terminated),
         "time": float(time),
+        "monitored_pairs": int(len(checker)),
     }
     if certify_us is not None:
         out["certify_us"] = float(certify_us)
@@ -298,17 +312,78 @@ def _make_budget(budget: Any) -> Any:
     from monitor.certify.common import Budget
 
     if isinstance(budget, Budget):
-        return Budget(seconds=budget.seconds, tests=budget.tests)
+        return Budget(seconds=_budget_seconds(budget.seconds), tests=_budget_tests(budget.tests))
     if isinstance(budget, dict):
-        return Budget(seconds=budget.get("seconds"), tests=budget.get("tests"))
+        unknown = sorted(str(k) for k in budget if k not in ("seconds", "tests"))
+        if unknown:
+            raise InvalidInputError(f"budget: unknown keys {unknown}; use 'seconds' and/or 'tests'")
+        return Budget(seconds=_budget_seconds(budget.get("seconds")),
+                      tests=_budget_tests(budget.get("tests")))
     bad = f"budget must be seconds (float), tests (int), a dict or a Budget; got {budget!r}"
     if isinstance(budget, bool):
         raise InvalidInputError(bad)
     if isinstance(budget, (int, np.integer)):
-        return Budget(tests=int(budget))
+        return Budget(tests=_budget_tests(budget))
     if isinstance(budget, (float, np.floating)):
-        return Budget(seconds=float(budget))
+        return Budget(seconds=_budget_seconds(budget))
     raise InvalidInputError(bad)
+
+
+def _is_real(x: Any) -> bool:
+    """True for a real number (Python or numpy int/float), False for bool and everything else."""
+    return (not isinstance(x, (bool, np.bool_))
+            and isinstance(x, (int, float, np.integer, np.floating)))
+
+
+def _budget_seconds(seconds: Any) -> float | None:
+    """Validated ``budget`` seconds: None or a finite number > 0."""
+    if seconds is None:
+        return None
+    if not _is_real(seconds) or not math.isfinite(float(seconds)) or float(seconds) <= 0:
+        raise InvalidInputError(f"budget seconds must be a finite number > 0, got {seconds!r}")
+    return float(seconds)
+
+
+def _budget_tests(tests: Any) -> int | None:
+    """Validated ``budget`` tests: None or an integer >= 1."""
+    if tests is None:
+        return None
+    if isinstance(tests, (bool, np.bool_)) or not isinstance(tests, (int, np.integer)) or int(tests) < 1:
+        raise InvalidInputError(f"budget tests must be an integer >= 1, got {tests!r}")
+    return int(tests)
+
+
+def _check_log(log: Any) -> None:
+    """``log`` must be None, a path or an object with ``write_window`` (a MonitorLog)."""
+    if isinstance(log, (str, os.PathLike)):
+        if not Path(log).parent.is_dir():
+            raise InvalidInputError(f"log: the directory of {str(log)!r} does not exist")
+        return
+    if log is None or callable(getattr(log, "write_window", None)):
+        return
+    raise InvalidInputError(f"log must be None, an .mcap path or a monitor.log.MonitorLog, got "
+                            f"{type(log).__name__} {log!r}")
+
+
+def _check_fallback(fallback: Any, shape: tuple[int, ...]) -> Any:
+    """``fallback`` must be None, a callable or a finite array of ``shape``; returns the stored value."""
+    if fallback is None or callable(fallback):
+        return fallback
+    try:
+        arr = np.array(fallback, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InvalidInputError(f"fallback must be None, a callable or a numeric array of shape {shape}, "
+                                f"got {fallback!r}") from e
+    if arr.shape != shape:
+        raise InvalidInputError(f"fallback must have shape {shape} (one value per actuator), got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InvalidInputError(f"fallback contains NaN or inf: {arr}")
+    return arr
+
+
+def _model_name(model: mujoco.MjModel) -> str:
+    """The model's name (``<mujoco model="...">``), or ``""``."""
+    return bytes(model.names).split(b"\0", 1)[0].decode(errors="replace")
 
 
 class Gate:
@@ -329,7 +404,9 @@ class Gate:
             ``{"seconds": .., "tests": ..}`` or a :class:`monitor.certify.common.Budget`.
             An exhausted budget makes the window "uncertain", never "certified".
         log: None, a path (``.mcap``) or a :class:`monitor.log.MonitorLog`; every
-            window is written.
+            window is written. A path in use by another live gate is not overwritten:
+            the gate writes ``<stem>.1<suffix>``, ``<stem>.2<suffix>``, ... (see
+            :attr:`log_path`).
         frame_skip: default number of substeps per window (``nstep``).
         reuse: reuse certified results of pairs whose bodies are fixed and unchanged.
         brake: recoverability check (``"block"``/``"terminate"`` with the default or
@@ -347,9 +424,16 @@ class Gate:
         tolerances: numerical tolerances.
         log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
             ``log`` is a path (e.g. ``env_id``, ``model_source``).
+        action_shape: shape of the actions :meth:`decide` receives, against which an
+            array ``fallback`` is checked (default ``(nu,)``: the action is the control).
+
+    ``margin``, ``epsilon`` and ``tolerances`` may be reassigned (validated; the reuse
+    cache is keyed on them). The scene is built at construction; a gate with no
+    candidate pairs warns (``UserWarning``) once, at construction, since it checks nothing.
 
     Raises:
-        InvalidInputError: on an unknown option, negative margin or epsilon <= 0.
+        InvalidInputError: on an unknown option, a bad ``log``, ``fallback``, ``budget`` or
+            ``tolerances``, negative margin or epsilon <= 0.
     """
 
     def __init__(self, model: mujoco.MjModel, *, pairs: Any = "mujoco", margin: float = 0.0,
@@ -358,7 +442,8 @@ class Gate:
                  fallback: Any = None, budget: Any = None, log: Any = None, frame_skip: int = 1,
                  reuse: bool = True, brake: bool = True, brake_horizon: float = 0.25,
                  brake_vel_tol: float = 1e-3, tolerances: Tolerances = DEFAULT,
-                 log_options: dict[str, Any] | None = None) -> None:
+                 log_options: dict[str, Any] | None = None,
+                 action_shape: tuple[int, ...] | None = None) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
         if on_violation not in ON_VIOLATION:
@@ -367,21 +452,22 @@ class Gate:
             raise InvalidInputError(f"unsafe must be one of {UNSAFE}, got {unsafe!r}")
         if not (callable(predictor) or predictor in PREDICTORS):
             raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
-        if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0):
-            raise InvalidInputError(f"margin must be a finite number >= 0, got {margin!r}")
-        if not (isinstance(epsilon, (int, float)) and math.isfinite(epsilon) and epsilon > 0):
-            raise InvalidInputError(f"epsilon must be a finite number > 0, got {epsilon!r}")
         if int(frame_skip) < 1:
             raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
         _make_budget(budget)  # validate early
+        _check_log(log)
+        self._cache: dict[int, tuple[bytes, PairResult]] = {}
+        self._cache_context: tuple[Any, ...] | None = None
+        self._scene_builds = 0
         self.model = model
         self.pairs = pairs
-        self.margin = float(margin)
-        self.epsilon = float(epsilon)
+        self.margin = margin
+        self.epsilon = epsilon
         self.predictor = predictor
         self.on_violation = on_violation
         self.unsafe = unsafe
-        self.fallback = fallback
+        self._fallback_shape = (model.nu,) if action_shape is None else tuple(action_shape)
+        self.fallback = _check_fallback(fallback, self._fallback_shape)
         self.budget = budget
         self.frame_skip = int(frame_skip)
         self.reuse = bool(reuse)
@@ -390,19 +476,74 @@ class Gate:
         self.brake_vel_tol = float(brake_vel_tol)
         self._committed: np.ndarray | None = None
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
+        self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
+        self._scene = None
         self.tolerances = tolerances
         self._rollout = Rollout(model)
-        self._scene = None
-        self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._log_spec = log
         self._log_options = dict(log_options or {})
         self._log = None
         self._log_owned = False
+        self._log_lock: Any = None
+        self.log_path: Path | None = None
+        """The file the gate writes (None until the first window, or when not logging to a path)."""
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
                       "reused_pairs": 0, "pairs": 0}
         self._warned = False
+        if not self.scene.candidate_pairs:
+            where = self._log_options.get("env_id") or _model_name(model) or "the model"
+            warnings.warn(
+                f"monitor.Gate on {where}: no candidate pairs to check under pairs={pairs!r}, so every "
+                "window is certified without checking anything (info['safety']['monitored_pairs'] == 0). "
+                "Pass pairs='all' or a list of geom-name pairs to monitor.", UserWarning, stacklevel=2)
+
+    # ----------------------------------------------------------------- settings the cache depends on
+    @property
+    def margin(self) -> float:
+        """Clearance (m) that counts as safe; reassignable (validated, the reuse cache is keyed on it)."""
+        return self._margin
+
+    @margin.setter
+    def margin(self, value: float) -> None:
+        if not _is_real(value) or not math.isfinite(float(value)) or value < 0:
+            raise InvalidInputError(f"margin must be a finite number >= 0, got {value!r}")
+        self._margin = float(value)
+
+    @property
+    def epsilon(self) -> float:
+        """Certification tolerance (m); reassignable (validated, the reuse cache is keyed on it)."""
+        return self._epsilon
+
+    @epsilon.setter
+    def epsilon(self, value: float) -> None:
+        if not _is_real(value) or not math.isfinite(float(value)) or value <= 0:
+            raise InvalidInputError(f"epsilon must be a finite number > 0, got {value!r}")
+        self._epsilon = float(value)
+
+    @property
+    def tolerances(self) -> Tolerances:
+        """Numerical tolerances; reassigning rebuilds the scene (built with them) and empties the cache."""
+        return self._tolerances
+
+    @tolerances.setter
+    def tolerances(self, value: Tolerances) -> None:
+        if not isinstance(value, Tolerances):
+            raise InvalidInputError(f"tolerances must be a monitor.Tolerances, got {type(value).__name__}")
+        self._tolerances = value
+        self._scene = None
+
+    def _reuse_context(self) -> tuple[Any, ...]:
+        """Everything a reused pair result depends on besides the two bodies' poses."""
+        version = getattr(self.scene, "version", 0)
+        return (self._margin, self._epsilon, self._tolerances, self._scene_builds, version)
+
+    def _sync_scene(self) -> None:
+        """Re-read the live model into the scene (``Scene.sync``, when the scene has it)."""
+        sync = getattr(self.scene, "sync", None)
+        if callable(sync):
+            sync()
 
     # ----------------------------------------------------------------- scene / certify
     @property
@@ -412,6 +553,7 @@ class Gate:
             from monitor.scene import Scene
 
             self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances)
+            self._scene_builds += 1
         return self._scene
 
     @property
@@ -427,7 +569,8 @@ class Gate:
         return self._rollout.plan(data, ctrl, n)
 
     def certify_plan(self, plan: Any) -> Certificate:
-        """Certify an explicit plan (with pair reuse and the gate's budget)."""
+        """Certify an explicit plan (with pair reuse and the gate's budget) against the live model."""
+        self._sync_scene()
         return self._certify(plan)[0]
 
     def _certify(self, plan: Any) -> tuple[Certificate, float]:
@@ -454,6 +597,10 @@ class Gate:
         """Indices of pairs to certify (None = all), reusable results, cache keys of fixed pairs."""
         if not self.reuse:
             return None, {}, {}
+        context = self._reuse_context()
+        if context != self._cache_context:
+            self._cache.clear()
+            self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
         pair_bodies = [(scene.geoms[a].body_id, scene.geoms[b].body_id) for a, b in scene.pair_ids]
         fixed = [i for i, (ba, bb) in enumerate(pair_bodies) if not moving[ba] and not moving[bb]]
@@ -522,7 +669,7 @@ class Gate:
         if fb is None:
             return hold_ctrl(self.model, data)
         if callable(fb):
-            return np.asarray(fb(data), dtype=np.float64)
+            return _check_fallback(fb(data), self._fallback_shape)  # typed error on a bad return value
         return np.asarray(fb, dtype=np.float64)
 
     def reset(self) -> None:
@@ -535,10 +682,12 @@ class Gate:
 
         That is the case when the live state equals a tail waypoint bit for bit
         (time, qpos, qvel, mocap) and the window ends inside the tail: the
-        committed brake then reproduces the tail exactly. Else None.
+        committed brake then reproduces the tail exactly, and margin, epsilon,
+        tolerances and the scene version are those the tail was certified under.
+        Else None.
         """
-        if self._tail is None:
-            return None
+        if self._tail is None or self._tail_context != self._reuse_context():
+            return None  # no tail, or certified under other settings / geometry
         plan, cert, qvel = self._tail
         if not cert.certified:
             return None
@@ -587,6 +736,7 @@ class Gate:
         if n < 1:
             raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
         ctrl = np.asarray(ctrl)
+        self._sync_scene()  # certify against the model as it is now (domain randomisation, tuning)
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
@@ -643,6 +793,7 @@ class Gate:
         elif not unsafe:
             self._committed = brake_next
             self._tail = None if brake_next is None else (tail, tail_cert, tail_qvel)
+            self._tail_context = self._reuse_context()
         report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
                             applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
         self._account(report)
@@ -666,7 +817,11 @@ class Gate:
             the :class:`StepReport` (``stepped=True``).
         """
         n = self.frame_skip if nstep is None else int(nstep)
-        ctrl = np.asarray(ctrl, dtype=np.float64)
+        try:
+            ctrl = np.asarray(ctrl, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise InvalidInputError(
+                f"ctrl must be a numeric array of shape ({self.model.nu},), got {ctrl!r}") from e
         if ctrl.shape != (self.model.nu,):
             raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
         if not np.all(np.isfinite(ctrl)):
@@ -696,13 +851,19 @@ class Gate:
         if self._log is not None or self._log_spec is None:
             return self._log
         spec = self._log_spec
-        if isinstance(spec, (str, Path)):
+        if isinstance(spec, (str, os.PathLike)):
+            from monitor.log._lock import claim_log_path
             from monitor.log.writer import MonitorLog  # lazy: mcap only when logging
 
+            path, self._log_lock = claim_log_path(Path(spec))
+            if path != Path(spec):
+                warnings.warn(f"monitor.Gate: log {str(spec)!r} is being written by another gate; this gate "
+                              f"writes {str(path)!r}", UserWarning, stacklevel=4)
+            self.log_path = path
             meta = {"margin": self.margin, "epsilon": self.epsilon, "pairs": str(self.pairs),
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip}
-            self._log = MonitorLog(spec, model=self.model, metadata=meta, **self._log_options)
+            self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
         else:
@@ -720,9 +881,14 @@ class Gate:
 
     def close(self) -> None:
         """Finish the log if the gate opened it."""
-        if self._log is not None and self._log_owned:
-            self._log.__exit__(None, None, None)
-        self._log, self._log_owned = None, False
+        try:
+            if self._log is not None and self._log_owned:
+                self._log.__exit__(None, None, None)
+        finally:
+            self._log, self._log_owned = None, False
+            if self._log_lock is not None:
+                self._log_lock.close()  # releases the flock
+                self._log_lock = None
 
     def __enter__(self) -> Gate:
         return self

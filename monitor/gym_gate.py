@@ -9,8 +9,27 @@ decision into an ``env.step`` call, and reports in ``info``:
 * ``info["cost"]``: 1.0 when the proposed action's window has a confirmed
   violation, else 0.0 (safety-gymnasium's convention in the 5-tuple API).
 
-The action is assumed to be written to ``data.ctrl`` by the env (what
-gymnasium's ``MujocoEnv.do_simulation`` does) when ``predictor="rollout"``.
+Wrappers between the gate and the MuJoCo env. The gate predicts the control the
+env will actually apply: it walks the chain from the wrapped env down to
+``env.unwrapped`` and composes every ``gymnasium.ActionWrapper.action`` transform
+(outermost first; e.g. ``RescaleAction``, ``ClipAction``, a user's action wrapper)
+into ``T``. Each step evaluates ``c = T(action)`` exactly once; the gate decides in
+the env's own action space (for the rollout predictor: ``c`` is the control,
+written to the scratch ``ctrl``), then steps the wrapper chain with the action
+transforms bypassed for that call, so that ``MujocoEnv.do_simulation`` receives
+exactly the certified ``c`` (or the fallback the gate chose instead). Wrappers
+known to pass the action through unchanged (``TimeLimit``, ``OrderEnforcing``, ``PassiveEnvChecker``,
+``RecordEpisodeStatistics``, observation and reward wrappers, render/record
+wrappers, any wrapper that does not override ``step``) are skipped. Any other
+wrapper in between (one that overrides ``step``, ``RepeatAction``, ``StickyAction``,
+``Autoreset``, ...) could change the motion, and the gate refuses it at
+construction (:class:`InvalidInputError` naming the wrapper class). After every
+step of the rollout predictor the gate checks that ``data.ctrl`` equals the control
+it certified and raises :class:`InvalidInputError` otherwise (e.g. an env whose
+``step`` changes the action before ``do_simulation``), so a difference is never
+silent. A user fallback (array or callable) is an action of the gate's own action
+space and goes through ``T`` like a proposal; the default fallback (hold position)
+and the braking-tail check work in the env's control space, as without wrappers.
 """
 
 from __future__ import annotations
@@ -25,6 +44,57 @@ import numpy as np
 from monitor.errors import InvalidInputError
 from monitor.gate import Gate, StepReport, safety_info
 
+_W = gymnasium.wrappers
+_PASS_THROUGH_STEPS = frozenset({
+    gymnasium.Wrapper.step, gymnasium.ObservationWrapper.step, gymnasium.RewardWrapper.step,
+    _W.TimeLimit.step, _W.OrderEnforcing.step, _W.PassiveEnvChecker.step, _W.RecordEpisodeStatistics.step,
+    _W.RecordVideo.step, _W.RenderCollection.step, _W.HumanRendering.step, _W.NormalizeReward.step,
+    _W.FrameStackObservation.step, _W.TimeAwareObservation.step,
+})
+"""``step`` methods that hand the action to the inner env unchanged and step it once."""
+_STATEFUL_ACTION_WRAPPERS = (_W.StickyAction,)
+"""Action wrappers whose ``action`` depends on more than the action (state, RNG): refused."""
+_MISSING = object()
+
+
+def _identity(action: Any) -> Any:
+    return action
+
+
+def action_wrappers(env: gymnasium.Env) -> list[gymnasium.ActionWrapper]:
+    """The action transforms between ``env`` and ``env.unwrapped``, outermost first.
+
+    Args:
+        env: the env the gate wraps (it may itself be the unwrapped env).
+
+    Returns:
+        the ``ActionWrapper`` instances whose ``action`` maps the gate's action, in the
+        order the actions pass through them.
+
+    Raises:
+        InvalidInputError: naming the class of a wrapper that could change the action or the
+            motion in a way the gate cannot predict.
+    """
+    chain: list[gymnasium.ActionWrapper] = []
+    w, inner = env, env.unwrapped
+    while w is not inner:
+        cls = type(w)
+        if isinstance(w, gymnasium.ActionWrapper) and not isinstance(w, _STATEFUL_ACTION_WRAPPERS) \
+                and cls.step is gymnasium.ActionWrapper.step:
+            chain.append(w)
+        elif not isinstance(w, gymnasium.ActionWrapper) and cls.step in _PASS_THROUGH_STEPS:
+            pass
+        else:
+            raise InvalidInputError(
+                f"SafetyGate cannot predict the control through the wrapper "
+                f"{cls.__module__}.{cls.__qualname__} between it and the MuJoCo env: it may change the "
+                "action or the motion (it overrides step, repeats steps or keeps state). Put SafetyGate "
+                "below it, or make it a gymnasium.ActionWrapper whose action() is a function of the action.")
+        w = getattr(w, "env", None)
+        if w is None:
+            raise InvalidInputError(f"env: {cls.__qualname__} has no .env, cannot reach env.unwrapped")
+    return chain
+
 
 class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     """Certify-then-step wrapper for MuJoCo gymnasium environments.
@@ -34,7 +104,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             ``data`` (MjData), e.g. any ``MujocoEnv``.
         predictor: ``"rollout"`` (scratch rollout of ``frame_skip`` substeps with
             ``ctrl = action``), ``"plan"`` (``env.unwrapped.planned_trajectory(action)``)
-            or a callable ``predictor(env, obs, action) -> Plan``.
+            or a callable ``predictor(env, obs, action) -> Plan``. With action wrappers
+            between the gate and the MuJoCo env, ``action`` here is the action the MuJoCo
+            env receives (after the wrappers' transforms).
         pairs: candidate pairs (``"mujoco"``, ``"all"`` or geom-name pairs).
         margin: clearance (m) that counts as safe.
         epsilon: certification tolerance (m).
@@ -43,7 +115,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             action, clipped to the action space, when the action is not ``data.ctrl``),
             an action array, or a callable ``fallback(env, obs) -> action``.
         budget: per-step work limit (seconds float, tests int, dict or Budget).
-        log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`.
+        log: None, an ``.mcap`` path or a :class:`monitor.log.MonitorLog`. A path is claimed
+            exclusively (``fcntl.flock``); when another live gate writes it (e.g. the sub-envs
+            of ``gym.make_vec(..., wrappers=[partial(SafetyGate, log="x.mcap")])``) this gate
+            writes the first free ``x.1.mcap``, ``x.2.mcap``, ... (``gate.log_path``), never
+            the same file.
         unsafe: ``"uncertain"`` (default: anything not certified is unsafe) or ``"violation"``.
         timing: add ``info["safety"]["certify_us"]`` (wall time, µs). Off by default
             because a wall time differs between identical runs, which fails
@@ -52,7 +128,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         brake: recoverability check with a committed brake (see :class:`monitor.Gate`).
 
     Raises:
-        InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data or an option is invalid.
+        InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data, an option is invalid,
+            or a wrapper between the gate and the MuJoCo env could change the action in a way
+            the gate cannot predict (see the module docstring).
     """
 
     def __init__(self, env: gymnasium.Env, *, predictor: str | Callable[..., Any] = "rollout",
@@ -78,23 +156,36 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{type(u).__name__} has none")
         if not isinstance(env.action_space, gymnasium.spaces.Box):
             raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
-        action_is_ctrl = tuple(env.action_space.shape) == (model.nu,)
+        self.action_chain = action_wrappers(env)
+        self._action_shape = tuple(env.action_space.shape)
+        inner_space = u.action_space if self.action_chain else env.action_space
+        if not isinstance(inner_space, gymnasium.spaces.Box):
+            raise InvalidInputError(f"SafetyGate needs a Box action space in {type(u).__name__}, "
+                                    f"got {inner_space}")
+        self._inner_space = inner_space
+        inner_shape = tuple(inner_space.shape)
+        action_is_ctrl = inner_shape == (model.nu,)
         if predictor == "rollout" and not action_is_ctrl:
             raise InvalidInputError(
                 f"predictor='rollout' writes the action to data.ctrl, but the action shape "
-                f"{env.action_space.shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
+                f"{inner_shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
         self.predictor_mode = predictor
         self.user_fallback = fallback
         self.timing = bool(timing)
+        gate_fallback = None if callable(fallback) else fallback
+        if gate_fallback is not None and self.action_chain:  # an action: the env receives T(fallback)
+            gate_fallback = self._inner_action(self.to_ctrl(self._as_action(gate_fallback)), "fallback")
         if fallback is None and not action_is_ctrl:
             # the action is not data.ctrl: "hold position" is unknown, use the zero action
-            fallback = np.zeros(env.action_space.shape)
+            gate_fallback = self._as_inner(np.zeros(inner_shape))
+        if not action_is_ctrl:
             brake = False  # the braking tail needs the action to be the control
-        gate_fallback = None if fallback is None or callable(fallback) else np.asarray(fallback, float)
         self.gate = Gate(model, pairs=pairs, margin=margin, epsilon=epsilon, predictor="rollout",
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
                          fallback=gate_fallback, brake=brake,
-                         frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env))
+                         frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
+                         action_shape=inner_shape)
+        self._unwrapped = u
         self._obs: Any = None
 
     # ----------------------------------------------------------------- helpers
@@ -110,31 +201,116 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         return opts
 
     def _as_action(self, a: Any) -> np.ndarray:
+        """A gate-made or fallback action, clipped to the action space and cast to its dtype."""
         space = self.env.action_space
+        try:
+            arr = np.asarray(a, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise InvalidInputError(f"fallback must give a numeric action, got {a!r}") from e
+        if arr.shape not in ((), self._action_shape) or not np.isfinite(arr).all():
+            raise InvalidInputError(f"fallback must give a finite action of shape {self._action_shape}, "
+                                    f"got {arr!r}")
+        return np.asarray(np.clip(arr, space.low, space.high), dtype=space.dtype)
+
+    def _as_inner(self, a: Any) -> np.ndarray:
+        """A gate-made action of the env's own action space (hold, brake), clipped to it and cast."""
+        space = self._inner_space
         return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
+
+    def _inner_action(self, c: Any, what: str) -> np.ndarray:
+        """``c = T(action)`` checked: a finite numeric array of the env's own action shape."""
+        shape = tuple(self._inner_space.shape)
+        try:
+            arr = np.asarray(c)
+            ok = arr.shape == shape and np.isfinite(np.asarray(arr, dtype=np.float64)).all()
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise InvalidInputError(f"{what}: the action wrappers map it to {c!r}, not a finite array of "
+                                    f"shape {shape} for {type(self.env.unwrapped).__name__}")
+        return arr
+
+    def to_ctrl(self, action: Any) -> Any:
+        """The action as the MuJoCo env receives it: every action wrapper's ``action()``, outermost first."""
+        for w in self.action_chain:
+            action = w.action(action)
+        return action
+
+    def _step_env(self, inner_action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Step the wrapped env so that the MuJoCo env receives exactly ``inner_action``.
+
+        The action wrappers' transforms were applied by the gate already (once); for this
+        call each ``ActionWrapper.action`` is the identity. Every other wrapper steps as usual.
+        """
+        if not self.action_chain:
+            return self.env.step(inner_action)
+        saved = [w.__dict__.get("action", _MISSING) for w in self.action_chain]
+        for w in self.action_chain:
+            w.action = _identity  # instance attribute: shadows the class's transform for this call
+        try:
+            return self.env.step(inner_action)
+        finally:
+            for w, old in zip(self.action_chain, saved):
+                if old is _MISSING:
+                    del w.action
+                else:
+                    w.action = old
 
     def _predict_fn(self) -> Callable[[Any], Any] | None:
         u, mode = self.env.unwrapped, self.predictor_mode
         if mode == "rollout":
-            return None
+            return None  # the gate's own rollout with ctrl = the env's action
         if mode == "plan":
             return u.planned_trajectory
         return lambda a: mode(self.env, self._obs, a)
+
+    def _check_applied_ctrl(self, applied: Any) -> None:
+        """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
+        if self.predictor_mode != "rollout":
+            return
+        expected = np.asarray(applied, dtype=np.float64)
+        ctrl = self._unwrapped.data.ctrl
+        if ctrl.shape != expected.shape or not (ctrl == expected).all():
+            raise InvalidInputError(
+                f"env: after the step data.ctrl = {np.array2string(ctrl)} but the gate certified ctrl = "
+                f"{np.array2string(expected)}: something between SafetyGate and "
+                f"{type(self.env.unwrapped).__name__}, or its step, changed the action in a way the gate "
+                "cannot predict; the window that ran was not certified")
 
     def _fallback_fn(self) -> Callable[[], np.ndarray] | None:
         fb = self.user_fallback
         if fb is None:
             return None  # the gate's default: committed brake, else hold position
         if callable(fb):
-            return lambda: self._as_action(fb(self.env, self._obs))
+            if not self.action_chain:
+                return lambda: self._as_action(fb(self.env, self._obs))
+            return lambda: self._inner_action(self.to_ctrl(self._as_action(fb(self.env, self._obs))),
+                                              "fallback")
         return None  # an array fallback is the gate's own (cast on use)
 
     # ----------------------------------------------------------------- gymnasium API
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        """Certify the window of ``action``, gate it, then step the wrapped env."""
-        report: StepReport = self.gate.decide(self.env.unwrapped.data, action, predict=self._predict_fn(),
-                                              fallback=self._fallback_fn(), cast=self._as_action)
-        obs, reward, terminated, truncated, info = self.env.step(report.applied_ctrl)
+        """Certify the window of ``action``, gate it, then step the wrapped env.
+
+        Raises:
+            InvalidInputError: ``action`` is not a finite numeric array of the action space's
+                shape, or (rollout predictor) the env applied a control other than the certified one.
+        """
+        shape = self._action_shape
+        try:
+            arr = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise InvalidInputError(f"action must be a numeric array of shape {shape}, got {action!r}") from e
+        if arr.shape != shape:
+            raise InvalidInputError(f"action must have shape {shape} (the action space's), got {arr.shape}")
+        if not np.isfinite(arr).all():
+            raise InvalidInputError(f"action contains NaN or inf: {arr}")
+        if self.action_chain:
+            action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
+        report: StepReport = self.gate.decide(self._unwrapped.data, action, predict=self._predict_fn(),
+                                              fallback=self._fallback_fn(), cast=self._as_inner)
+        obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
+        self._check_applied_ctrl(report.applied_ctrl)
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)

@@ -16,17 +16,7 @@ from monitor._paths import scene_path
 OWN_ENVS = ["monitor/Arm-v0", "monitor/Tunnel-v0"]
 
 
-def _agv_available() -> bool:
-    try:
-        import envs.agv_v0  # noqa: F401
-
-        scene_path("agv_trays")
-    except (ImportError, FileNotFoundError):
-        return False
-    return True
-
-
-ALL_ENVS = OWN_ENVS + (["monitor/AGV-v0"] if _agv_available() else [])
+ALL_ENVS = [*OWN_ENVS, "monitor/AGV-v0"]  # all part of this repository: a broken one fails, never skips
 
 
 @pytest.mark.parametrize("env_id", ALL_ENVS)
@@ -153,7 +143,6 @@ def test_gate_keeps_arm_off_the_post_500_steps():
 
 
 # ----------------------------------------------------------------------------- AGV and trays
-agv_only = pytest.mark.skipif(not _agv_available(), reason="models/agv_trays or its schedules not available")
 
 
 def _run_agv(schedule, mode, steps, rate=1.0):
@@ -174,7 +163,6 @@ def _run_agv(schedule, mode, steps, rate=1.0):
     return rows
 
 
-@agv_only
 def test_agv_straight_schedule_violation_found_in_its_window():
     from monitor.certify.extrusion_scenes import STRAIGHT_FIRST_CONTACT
 
@@ -188,14 +176,12 @@ def test_agv_straight_schedule_violation_found_in_its_window():
     assert sum(r[5] for r in rows) > 0, "MuJoCo sees the collision too (independent check)"
 
 
-@agv_only
 def test_agv_straight_schedule_blocked_never_touches():
     rows = _run_agv("straight", "block", 130)
     assert sum(r[4] for r in rows) > 0, "the gate stopped the vehicle"
     assert all(r[5] == 0 for r in rows), "MuJoCo reports no contact at any step state"
 
 
-@agv_only
 def test_agv_weaving_narrow_miss_is_certified():
     rows = _run_agv("weaving", "block", 125)  # plate 1 passes over the vehicle for t in 8.2..11.8 s
     assert all(r[0] == "certified" for r in rows)

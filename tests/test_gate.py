@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import math
 
 import gymnasium as gym
 import mujoco
@@ -194,11 +195,6 @@ def test_step_rejects_bad_ctrl():
 
 # ----------------------------------------------------------------------------- with the real engine
 def _agv_env():
-    pytest.importorskip("monitor.certify.extrusion_scenes")
-    try:
-        scene_path("agv_trays")
-    except FileNotFoundError:
-        pytest.skip("models/agv_trays not available")
     env = gym.make("monitor/AGV-v0", schedule="weaving").unwrapped
     env.reset(seed=0)
     return env
@@ -257,8 +253,7 @@ def test_block_on_tunnel_reuses_the_committed_tail():
 
 
 def test_log_has_one_window_per_step(tmp_path):
-    reader = pytest.importorskip("monitor.log.reader")
-    from monitor.log import topics
+    from monitor.log import reader, topics
 
     m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
     d = mujoco.MjData(m)
@@ -272,3 +267,122 @@ def test_log_has_one_window_per_step(tmp_path):
     extra = sum(1 for r in reports if r.replaced and not r.fallback_certified)
     assert len(certs) == len(reports) + extra
     assert [c["verdict"] for c in certs[: len(reports)]] == [r.verdict for r in reports]
+
+
+# ----------------------------------------------------------------------------- issue 11: the gate boundary
+def _tunnel():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    return m, d
+
+
+def test_step_with_non_numeric_ctrl_is_a_typed_error():
+    m, d = _tunnel()
+    with pytest.raises(InvalidInputError, match="ctrl"):
+        Gate(m).step(d, "abc")
+
+
+@pytest.mark.parametrize(("kwargs", "name"), [
+    ({"log": 123}, "log"),
+    ({"log": object()}, "log"),
+    ({"log": "/nonexistent-dir-h11b/x.mcap"}, "log"),
+    ({"fallback": [1, 2, 3]}, "fallback"),  # the tunnel has one actuator
+    ({"fallback": [np.nan]}, "fallback"),
+    ({"fallback": "stop"}, "fallback"),
+    ({"budget": {"seconds": "1"}}, "budget"),
+    ({"budget": {"seconds": -1.0}}, "budget"),
+    ({"budget": {"seconds": math.nan}}, "budget"),
+    ({"budget": {"tests": 2.5}}, "budget"),
+    ({"budget": {"tests": 0}}, "budget"),
+    ({"budget": {"secs": 1.0}}, "budget"),
+    ({"budget": -1.0}, "budget"),
+    ({"tolerances": {"abs_pad": 0.0}}, "tolerances"),
+])
+def test_bad_gate_argument_raises_at_construction(kwargs, name):
+    m, _ = _tunnel()
+    with pytest.raises(InvalidInputError, match=name):
+        Gate(m, **kwargs)
+
+
+def _static_pair_model(gap: float = 0.1) -> mujoco.MjModel:
+    """A sphere (r 0.1) on a slide joint at rest, a wall whose face is ``gap`` away; no gravity."""
+    return mujoco.MjModel.from_xml_string(
+        '<mujoco><option gravity="0 0 0"/><worldbody>'
+        f'<geom name="wall" type="box" size="0.05 0.5 0.5" pos="{0.15 + gap} 0 0"/>'
+        '<body name="b"><joint name="s" type="slide" axis="0 1 0"/>'
+        '<geom name="ball" type="sphere" size="0.1"/></body></worldbody></mujoco>')
+
+
+def test_reuse_cache_is_keyed_on_the_margin():
+    """The issue's reproduction: a static pair 0.1 m apart, certified at margin 0, then margin 0.2."""
+    from monitor import Plan, Scene, certify
+
+    m = _static_pair_model(0.1)
+    d = mujoco.MjData(m)
+    gate = Gate(m, pairs="all")
+    assert gate.step(d, np.zeros(0)).verdict == "certified"
+    assert gate.step(d, np.zeros(0)).certificate.stats.get("reused_pairs") == 1  # the cache is in use
+    gate.margin = 0.2
+    fresh = certify(Scene.from_model(m, pairs="all"), Plan([d.time, d.time + m.opt.timestep],
+                                                             [d.qpos, d.qpos], m), margin=0.2)
+    assert fresh.verdict == "violation"
+    assert gate.step(d, np.zeros(0)).verdict == fresh.verdict
+    gate.margin = 0.0
+    assert gate.step(d, np.zeros(0)).verdict == "certified"
+
+
+def test_reuse_cache_is_keyed_on_epsilon_tolerances_and_scene_version(monkeypatch):
+    m = _static_pair_model(0.1)
+    d = mujoco.MjData(m)
+    gate = Gate(m, pairs="all")
+    gate.step(d, np.zeros(0))
+
+    def reused() -> int:
+        return gate.step(d, np.zeros(0)).certificate.stats.get("reused_pairs", 0)
+
+    assert reused() == 1
+    gate.epsilon = 2e-3
+    assert reused() == 0 and reused() == 1
+    monkeypatch.setattr(gate.scene, "version", getattr(gate.scene, "version", 0) + 1, raising=False)
+    assert reused() == 0 and reused() == 1
+    from monitor.tolerances import Tolerances
+
+    gate.tolerances = Tolerances(abs_pad=gate.tolerances.abs_pad * 2)
+    assert reused() == 0 and reused() == 1
+    with pytest.raises(InvalidInputError, match="margin"):
+        gate.margin = -1.0
+    with pytest.raises(InvalidInputError, match="epsilon"):
+        gate.epsilon = 0.0
+
+
+def test_zero_candidate_pairs_warn_once_at_construction():
+    m = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><freejoint/><geom type="sphere" size=".1"/></body></worldbody></mujoco>')
+    with pytest.warns(UserWarning, match="no candidate pairs") as rec:
+        gate = Gate(m)
+    assert len(rec) == 1
+    d = mujoco.MjData(m)
+    report = gate.step(d, np.zeros(0))
+    assert report.verdict == "certified" and report.info()["monitored_pairs"] == 0
+
+
+def test_committed_tail_is_not_reused_after_a_setting_changed():
+    """The committed brake's tail was certified at margin 0; at margin 0.5 (the wall is ~0.3 m away)
+    the brake window must be re-certified, not taken from that tail."""
+    m, d = _tunnel()
+    gate = Gate(m)
+    assert gate.step(d, np.array([1.0])).verdict == "certified"  # commits a brake and its tail
+    assert gate._tail is not None
+    gate.margin = 0.5
+    r = gate.step(d, np.array([1.0]))
+    assert r.replaced and r.verdict == "violation"
+    assert r.applied_verdict == "violation" and not r.fallback_certified
+    assert gate.stats["tail_reused"] == 0
+
+
+def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
+    m, d = _tunnel()
+    gate = Gate(m, margin=0.5, fallback=lambda data: [0.0, 0.0])  # the wall is within 0.5 m: blocked
+    with pytest.raises(InvalidInputError, match="fallback"):
+        gate.step(d, np.array([1.0]))

@@ -1,6 +1,7 @@
 """Every public name imports, and ``monitor.certify`` works both as function and package."""
 
 import importlib
+import inspect
 
 import pytest
 
@@ -9,7 +10,28 @@ import monitor
 
 @pytest.mark.parametrize("name", [n for n in monitor.__all__ if n != "__version__"])
 def test_public_name_imports(name):
-    assert getattr(monitor, name) is not None
+    """Each public name resolves to the class or function of that name defined in the package
+    (``certify`` and ``rollouts`` are callable submodules: module and function at once)."""
+    value = getattr(monitor, name)
+    if inspect.ismodule(value):
+        assert callable(value) and value.__name__ == f"monitor.{name}", value
+    else:
+        assert inspect.isclass(value) or inspect.isfunction(value), (name, type(value))
+        assert value.__name__ == name
+        assert value.__module__.split(".")[0] == "monitor", value.__module__
+    namespace: dict = {}
+    exec(f"from monitor import {name}", namespace)  # the form users write
+    assert namespace[name] is value
+
+
+def test_all_lists_each_name_once_and_star_import_works():
+    assert len(set(monitor.__all__)) == len(monitor.__all__)
+    assert isinstance(monitor.__version__, str) and monitor.__version__.count(".") >= 1
+    namespace: dict = {}
+    exec("from monitor import *", namespace)
+    assert set(monitor.__all__) <= set(namespace)
+    with pytest.raises(AttributeError):
+        monitor.NoSuchName  # noqa: B018
 
 
 def test_certify_is_callable_after_submodule_import(tmp_path):

@@ -1,7 +1,8 @@
 """Red-team soundness tests for ``monitor.certify`` (independent oracle: tests/redteam_oracle.py).
 
-Tests named ``test_fn_*`` are confirmed FALSE NEGATIVES (certified while the motion really
-collides / comes closer than the margin); they are left failing on purpose until fixed.
+Tests named ``test_fn_*`` reproduce confirmed FALSE NEGATIVES (certified while the motion really
+collides / comes closer than the margin). Every one of them is fixed now and must pass: they are
+regressions (each section comment names the fixing commit), none is expected to fail.
 Every "collides" label is backed by a witness verified with the oracle's closed-form
 membership tests (``check_witness``). Other tests are attacks that failed (regressions).
 """
@@ -592,13 +593,14 @@ def test_random_sweep_margin_trick():
                 _assert_not_certified(cert, f"seed {seed}, margin {margin}, {meth}")
 
 
-# --------------------------------------------------------------------------- FN 4: maxhullvert
+# ------------------------------------------------------------------- FN 4 (fixed in b11fdf3; regression)
 
 
 def test_fn_mesh_maxhullvert_reduced_hull():
-    """A mesh with maxhullvert="4": Scene takes the 4-vertex hull from mesh_graph, but MuJoCo 4.0
-    still collides the sphere with the full mesh (mj_forward reports a contact, mj_geomDistance
-    -0.031 m) when the sphere crosses the corner outside the reduced hull: certified anyway.
+    """A mesh with maxhullvert="4": MuJoCo 4.0 still collides the sphere with the full mesh
+    (mj_forward reports a contact, mj_geomDistance -0.031 m) when the sphere crosses a corner
+    outside the reduced hull. The Scene used to take the 4-vertex hull from mesh_graph and
+    certified this motion; since b11fdf3 it takes the hull of all compiled vertices.
     """
     v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [.6, .6, .6],
                   [-.6, -.6, .6]]) * 0.3
