@@ -67,6 +67,12 @@ def _violation_row(cert: dict[str, Any]) -> dict[str, Any]:
 _NUM = (int, float)
 
 
+def _short(x: Any, n: int = 40) -> str:
+    """``repr(x)`` cut to ``n`` characters (hostile values stay one short line)."""
+    r = repr(x)
+    return r if len(r) <= n else r[:n] + "..."
+
+
 def _is_num(x: Any) -> bool:
     return isinstance(x, _NUM) and not isinstance(x, bool) and math.isfinite(x)
 
@@ -108,9 +114,9 @@ def certificate_problem(c: dict[str, Any]) -> str | None:
     """
     k = c.get("index")
     if not _is_int(k) or k < 0:
-        return f"index {str(k)[:40]!r} is not an integer >= 0"
+        return f"index {_short(k, 40)} is not an integer >= 0"
     if not _is_num(c.get("sim_time")) or c["sim_time"] < 0:
-        return f"sim_time {str(c.get('sim_time'))[:40]!r} is not a finite number >= 0"
+        return f"sim_time {_short(c.get('sim_time'), 40)} is not a finite number >= 0"
     for key in ("verdict", "method"):
         if not isinstance(c.get(key), str):
             return f"{key} is not a string"
@@ -123,7 +129,7 @@ def certificate_problem(c: dict[str, Any]) -> str | None:
             return f"{key} is not a number"
     for key in ("clearance", "earliest_time"):
         if c.get(key) is not None and not _is_num(c.get(key)):
-            return f"{key} {str(c.get(key))[:40]!r} is not a number or null"
+            return f"{key} {_short(c.get(key), 40)} is not a number or null"
     pairs = c.get("pairs")
     if not isinstance(pairs, list):
         return "pairs is not a list"
@@ -161,6 +167,46 @@ def split_certificates(contents: LogContents) -> tuple[list[dict[str, Any]], lis
     return good, bad
 
 
+def _integrity(contents: LogContents, certs: list[dict[str, Any]],
+               bad_messages: list[dict[str, Any]]) -> list[str]:
+    """Cheap whole-log consistency checks that catch dropped or re-routed messages.
+
+    The writer numbers windows 0, 1, 2, ... and writes one ``/monitor/violation`` message
+    per non-certified certificate, every JSON payload with an integer ``index``. So: a gap
+    in the certificate indices, a violation message without a matching non-certified
+    certificate (or the reverse), or a payload without an integer index means messages
+    were lost or moved (bit rot in a channel id, an edited log).
+    """
+    out = []
+    for topic in topics.JSON_TOPICS:
+        n = sum(1 for m in contents.topic(topic) if not _is_int(m.get("index")) or m["index"] < 0)
+        if n and topic != topics.CERTIFICATE:  # malformed certificates are listed in bad_messages
+            out.append(f"{n} {topic} message(s) without an integer index")
+    for p in contents.topic(topics.PLAN):
+        if not isinstance(p.get("times"), list):
+            out.append(f"{topics.PLAN} message {str(p.get('index'))[:20]} has no times list")
+            break
+    have = {c["index"] for c in certs} | {b["index"] for b in bad_messages if b["index"] is not None}
+    if have:
+        gaps = sorted(set(range(max(have) + 1)) - have) if max(have) < 10 * len(have) + 10 else None
+        if gaps is None:
+            out.append(f"certificate indices reach {max(have)} with only {len(have)} certificates")
+        elif gaps:
+            out.append(f"certificate indices have {len(gaps)} gap(s) (first: {gaps[:5]}): certificates lost")
+    flagged = Counter(c["index"] for c in certs if c["verdict"] != "certified")
+    viol = Counter(m["index"] for m in contents.topic(topics.VIOLATION) if _is_int(m.get("index")))
+    if contents.stop_kind == "truncated" and have:  # a killed writer may have cut the last window short
+        flagged.pop(max(have), None)
+        viol.pop(max(have), None)
+    if flagged != viol:
+        only_v = sorted((viol - flagged).keys())[:5]
+        only_c = sorted((flagged - viol).keys())[:5]
+        out.append(f"{topics.VIOLATION} messages do not match the non-certified certificates "
+                   f"(violation message without such a certificate: {only_v}; certificate without "
+                   f"violation message: {only_c})")
+    return out
+
+
 def analyze(contents: LogContents) -> dict[str, Any]:
     """Summary of one log (pure function of the recovered contents).
 
@@ -172,7 +218,7 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         dict with ``file`` (path, size, complete, unreadable_bytes, stop_reason,
         stop_kind, messages, bad_payloads, bad_records, problems), ``run`` (metadata),
         ``bad_messages`` (rows: index, problem), ``unknown_verdicts`` (rows: index,
-        verdict), ``windows``, ``verdicts``
+        verdict), ``integrity`` (problems found by :func:`_integrity`), ``windows``, ``verdicts``
         ({verdict: count}), ``blocked_actions``, ``actions``, ``latency_us``
         ({p50, p95, max, n}), ``checker_mix`` ({method: pairs}), ``violations``
         (rows: index, sim_time, verdict, time, geoms, bodies, point, distance,
@@ -205,7 +251,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         series["margin"].append(c.get("margin"))
         if v != "certified":
             rows.append(_violation_row(c))
-    actions = contents.topic(topics.ACTION)
+    actions = [a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))]
+    integrity = _integrity(contents, certs, bad_messages)
     run = {k: v for k, v in contents.run.items() if not k.startswith("version.")}
     for key in ("margin", "epsilon", "method"):  # not in the metadata: from the first certificate
         if run.get(key) is None and certs and key in certs[0]:
@@ -219,6 +266,7 @@ def analyze(contents: LogContents) -> dict[str, Any]:
                  "library": contents.library, "attachments": sorted(contents.attachments)},
         "bad_messages": bad_messages,
         "unknown_verdicts": unknown,
+        "integrity": integrity,
         "run": run,
         "versions": {k[len("version."):]: v for k, v in contents.run.items() if k.startswith("version.")},
         "windows": sum(verdicts.values()),
@@ -270,7 +318,7 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
 
         return BodyMotion(times, np.asarray(msg["pos"], np.float64), np.asarray(msg["quat"], np.float64))
     if msg.get("kind", "plan") != "plan":
-        raise InvalidInputError(f"logged plan kind {str(msg.get('kind'))[:40]!r} is unknown")
+        raise InvalidInputError(f"logged plan kind {_short(msg.get('kind'), 40)} is unknown")
     from monitor.motion.plan import Plan
 
     qpos = np.asarray(msg["qpos"], dtype=np.float64)
@@ -309,14 +357,14 @@ def tolerance_problems(tol: Any) -> list[str]:
     out = []
     for k, v in tol.items():
         if k not in fields:
-            out.append(f"unknown tolerance field {str(k)[:40]!r}")
+            out.append(f"unknown tolerance field {_short(k, 40)}")
         elif k in _TOL_INT_RANGES:
             lo, hi = _TOL_INT_RANGES[k]
             if not _is_int(v) or not lo <= v <= hi:
-                out.append(f"{k}={str(v)[:40]!r} is not an integer in [{lo}, {hi}]")
+                out.append(f"{k}={_short(v, 40)} is not an integer in [{lo}, {hi}]")
         elif not _is_num(v) or v < 0 or (k == "quat_norm_tol" and v == 0):
             bound = "> 0" if k == "quat_norm_tol" else ">= 0"
-            out.append(f"{k}={str(v)[:40]!r} is not a finite number {bound}")
+            out.append(f"{k}={_short(v, 40)} is not a finite number {bound}")
     return out
 
 
@@ -365,7 +413,7 @@ def parse_pair_policy(value: Any) -> str | list[tuple[str, str]]:
     if isinstance(pol, (list, tuple)) and all(
             isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(g, str) for g in p) for p in pol):
         return [(str(p[0]), str(p[1])) for p in pol]
-    raise InvalidInputError(f"pair policy {str(value)[:60]!r} is neither 'mujoco', 'all' nor a list of "
+    raise InvalidInputError(f"pair policy {_short(value, 60)} is neither 'mujoco', 'all' nor a list of "
                             f"geom-name pairs")
 
 
@@ -456,7 +504,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         if key in run:
             v = run[key]
             if not _is_num(v) or not ok(v):
-                find(CRITICAL, f"run metadata {key}={str(v)[:40]!r} is invalid")
+                find(CRITICAL, f"run metadata {key}={_short(v, 40)} is invalid")
             else:
                 run_claims[key] = float(v)
 
@@ -474,7 +522,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         try:
             scene = scene_cls.from_model(model, pairs=policy, tolerances=tol)
         except (MonitorError, ValueError, TypeError) as exc:
-            find(CRITICAL, f"logged pair policy {str(raw_policy)[:80]!r} is not valid for the attached "
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not valid for the attached "
                            f"model: {exc}")
         if isinstance(policy, list):
             notes.append(f"pair policy is an explicit list of {len(policy)} pair(s): only those pairs are "
@@ -495,7 +543,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         if _is_int(k):
             plan_msgs.setdefault(k, []).append(p)
         else:
-            find(UNVERIFIABLE, f"plan message without an integer index ({str(k)[:40]!r})")
+            find(UNVERIFIABLE, f"plan message without an integer index ({_short(k, 40)})")
     for k, ps in sorted(plan_msgs.items()):
         if len(ps) > 1:
             find(CRITICAL, f"window index {k} has {len(ps)} plan messages", k)
@@ -531,7 +579,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         for key, ok in (("margin", lambda x: x >= 0), ("epsilon", lambda x: x > 0)):
             v = c[key]
             if not _is_num(v) or not ok(v):
-                find(CRITICAL, f"{key}={str(v)[:40]!r} is invalid", k)
+                find(CRITICAL, f"{key}={_short(v, 40)} is invalid", k)
                 claims_ok = False
             elif key in run_claims and float(v) != run_claims[key]:
                 find(CRITICAL, f"{key}={v} differs from the run's {run_claims[key]}", k)
@@ -686,6 +734,8 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
             lines.append(f"     {why}")
         for row in entry.get("bad_messages", [])[:5]:
             lines.append(f"     certificate index {row['index']}: {row['problem']}")
+    for why in entry.get("integrity", []):
+        lines.append(f"   INTEGRITY: {why}")
     for row in entry.get("unknown_verdicts", [])[:10]:
         lines.append(f"   UNKNOWN VERDICT {row['verdict']!r} in window {row['index']} (not counted below)")
     run = entry.get("run", {})

@@ -63,7 +63,7 @@ def _read_code(entry: dict[str, Any]) -> int:
     f = entry.get("file", {})
     if f.get("stop_kind") == "corrupt" or f.get("bad_payloads") or f.get("bad_records"):
         return 2
-    if entry.get("bad_messages") or entry.get("unknown_verdicts"):
+    if entry.get("bad_messages") or entry.get("unknown_verdicts") or entry.get("integrity"):
         return 2
     return 0
 
