@@ -134,6 +134,9 @@ class LogContents:
         attachments: attachment name -> bytes (attachments with a wrong CRC are dropped
             and counted as bad records).
         schemas: schema name -> (encoding, data bytes) of every schema seen.
+        records_walked: records whose header was read (chunk records included): the
+            reader's work, bounded by the file size (at most size / 13 + a few).
+        bytes_read: bytes read from the file (skipped records are seeked over, not read).
     """
 
     path: str
@@ -153,6 +156,8 @@ class LogContents:
     metadata: dict[str, dict[str, Any]] = field(default_factory=dict)
     attachments: dict[str, bytes] = field(default_factory=dict)
     schemas: dict[str, tuple[str, bytes]] = field(default_factory=dict)
+    records_walked: int = 0
+    bytes_read: int = 0
 
     @property
     def run(self) -> dict[str, Any]:
@@ -231,12 +236,14 @@ def _decode_metadata_value(v: str) -> Any:
 class _Walker:
     """Length-checked record walk over a binary file object (or an in-memory chunk)."""
 
-    def __init__(self, f: BinaryIO, size: int, bar: Any, base: int = 0) -> None:
-        self.f, self.size, self.bar = f, size, bar
-        self.pos = base
+    def __init__(self, f: BinaryIO, size: int, bar: Any, out: LogContents | None = None) -> None:
+        self.f, self.size, self.bar, self.out = f, size, bar, out
+        self.pos = 0
 
     def read_exact(self, n: int) -> bytes | None:
         data = self.f.read(n)
+        if self.out is not None:
+            self.out.bytes_read += len(data)
         if len(data) != n:
             return None
         self.pos += n
@@ -325,6 +332,7 @@ def _records(w: _Walker, out: LogContents, *, in_chunk: bool = False) -> Iterato
         if in_chunk and start >= w.size:
             return
         head = w.read_exact(_RECORD_HEAD)
+        out.records_walked += 1
         if head is None:
             if in_chunk:
                 corrupt(f"chunk ends inside a record header at chunk byte {start}")
@@ -466,7 +474,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
     channels: dict[int, Channel] = {}
     try:
         with open(p, "rb") as f:
-            w = _Walker(f, size, bar)
+            w = _Walker(f, size, bar, out)
             magic = w.read_exact(len(MAGIC))
             if magic != MAGIC:
                 kind = "empty file" if size == 0 else "does not start with the MCAP magic"
