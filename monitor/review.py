@@ -768,10 +768,11 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
         if ver.get("error"):
             lines.append(f"   verify: ERROR {ver['error']}")
             return
-        lines.append(f"   verify ({ver['model_source']}): {ver['checked']} of {ver.get('windows', '?')} "
-                     f"re-derived, {len(ver['mismatches'])} mismatch(es), {ver['critical']} critical, "
-                     f"{ver.get('unverifiable', 0)} unverifiable, {ver['missing_plans']} without plan, "
-                     f"{len(ver['errors'])} error(s), {ver.get('pairs_differ', 0)} with a different pair set")
+        lines.append(f"   verify ({ver['model_source']}): {ver['checked']} re-derived, "
+                     f"{len(ver['mismatches'])} mismatch(es), {ver['critical']} critical, "
+                     f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s); "
+                     f"{ver.get('unverifiable', 0)} unverifiable, {ver.get('pairs_differ', 0)} with a "
+                     f"different pair set; {ver.get('windows', '?')} window(s) in the log")
         mc = ver.get("model_consistency")
         if mc:
             lines.append(f"     model: {mc['status']}: {mc['detail']}")

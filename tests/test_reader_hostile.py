@@ -141,7 +141,8 @@ def test_50_mb_of_zeros_after_the_magic_is_rejected_at_once(tmp_path):
 def test_sparse_4_gb_file_after_a_genuine_head(tmp_path, log_path):
     p = tmp_path / "sparse.mcap"
     with open(p, "wb") as f:
-        f.write(log_path.read_bytes()[:-200])  # a genuine log, cut, then 4 GB of holes
+        data = log_path.read_bytes()
+        f.write(data[: len(data) // 2])  # a genuine log cut in its data section, then 4 GB of holes
         f.truncate(4 * 1024 * MB)
     with deadline(10), peak_memory(16 * MB):
         c = read_log(p)

@@ -59,11 +59,24 @@ def add_parser(p: argparse.ArgumentParser) -> None:
 
 
 def _read_code(entry: dict[str, Any]) -> int:
-    """2 when anything was damaged or skipped while reading, or an unknown verdict was seen."""
+    """2 when anything was damaged or skipped while reading, or an unknown verdict was seen.
+
+    Sets ``entry["problem"]`` (one line for stderr) when it returns 2.
+    """
     f = entry.get("file", {})
-    if f.get("stop_kind") == "corrupt" or f.get("bad_payloads") or f.get("bad_records"):
-        return 2
-    if entry.get("bad_messages") or entry.get("unknown_verdicts") or entry.get("integrity"):
+    why = []
+    if f.get("stop_kind") == "corrupt":
+        why.append(f"damaged file ({f.get('stop_reason')})")
+    n_skipped = ((f.get("bad_payloads") or 0) + (f.get("bad_records") or 0)
+                 + len(entry.get("bad_messages", [])))
+    if n_skipped:
+        why.append(f"{n_skipped} bad message(s)/record(s) skipped")
+    if entry.get("unknown_verdicts"):
+        why.append(f"{len(entry['unknown_verdicts'])} certificate(s) with an unknown verdict")
+    if entry.get("integrity"):
+        why.append(entry["integrity"][0])
+    if why:
+        entry["problem"] = f"{f.get('path')}: " + "; ".join(why)
         return 2
     return 0
 
@@ -181,4 +194,6 @@ def run(args: argparse.Namespace) -> int:
     for e in entries:
         if e.get("error"):
             print(f"error: {e['error']}", file=sys.stderr)
+        elif e.get("problem"):
+            print(f"error: {e['problem']}", file=sys.stderr)
     return _worst(*codes)

@@ -414,6 +414,10 @@ _FOOTER_RECORD = _RECORD_HEAD + 20
 
 def _read_footer(w: _Walker, out: LogContents) -> None:
     """After DataEnd: skip the summary section (never walked) and check footer + closing magic."""
+    if not out.closed_by_writer:  # cut inside the summary: every data record was read
+        out.stop_reason = "file ends inside the summary section (every data record was read)"
+        out.readable_bytes = w.pos
+        return
     tail = w.size - len(MAGIC) - _FOOTER_RECORD
     if tail < w.pos:
         out.stop_reason, out.stop_kind = "no room for the footer after the data section", "corrupt"
