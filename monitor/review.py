@@ -193,6 +193,8 @@ def _integrity(contents: LogContents, certs: list[dict[str, Any]],
             out.append(f"certificate indices reach {max(have)} with only {len(have)} certificates")
         elif gaps:
             out.append(f"certificate indices have {len(gaps)} gap(s) (first: {gaps[:5]}): certificates lost")
+    if contents.seal_status == "mismatch":
+        out.append(f"digest seal: {contents.seal_detail}")
     flagged = Counter(c["index"] for c in certs if c["verdict"] != "certified")
     viol = Counter(m["index"] for m in contents.topic(topics.VIOLATION) if _is_int(m.get("index")))
     if contents.stop_kind == "truncated" and have:  # a killed writer may have cut the last window short
@@ -262,7 +264,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
                  "unreadable_bytes": contents.unreadable_bytes, "stop_reason": contents.stop_reason,
                  "stop_kind": contents.stop_kind, "messages": dict(contents.counts),
                  "bad_payloads": contents.bad_payloads, "bad_records": contents.bad_records,
-                 "problems": list(contents.problems),
+                 "problems": list(contents.problems), "seal": contents.seal_status,
+                 "seal_detail": contents.seal_detail,
                  "library": contents.library, "attachments": sorted(contents.attachments)},
         "bad_messages": bad_messages,
         "unknown_verdicts": unknown,
@@ -482,6 +485,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     def find(severity: str, reason: str, index: int | None = None) -> None:
         findings.append({"index": index, "severity": severity, "reason": reason})
 
+    if contents.seal_status == "mismatch":
+        find(CRITICAL, f"digest seal: {contents.seal_detail}")
+    elif contents.seal_status == "unsealed":
+        notes.append("log is not sealed (no digest): edits after writing cannot be detected by digest")
     consistency = model_consistency(contents)
     if consistency["status"] == "inconsistent":
         find(CRITICAL, consistency["detail"])

@@ -69,6 +69,7 @@ from mcap.records import (
 
 from monitor.errors import InvalidInputError, LogFormatError
 from monitor.log import topics
+from monitor.log.digest import METADATA_DIGEST, Digest, check_seal
 
 MAGIC = b"\x89MCAP0\r\n"
 _RECORD_HEAD = 9  # opcode (1) + length (8)
@@ -137,6 +138,9 @@ class LogContents:
         records_walked: records whose header was read (chunk records included): the
             reader's work, bounded by the file size (at most size / 13 + a few).
         bytes_read: bytes read from the file (skipped records are seeked over, not read).
+        seal: the ``monitor.digest`` seal record (None when the log is unsealed).
+        seal_status: ``"sealed" | "mismatch" | "unsealed"`` and ``seal_detail`` (see
+            :mod:`monitor.log.digest`: what a seal proves and what it does not).
     """
 
     path: str
@@ -158,6 +162,9 @@ class LogContents:
     schemas: dict[str, tuple[str, bytes]] = field(default_factory=dict)
     records_walked: int = 0
     bytes_read: int = 0
+    seal: dict[str, str] | None = None
+    seal_status: str = "unsealed"
+    seal_detail: str = ""
 
     @property
     def run(self) -> dict[str, Any]:
@@ -476,6 +483,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
 
         bar = tqdm(total=size, unit="B", unit_scale=True, desc=f"reading {p.name}", leave=False)
     channels: dict[int, Channel] = {}
+    digest = Digest()
     try:
         with open(p, "rb") as f:
             w = _Walker(f, size, bar, out)
@@ -496,11 +504,19 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                 elif isinstance(rec, Channel):
                     channels[rec.id] = rec
                 elif isinstance(rec, Message):
+                    ch = channels.get(rec.channel_id)
+                    digest.message(ch.topic if ch else "", rec.log_time, rec.publish_time, rec.sequence,
+                                   rec.data)
                     _take_message(out, channels, rec)
                 elif isinstance(rec, Metadata):
+                    if rec.name == METADATA_DIGEST:
+                        out.seal = dict(rec.metadata)
+                        continue
+                    digest.metadata(rec.name, rec.metadata)
                     merged = out.metadata.setdefault(rec.name, {})
                     merged.update({k: _decode_metadata_value(v) for k, v in rec.metadata.items()})
                 elif isinstance(rec, Attachment):
+                    digest.attachment(rec.name, rec.media_type, rec.data)
                     out.attachments[rec.name] = bytes(rec.data)
     finally:
         if bar is not None:
@@ -511,6 +527,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
         out.stop_reason = (f"{out.stop_reason}; but the file ends with the closing MCAP magic, so its "
                            f"writer finished it: the file is damaged, not cut")
     out.unreadable_bytes = 0 if out.complete else size - out.readable_bytes
+    out.seal_status, out.seal_detail = check_seal(out.seal, digest)
     return out
 
 
