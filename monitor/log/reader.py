@@ -222,10 +222,14 @@ def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return d
 
 
+_STRICT = json.JSONDecoder(parse_constant=_reject_constant, object_pairs_hook=_no_duplicates)
+
+
 def loads_strict(data: bytes | str) -> Any:
     """Strict JSON: no NaN/Infinity, no duplicated keys; raises ValueError (also on deep nesting)."""
     try:
-        return json.loads(data, parse_constant=_reject_constant, object_pairs_hook=_no_duplicates)
+        text = data.decode("utf-8") if isinstance(data, (bytes, bytearray, memoryview)) else data
+        return _STRICT.decode(text)
     except RecursionError as exc:
         raise ValueError("JSON nested too deeply") from exc
 
