@@ -1,6 +1,6 @@
 """``python -m monitor review LOG.mcap [LOG2.mcap ...]``: summarise, re-verify and report logs.
 
-Exit codes (printed by ``--help``; 1 takes precedence over 2 over 0):
+Exit codes (1 takes precedence over 2, 2 over 0):
 
   0  every log was read whole (a killed writer's cut tail excepted), nothing was
      skipped, and with --verify every window was re-derived from the attached
@@ -34,7 +34,9 @@ from typing import Any
 
 def add_parser(p: argparse.ArgumentParser) -> None:
     """Add the review options to the subcommand parser ``p``."""
-    p.description = __doc__.replace("``", "'")
+    import re
+
+    p.description = re.sub(r":\w+:`~?([^`]+)`", r"\1", __doc__).replace("``", "'")  # no raw reST
     p.formatter_class = argparse.RawDescriptionHelpFormatter
     p.add_argument("logs", nargs="+", metavar="LOG.mcap", help="monitor MCAP log(s)")
     p.add_argument("--verify", action="store_true",
