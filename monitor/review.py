@@ -425,7 +425,8 @@ def _pair_key(geoms: Any) -> frozenset:
 
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
-           limit: int | None = None, tolerances: dict[str, Any] | None = None) -> dict[str, Any]:
+           limit: int | None = None, tolerances: dict[str, Any] | None = None,
+           expect_pairs: str | None = None) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
@@ -455,6 +456,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         progress: tqdm bar over windows; None = when there are more than 200.
         limit: verify only the first ``limit`` windows (the rest are reported unverifiable).
         tolerances: tolerance fields overriding the library defaults (validated).
+        expect_pairs: ``"mujoco"`` or ``"all"``: the pair policy the auditor requires. A log
+            whose policy differs is critical and is recomputed with this policy instead (a
+            log that consistently claims fewer pairs is otherwise only reported in a note).
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -472,7 +476,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     """
     from dataclasses import asdict
 
-    from monitor.errors import MonitorError
+    from monitor.errors import InvalidInputError, MonitorError
     from monitor.log.reader import load_model, model_consistency
 
     tol = make_tolerances(tolerances)
@@ -524,6 +528,13 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         policy = parse_pair_policy(raw_policy)
     except MonitorError as exc:
         find(CRITICAL, f"logged pair policy is invalid: {exc}")
+    if expect_pairs is not None:
+        if expect_pairs not in ("mujoco", "all"):
+            raise InvalidInputError(f"expect_pairs must be 'mujoco' or 'all', got {expect_pairs!r}")
+        if policy != expect_pairs:
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not the required "
+                           f"{expect_pairs!r}")
+        policy = expect_pairs
     scene = None
     if policy is not None:
         try:

@@ -303,3 +303,25 @@ def test_crafted_fields_cost_only_their_message(genuine, tmp_path, capsys):
     genuine_line = f"windows {N_WINDOWS}: certified {N_WINDOWS - len(bad)}, violation {len(bad)}"
     assert genuine_line in out
     assert out.count("== /") == 2
+
+
+def test_consistent_short_pair_policy_is_noted_and_caught_by_expect_pairs(genuine, tmp_path, capsys):
+    """The strongest pair forgery: metadata and every certificate claim the same single far pair.
+    The log then only claims that pair (a note says so); an auditor who requires MuJoCo's pair
+    filter gets a critical finding and a recomputation over every pair."""
+    far = ["post_b", "shelf_low"]
+
+    def one_pair(topic, o):
+        if topic == topics.CERTIFICATE:
+            o["pairs"] = [dict(o["pairs"][0], geoms=far, bodies=["post_b", "shelf"], verdict="certified")]
+        return o
+
+    dst = tmp_path / "short.mcap"
+    rewrite(genuine["path"], dst, msg=flip(genuine["bad"], one_pair),
+            metadata=_run_meta(pairs=[far]))
+    code, out = review(dst, capsys)
+    assert "note: pair policy is an explicit list of 1 pair(s): only those pairs are certified" in out
+    code, out = review(dst, capsys, "--expect-pairs", "mujoco")
+    assert code == 1, out
+    assert "[CRITICAL] log: logged pair policy [['post_b', 'shelf_low']] is not the required 'mujoco'" in out
+    assert "logged certified -> recomputed violation  [CRITICAL]" in out

@@ -47,6 +47,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                         "cross-checked when both load)")
     p.add_argument("--limit", type=int, default=None,
                    help="--verify only the first N windows of each log (the rest are unverified: exit 2)")
+    p.add_argument("--expect-pairs", choices=("mujoco", "all"), default=None,
+                   help="--verify requires this pair policy (a log claiming another one, e.g. a short "
+                        "explicit list, is critical); default: the logged policy, reported")
     p.add_argument("--tolerances", metavar="JSON", default=None,
                    help="tolerance fields for --verify, e.g. '{\"abs_pad\": 1e-10}' (default: the library's; "
                         "logged tolerances are only compared, never used)")
@@ -105,7 +108,8 @@ def _review_one(path: str, args: argparse.Namespace,
     elif args.verify:
         try:
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
-                                     limit=args.limit, tolerances=getattr(args, "tolerance_values", None))
+                                     limit=args.limit, tolerances=getattr(args, "tolerance_values", None),
+                                     expect_pairs=getattr(args, "expect_pairs", None))
         except ImportError as exc:
             entry["verify"] = {"error": f"verification needs the certification engine: {exc}"}
         except (MonitorError, ValueError) as exc:
@@ -137,8 +141,8 @@ def run(args: argparse.Namespace) -> int:
         except (ValueError, InvalidInputError) as exc:
             print(f"error: --tolerances: {exc}", file=sys.stderr)
             return 2
-    if args.tolerance_values and getattr(args, "ray", False):
-        print("error: --tolerances is not supported with --ray yet", file=sys.stderr)
+    if (args.tolerance_values or getattr(args, "expect_pairs", None)) and getattr(args, "ray", False):
+        print("error: --tolerances and --expect-pairs are not supported with --ray yet", file=sys.stderr)
         return 2
     paths = expand_logs(args.logs)
     if not paths:
