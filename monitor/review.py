@@ -648,7 +648,12 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
 
 
 def verify_exit_code(ver: dict[str, Any]) -> int:
-    """1 critical finding or flip; 2 anything left unverified or an error; 0 all re-derived and agreed."""
+    """Exit code of one log's verification.
+
+    1 a critical finding or flip; 2 anything left unverified, an error, or a non-critical
+    disagreement that no logged reason explains (violation <-> uncertain); 0 all re-derived
+    and agreed (a logged "uncertain" whose budget was exhausted may recompute to anything).
+    """
     if ver.get("error"):
         return 2
     if ver.get("critical"):
@@ -656,6 +661,8 @@ def verify_exit_code(ver: dict[str, Any]) -> int:
     if ver.get("unverifiable") or ver.get("errors") or ver.get("missing_plans") \
             or ver.get("checked", 0) < ver.get("windows", 0):
         return 2
+    if any(not m.get("reason") for m in ver.get("mismatches", [])):
+        return 2  # e.g. violation <-> uncertain: not a safety flip, but the window did not agree
     return 0
 
 

@@ -342,3 +342,20 @@ def test_bad_tolerances_option_is_one_line(hand_log, capsys):
 def test_fmt_bound_keeps_the_sign():
     assert review.fmt_bound(-1e308) == "-inf" and review.fmt_bound(1e308) == "inf"
     assert review.fmt_bound(None) == "unknown" and review.fmt_bound(0.0123) == "0.0123"
+
+
+def test_unexplained_noncritical_disagreement_exits_2(tmp_path, monkeypatch, capsys):
+    """Logged "uncertain" (no budget flag) that recomputes to "violation": not a safety flip, but
+    the window did not agree, so not exit 0; with the budget flag it is explained (exit 0)."""
+    pytest.importorskip("monitor.motion.plan")
+    monkeypatch.setattr(review, "_engine", lambda: (_FakeScene, _fake_certify))
+    model = mujoco.MjModel.from_xml_string(XML)
+    for exhausted, want in ((False, 2), (True, 0)):
+        path = tmp_path / f"u{exhausted}.mcap"
+        with MonitorLog(path, model=model, metadata={"pairs": "all"}, foxglove=False) as log:
+            c = _fake_certify(None, _plan(model, 0.0, 0.1), window=(0.0, 0.01)).to_dict()
+            assert c["verdict"] == "violation"
+            c.update(verdict="uncertain", stats={"budget_exhausted": exhausted})
+            log.write_window(0.0, _plan(model, 0.0, 0.1), c)
+        assert main(["review", "--verify", str(path)]) == want
+        assert "logged uncertain -> recomputed violation" in capsys.readouterr().out
