@@ -280,10 +280,7 @@ def _parse(opcode: int, body: bytes) -> Any:
     parsers = {Opcode.SCHEMA: Schema.read, Opcode.CHANNEL: Channel.read, Opcode.CHUNK: Chunk.read,
                Opcode.METADATA: Metadata.read, Opcode.ATTACHMENT: Attachment.read,
                Opcode.HEADER: Header.read, Opcode.FOOTER: Footer.read, Opcode.DATA_END: DataEnd.read}
-    rec = parsers[opcode](s)
-    if s.count != len(body) and opcode not in (Opcode.HEADER, Opcode.FOOTER, Opcode.DATA_END):
-        raise ValueError(f"record body has {len(body) - s.count} trailing byte(s)")
-    return rec
+    return parsers[opcode](s)  # trailing bytes are allowed: the MCAP spec lets records grow new fields
 
 
 def _chunk_data(chunk: Chunk) -> bytes:
