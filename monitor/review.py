@@ -3,8 +3,15 @@
 * :func:`analyze` turns a :class:`~monitor.log.reader.LogContents` into a plain,
   JSON-serialisable summary dict (no I/O, no printing).
 * :func:`verify` recomputes every logged certificate from the model attached to
-  the log and the logged plan, with the logged margin, epsilon, method, pair
-  policy and tolerances, and lists the windows whose verdict changed.
+  the log and the logged plan. Everything else in the log is a claim that is
+  checked, never obeyed: the certificate's pair set must equal the one the model
+  and the logged pair policy give, its window must equal the plan's span, its
+  margin/epsilon/method must be valid and equal the run's, window indices must be
+  unique, verdicts must be one of the three, logged tolerances must be valid (the
+  recomputation uses the library defaults unless the caller passes others), and
+  ``model.xml`` must describe the same model as ``model.mjb``. A failed claim is a
+  *critical* finding; a window that cannot be recomputed (no plan, an error, a
+  malformed message) is an *unverifiable* finding. See :func:`verify`.
 * :func:`render_text` and :func:`write_report` present those dicts (text table,
   self-contained HTML with embedded matplotlib PNGs).
 
@@ -45,7 +52,7 @@ def _violation_row(cert: dict[str, Any]) -> dict[str, Any]:
     if wit:
         pair = next((p for p in bad if list(p.get("geoms", [])) == list(wit.get("geoms", []))), None)
         geoms = list(wit.get("geoms", []))
-        bodies = list(pair.get("bodies", [])) if pair else []
+        bodies = list(pair.get("bodies") or []) if pair else []
         return {"index": cert.get("index"), "sim_time": cert.get("sim_time"), "verdict": cert["verdict"],
                 "time": wit.get("time"), "geoms": geoms, "bodies": bodies, "point": wit.get("point"),
                 "distance": wit.get("distance"), "clearance": cert.get("clearance"),
@@ -53,23 +60,175 @@ def _violation_row(cert: dict[str, Any]) -> dict[str, Any]:
     first = bad[0] if bad else {}
     return {"index": cert.get("index"), "sim_time": cert.get("sim_time"), "verdict": cert["verdict"],
             "time": cert.get("earliest_time"), "geoms": list(first.get("geoms", [])),
-            "bodies": list(first.get("bodies", [])), "point": None, "distance": None,
+            "bodies": list(first.get("bodies") or []), "point": None, "distance": None,
             "clearance": cert.get("clearance"), "pairs": len(bad)}
+
+
+_NUM = (int, float)
+
+
+def _short(x: Any, n: int = 40) -> str:
+    """``repr(x)`` cut to ``n`` characters (hostile values stay one short line)."""
+    r = repr(x)
+    return r if len(r) <= n else r[:n] + "..."
+
+
+def _is_num(x: Any) -> bool:
+    return isinstance(x, _NUM) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _is_int(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+def _names2(x: Any) -> bool:
+    return isinstance(x, list) and len(x) == 2 and all(isinstance(v, str) for v in x)
+
+
+def _witness_problem(w: Any, where: str) -> str | None:
+    if w is None:
+        return None
+    if not isinstance(w, dict):
+        return f"{where} is not an object"
+    if not _is_num(w.get("time")):
+        return f"{where}.time is not a finite number"
+    if not _names2(w.get("geoms")):
+        return f"{where}.geoms is not two names"
+    pt = w.get("point")
+    if not (isinstance(pt, list) and len(pt) == 3 and all(_is_num(v) for v in pt)):
+        return f"{where}.point is not three finite numbers"
+    if w.get("distance") is not None and not _is_num(w.get("distance")):
+        return f"{where}.distance is not a number or null"
+    return None
+
+
+def certificate_problem(c: dict[str, Any]) -> str | None:
+    """Why a logged certificate payload is malformed (None when its fields are well typed).
+
+    Checks types only (the verdict's *value*, margin/epsilon ranges and the method name
+    are claims checked by :func:`verify`): ``index`` int >= 0, ``sim_time`` finite >= 0,
+    ``verdict``/``method`` strings, ``window`` two finite numbers, ``margin``/``epsilon``
+    numbers, ``clearance``/``earliest_time`` number or null, ``pairs`` a list of objects
+    with two geom names, a verdict string, a method string and a number-or-null
+    clearance, ``witness`` null or a well-formed witness, ``stats`` null or an object.
+    """
+    k = c.get("index")
+    if not _is_int(k) or k < 0:
+        return f"index {_short(k, 40)} is not an integer >= 0"
+    if not _is_num(c.get("sim_time")) or c["sim_time"] < 0:
+        return f"sim_time {_short(c.get('sim_time'), 40)} is not a finite number >= 0"
+    for key in ("verdict", "method"):
+        if not isinstance(c.get(key), str):
+            return f"{key} is not a string"
+    win = c.get("window")
+    if not (isinstance(win, list) and len(win) == 2 and all(_is_num(v) for v in win)):
+        return "window is not two finite numbers"
+    for key in ("margin", "epsilon"):
+        v = c.get(key)
+        if not (isinstance(v, _NUM) and not isinstance(v, bool)):
+            return f"{key} is not a number"
+    for key in ("clearance", "earliest_time"):
+        if c.get(key) is not None and not _is_num(c.get(key)):
+            return f"{key} {_short(c.get(key), 40)} is not a number or null"
+    pairs = c.get("pairs")
+    if not isinstance(pairs, list):
+        return "pairs is not a list"
+    for i, p in enumerate(pairs):
+        if not isinstance(p, dict) or not _names2(p.get("geoms")):
+            return f"pairs[{i}] has no two geom names"
+        if not isinstance(p.get("verdict"), str) or not isinstance(p.get("method", ""), str):
+            return f"pairs[{i}] verdict/method is not a string"
+        if p.get("bodies") is not None and not _names2(p.get("bodies")):
+            return f"pairs[{i}].bodies is not two names"
+        if p.get("clearance") is not None and not _is_num(p.get("clearance")):
+            return f"pairs[{i}].clearance is not a number or null"
+        why = _witness_problem(p.get("witness"), f"pairs[{i}].witness")
+        if why:
+            return why
+    why = _witness_problem(c.get("witness"), "witness")
+    if why:
+        return why
+    st = c.get("stats")
+    if st is not None and not isinstance(st, dict):
+        return "stats is not an object"
+    return None
+
+
+def split_certificates(contents: LogContents) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """(well-typed certificates in window order, rows ``{index, problem}`` of malformed ones)."""
+    good, bad = [], []
+    for c in contents.certificates():
+        why = certificate_problem(c)
+        if why is None:
+            good.append(c)
+        else:
+            k = c.get("index")
+            bad.append({"index": k if _is_int(k) else None, "problem": why})
+    return good, bad
+
+
+def _integrity(contents: LogContents, certs: list[dict[str, Any]],
+               bad_messages: list[dict[str, Any]]) -> list[str]:
+    """Cheap whole-log consistency checks that catch dropped or re-routed messages.
+
+    The writer numbers windows 0, 1, 2, ... and writes one ``/monitor/violation`` message
+    per non-certified certificate, every JSON payload with an integer ``index``. So: a gap
+    in the certificate indices, a violation message without a matching non-certified
+    certificate (or the reverse), or a payload without an integer index means messages
+    were lost or moved (bit rot in a channel id, an edited log).
+    """
+    out = []
+    for topic in topics.JSON_TOPICS:
+        n = sum(1 for m in contents.topic(topic) if not _is_int(m.get("index")) or m["index"] < 0)
+        if n and topic != topics.CERTIFICATE:  # malformed certificates are listed in bad_messages
+            out.append(f"{n} {topic} message(s) without an integer index")
+    for p in contents.topic(topics.PLAN):
+        if not isinstance(p.get("times"), list):
+            out.append(f"{topics.PLAN} message {str(p.get('index'))[:20]} has no times list")
+            break
+    have = {c["index"] for c in certs} | {b["index"] for b in bad_messages if b["index"] is not None}
+    if have:
+        gaps = sorted(set(range(max(have) + 1)) - have) if max(have) < 10 * len(have) + 10 else None
+        if gaps is None:
+            out.append(f"certificate indices reach {max(have)} with only {len(have)} certificates")
+        elif gaps:
+            out.append(f"certificate indices have {len(gaps)} gap(s) (first: {gaps[:5]}): certificates lost")
+    if contents.seal_status == "mismatch":
+        out.append(f"digest seal: {contents.seal_detail}")
+    flagged = Counter(c["index"] for c in certs if c["verdict"] != "certified")
+    viol = Counter(m["index"] for m in contents.topic(topics.VIOLATION) if _is_int(m.get("index")))
+    if contents.stop_kind == "truncated" and have:  # a killed writer may have cut the last window short
+        flagged.pop(max(have), None)
+        viol.pop(max(have), None)
+    if flagged != viol:
+        only_v = sorted((viol - flagged).keys())[:5]
+        only_c = sorted((flagged - viol).keys())[:5]
+        out.append(f"{topics.VIOLATION} messages do not match the non-certified certificates "
+                   f"(violation message without such a certificate: {only_v}; certificate without "
+                   f"violation message: {only_c})")
+    return out
 
 
 def analyze(contents: LogContents) -> dict[str, Any]:
     """Summary of one log (pure function of the recovered contents).
 
+    Malformed certificate payloads (:func:`certificate_problem`) are skipped and
+    listed in ``bad_messages``; certificates whose verdict is not one of the three
+    are never dropped silently: they are listed in ``unknown_verdicts``.
+
     Returns:
         dict with ``file`` (path, size, complete, unreadable_bytes, stop_reason,
-        messages, bad_payloads), ``run`` (metadata), ``windows``, ``verdicts``
+        stop_kind, messages, bad_payloads, bad_records, problems), ``run`` (metadata),
+        ``bad_messages`` (rows: index, problem), ``unknown_verdicts`` (rows: index,
+        verdict), ``integrity`` (problems found by :func:`_integrity`), ``windows``, ``verdicts``
         ({verdict: count}), ``blocked_actions``, ``actions``, ``latency_us``
         ({p50, p95, max, n}), ``checker_mix`` ({method: pairs}), ``violations``
         (rows: index, sim_time, verdict, time, geoms, bodies, point, distance,
         clearance), and ``series`` (per-window sim_time, verdict, clearance,
         latency_us for plots).
     """
-    certs = contents.certificates()
+    certs, bad_messages = split_certificates(contents)
+    unknown = []
     verdicts = Counter({v: 0 for v in VERDICTS})
     mix: Counter = Counter()
     lat: list[float] = []
@@ -78,14 +237,15 @@ def analyze(contents: LogContents) -> dict[str, Any]:
     for c in certs:
         v = c.get("verdict")
         if v not in VERDICTS:
+            unknown.append({"index": c["index"], "sim_time": c["sim_time"], "verdict": str(v)[:60]})
             continue
         verdicts[v] += 1
         mix.update(_checker_mix(c))
         ws = (c.get("stats") or {}).get("wall_seconds")
-        us = float(ws) * 1e6 if isinstance(ws, (int, float)) and math.isfinite(ws) else None
+        us = float(ws) * 1e6 if _is_num(ws) and 0 <= ws < 1e6 else None  # a crafted 1e308 s is not a latency
         if us is not None:
             lat.append(us)
-        series["sim_time"].append(float(c.get("sim_time", c["_log_time"] * 1e-9)))
+        series["sim_time"].append(float(c["sim_time"]))
         series["verdict"].append(v)
         cl = c.get("clearance")
         series["clearance"].append(float(cl) if isinstance(cl, (int, float)) else None)
@@ -93,7 +253,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         series["margin"].append(c.get("margin"))
         if v != "certified":
             rows.append(_violation_row(c))
-    actions = contents.topic(topics.ACTION)
+    actions = [a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))]
+    integrity = _integrity(contents, certs, bad_messages)
     run = {k: v for k, v in contents.run.items() if not k.startswith("version.")}
     for key in ("margin", "epsilon", "method"):  # not in the metadata: from the first certificate
         if run.get(key) is None and certs and key in certs[0]:
@@ -101,8 +262,14 @@ def analyze(contents: LogContents) -> dict[str, Any]:
     return {
         "file": {"path": contents.path, "size": contents.size, "complete": contents.complete,
                  "unreadable_bytes": contents.unreadable_bytes, "stop_reason": contents.stop_reason,
-                 "messages": dict(contents.counts), "bad_payloads": contents.bad_payloads,
+                 "stop_kind": contents.stop_kind, "messages": dict(contents.counts),
+                 "bad_payloads": contents.bad_payloads, "bad_records": contents.bad_records,
+                 "problems": list(contents.problems), "seal": contents.seal_status,
+                 "seal_detail": contents.seal_detail,
                  "library": contents.library, "attachments": sorted(contents.attachments)},
+        "bad_messages": bad_messages,
+        "unknown_verdicts": unknown,
+        "integrity": integrity,
         "run": run,
         "versions": {k[len("version."):]: v for k, v in contents.run.items() if k.startswith("version.")},
         "windows": sum(verdicts.values()),
@@ -136,6 +303,15 @@ def combine(summaries: list[dict[str, Any]]) -> dict[str, Any]:
 # --------------------------------------------------------------------------- verification
 
 
+METHODS = ("auto", "toleranced", "extrusion")
+"""Certificate-level methods :func:`monitor.certify` accepts."""
+
+CRITICAL = "critical"
+UNVERIFIABLE = "unverifiable"
+
+_POLICY_TEXT_LIMIT = 100_000
+
+
 def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     from monitor.errors import InvalidInputError
 
@@ -144,6 +320,8 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
         from monitor.motion.bodymotion import BodyMotion
 
         return BodyMotion(times, np.asarray(msg["pos"], np.float64), np.asarray(msg["quat"], np.float64))
+    if msg.get("kind", "plan") != "plan":
+        raise InvalidInputError(f"logged plan kind {_short(msg.get('kind'), 40)} is unknown")
     from monitor.motion.plan import Plan
 
     qpos = np.asarray(msg["qpos"], dtype=np.float64)
@@ -164,65 +342,241 @@ def _engine() -> tuple[Any, Any]:
     return Scene, certify
 
 
-def _tolerances(run: dict[str, Any]) -> Any:
+_TOL_INT_RANGES = {"max_depth": (1, 64), "facets": (3, 4096), "witness_candidates": (2, 10_000),
+                   "max_frontier": (0, 1 << 30)}
+
+
+def tolerance_problems(tol: Any) -> list[str]:
+    """Problems of a tolerances dict (logged or given): unknown fields, wrong types, bad ranges.
+
+    Float fields must be finite and >= 0 (``quat_norm_tol`` > 0); integer fields must be
+    integers in the ranges of ``_TOL_INT_RANGES`` (e.g. ``facets`` >= 3). Empty = valid.
+    """
+    from monitor.tolerances import Tolerances
+
+    if not isinstance(tol, dict):
+        return [f"tolerances is a {type(tol).__name__}, not an object"]
+    fields = Tolerances.__dataclass_fields__
+    out = []
+    for k, v in tol.items():
+        if k not in fields:
+            out.append(f"unknown tolerance field {_short(k, 40)}")
+        elif k in _TOL_INT_RANGES:
+            lo, hi = _TOL_INT_RANGES[k]
+            if not _is_int(v) or not lo <= v <= hi:
+                out.append(f"{k}={_short(v, 40)} is not an integer in [{lo}, {hi}]")
+        elif not _is_num(v) or v < 0 or (k == "quat_norm_tol" and v == 0):
+            bound = "> 0" if k == "quat_norm_tol" else ">= 0"
+            out.append(f"{k}={_short(v, 40)} is not a finite number {bound}")
+    return out
+
+
+def make_tolerances(values: dict[str, Any] | None) -> Any:
+    """Library defaults, or a :class:`~monitor.tolerances.Tolerances` from validated ``values``.
+
+    Raises:
+        InvalidInputError: :func:`tolerance_problems` found any.
+    """
+    from monitor.errors import InvalidInputError
     from monitor.tolerances import DEFAULT, Tolerances
 
-    tol = run.get("tolerances")
-    if isinstance(tol, dict):
-        known = {k: v for k, v in tol.items() if k in Tolerances.__dataclass_fields__}
-        return Tolerances(**known)
-    return DEFAULT
+    if not values:
+        return DEFAULT
+    bad = tolerance_problems(values)
+    if bad:
+        raise InvalidInputError("tolerances: " + "; ".join(bad))
+    return Tolerances(**values)
 
 
-def _pair_policy(run: dict[str, Any], cert: dict[str, Any]) -> Any:
-    pol = run.get("pairs", run.get("pair_policy"))
+def parse_pair_policy(value: Any) -> str | list[tuple[str, str]]:
+    """The logged pair policy: ``"mujoco"``, ``"all"`` or a list of (geom, geom) names.
+
+    Accepts a JSON list of two-name lists, or the text of one (``str()`` of a Python list of
+    tuples, as :class:`monitor.Gate` writes), parsed with :func:`ast.literal_eval` (literals
+    only, at most 100 kB).
+
+    Raises:
+        InvalidInputError: anything else.
+    """
+    import ast
+
+    from monitor.errors import InvalidInputError
+
+    pol = value
+    if isinstance(pol, str) and pol not in ("mujoco", "all"):
+        if len(pol) > _POLICY_TEXT_LIMIT:
+            raise InvalidInputError(f"pair policy text is longer than {_POLICY_TEXT_LIMIT} characters")
+        try:
+            pol = ast.literal_eval(pol)
+        except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError) as exc:
+            raise InvalidInputError(f"pair policy {value[:60]!r} is neither 'mujoco', 'all' nor a list of "
+                                    f"geom-name pairs") from exc
     if pol in ("mujoco", "all"):
         return pol
-    if isinstance(pol, list):
-        return [tuple(p) for p in pol]
-    return [tuple(p["geoms"]) for p in cert.get("pairs", [])]  # no policy logged: the certificate's pairs
+    if isinstance(pol, (list, tuple)) and all(
+            isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(g, str) for g in p) for p in pol):
+        return [(str(p[0]), str(p[1])) for p in pol]
+    raise InvalidInputError(f"pair policy {_short(value, 60)} is neither 'mujoco', 'all' nor a list of "
+                            f"geom-name pairs")
+
+
+def _pair_key(geoms: Any) -> frozenset:
+    return frozenset(map(str, geoms))
 
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
-           limit: int | None = None) -> dict[str, Any]:
-    """Recompute every logged certificate from the log alone.
+           limit: int | None = None, tolerances: dict[str, Any] | None = None,
+           expect_pairs: str | None = None) -> dict[str, Any]:
+    """Recompute every logged certificate from the attached model and the logged plan.
 
-    For each certificate message: rebuild ``Plan`` from the logged plan (same
-    index), ``Scene.from_model`` on the attached model with the logged pair policy
-    (and facets/tolerances if logged), and call ``monitor.certify`` with the
-    certificate's margin, epsilon, method and window.
+    Inputs of the recomputation: the model (attachments), the plan (same window index),
+    the pair set ``Scene.from_model(model, pairs=<logged policy>)`` (the policy is the one
+    claim that defines *what* is certified; a missing policy is assumed ``"mujoco"`` and
+    reported), the library's default :class:`~monitor.tolerances.Tolerances` (or
+    ``tolerances`` from the caller), and the certificate's margin, epsilon and method once
+    they are checked; the window is always the plan's span.
+
+    Claims checked (a failure is a *critical* finding, exit 1 in the CLI): verdict is
+    one of the three; index unique among certificates and among plans; method known;
+    margin finite >= 0 and epsilon finite > 0, both equal to the run metadata's when
+    that has them; window equal to the plan's span; the certificate's pair multiset equal
+    to the scene's; the pair policy valid for the model; logged tolerances valid (when
+    valid but different from the ones used, a note); ``model.xml`` and ``model.mjb`` the
+    same model; and the recomputed verdict equal to the logged one (certified <->
+    not-certified flips are critical, except logged "uncertain" windows whose
+    ``stats["budget_exhausted"]`` is true).
+
+    Unverifiable findings (exit 2 in the CLI): a malformed certificate, a window without
+    plan, an error while rebuilding or certifying, windows left out by ``limit``, a model
+    whose XML and MJB cannot be cross-checked, no logged pair policy.
 
     Args:
         contents: a read log.
         model_source: ``"auto" | "xml" | "mjb"`` (see :func:`monitor.log.reader.load_model`).
         progress: tqdm bar over windows; None = when there are more than 200.
-        limit: verify only the first ``limit`` windows.
+        limit: verify only the first ``limit`` windows (the rest are reported unverifiable).
+        tolerances: tolerance fields overriding the library defaults (validated).
+        expect_pairs: ``"mujoco"`` or ``"all"``: the pair policy the auditor requires. A log
+            whose policy differs is critical and is recomputed with this policy instead (a
+            log that consistently claims fewer pairs is otherwise only reported in a note).
 
     Returns:
-        dict with ``checked``, ``model_source``, ``mismatches`` (rows: index,
-        sim_time, logged, recomputed, critical, logged_clearance, clearance),
-        ``critical`` (number of certified <-> not-certified flips, except logged
-        "uncertain" windows whose ``stats["budget_exhausted"]`` is true), ``missing_plans``,
-        ``errors`` (rows: index, error), ``pairs_differ`` (windows whose pair set
-        differs from the scene's).
+        dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
+        ``model_source``, ``model_consistency``, ``tolerances`` (the values used),
+        ``pair_policy``, ``mismatches`` (rows: index, sim_time, logged, recomputed, critical,
+        logged_clearance, clearance, witness, reason), ``findings`` (rows: index or None,
+        severity ``"critical" | "unverifiable"``, reason), ``notes`` (strings),
+        ``critical`` (critical mismatches + critical findings), ``unverifiable`` (number
+        of unverifiable findings), ``missing_plans``, ``errors`` (rows: index, error),
+        ``pairs_differ``.
 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
+        InvalidInputError: bad ``tolerances`` or ``model_source``.
     """
-    from monitor.errors import MonitorError
-    from monitor.log.reader import load_model
+    from dataclasses import asdict
 
+    from monitor.errors import InvalidInputError, MonitorError
+    from monitor.log.reader import load_model, model_consistency
+
+    tol = make_tolerances(tolerances)
     scene_cls, certify = _engine()
     model, how = load_model(contents, model_source)
     run = contents.run
-    tol = _tolerances(run)
-    plans = contents.plans_by_index()
-    certs = contents.certificates()
-    if limit is not None:
+    findings: list[dict[str, Any]] = []
+    notes: list[str] = []
+
+    def find(severity: str, reason: str, index: int | None = None) -> None:
+        findings.append({"index": index, "severity": severity, "reason": reason})
+
+    if contents.seal_status == "mismatch":
+        find(CRITICAL, f"digest seal: {contents.seal_detail}")
+    elif contents.seal_status == "unsealed":
+        notes.append("log is not sealed (no digest): edits after writing cannot be detected by digest")
+    consistency = model_consistency(contents)
+    if consistency["status"] == "inconsistent":
+        find(CRITICAL, consistency["detail"])
+    elif consistency["status"] == "unchecked":
+        find(UNVERIFIABLE, consistency["detail"])
+
+    logged_tol = run.get("tolerances")
+    if logged_tol is not None:
+        bad = tolerance_problems(logged_tol)
+        if bad:
+            find(CRITICAL, "logged tolerances are invalid: " + "; ".join(bad))
+        else:
+            used = asdict(tol)
+            diff = {k: v for k, v in logged_tol.items() if used.get(k) != v}
+            if diff:
+                notes.append(f"logged tolerances {diff} differ from the ones used here; the logged "
+                             f"ones were not used")
+    run_claims: dict[str, float] = {}
+    for key, ok in (("margin", lambda x: x >= 0), ("epsilon", lambda x: x > 0)):
+        if key in run:
+            v = run[key]
+            if not _is_num(v) or not ok(v):
+                find(CRITICAL, f"run metadata {key}={_short(v, 40)} is invalid")
+            else:
+                run_claims[key] = float(v)
+
+    policy: Any = None
+    raw_policy = run.get("pairs", run.get("pair_policy"))
+    if raw_policy is None:
+        find(UNVERIFIABLE, "no pair policy in the run metadata: assumed the library default 'mujoco'")
+        raw_policy = "mujoco"
+    try:
+        policy = parse_pair_policy(raw_policy)
+    except MonitorError as exc:
+        find(CRITICAL, f"logged pair policy is invalid: {exc}")
+    if expect_pairs is not None:
+        if expect_pairs not in ("mujoco", "all"):
+            raise InvalidInputError(f"expect_pairs must be 'mujoco' or 'all', got {expect_pairs!r}")
+        if policy != expect_pairs:
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not the required "
+                           f"{expect_pairs!r}")
+        policy = expect_pairs
+    scene = None
+    if policy is not None:
+        try:
+            scene = scene_cls.from_model(model, pairs=policy, tolerances=tol)
+        except (MonitorError, ValueError, TypeError) as exc:
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not valid for the attached "
+                           f"model: {exc}")
+        if isinstance(policy, list):
+            notes.append(f"pair policy is an explicit list of {len(policy)} pair(s): only those pairs are "
+                         f"certified")
+    if run.get("facets") is not None and run.get("facets") != tol.facets:
+        notes.append(f"logged facets {str(run.get('facets'))[:20]} not used (tolerances.facets={tol.facets})")
+
+    good, bad_rows = split_certificates(contents)
+    for row in bad_rows:
+        find(UNVERIFIABLE, f"malformed certificate skipped: {row['problem']}", row["index"])
+    cert_count = Counter(c["index"] for c in good)
+    for k, n in sorted(cert_count.items()):
+        if n > 1:
+            find(CRITICAL, f"window index {k} has {n} certificates", k)
+    plan_msgs: dict[int, list[dict[str, Any]]] = {}
+    for p in contents.topic(topics.PLAN):
+        k = p.get("index")
+        if _is_int(k):
+            plan_msgs.setdefault(k, []).append(p)
+        else:
+            find(UNVERIFIABLE, f"plan message without an integer index ({_short(k, 40)})")
+    for k, ps in sorted(plan_msgs.items()):
+        if len(ps) > 1:
+            find(CRITICAL, f"window index {k} has {len(ps)} plan messages", k)
+
+    certs = good
+    if limit is not None and len(certs) > limit:
+        find(UNVERIFIABLE, f"{len(certs) - limit} window(s) not checked (--limit {limit})")
         certs = certs[:limit]
-    out: dict[str, Any] = {"checked": 0, "model_source": how, "mismatches": [], "critical": 0,
-                           "missing_plans": 0, "errors": [], "pairs_differ": 0}
-    scenes: dict[Any, Any] = {}
+    out: dict[str, Any] = {"windows": len(good) + len(bad_rows), "checked": 0, "model_source": how,
+                           "model_consistency": consistency, "tolerances": asdict(tol),
+                           "pair_policy": policy if isinstance(policy, str) else
+                           (None if policy is None else [list(p) for p in policy]),
+                           "mismatches": [], "findings": findings, "notes": notes, "critical": 0,
+                           "unverifiable": 0, "missing_plans": 0, "errors": [], "pairs_differ": 0}
+    scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     it = certs
     if progress is None:
         progress = len(certs) > 200
@@ -231,45 +585,85 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
 
         it = tqdm(certs, desc=f"verifying {contents.path}", unit="win", leave=False)
     for c in it:
-        k = int(c.get("index", -1))
-        if k not in plans:
+        k = c["index"]
+        verdict = c["verdict"]
+        if verdict not in VERDICTS:
+            find(CRITICAL, f"unknown verdict {verdict[:40]!r}", k)
+        method = c["method"]
+        claims_ok = True
+        if method not in METHODS:
+            find(CRITICAL, f"unknown method {method[:40]!r}", k)
+            claims_ok = False
+        for key, ok in (("margin", lambda x: x >= 0), ("epsilon", lambda x: x > 0)):
+            v = c[key]
+            if not _is_num(v) or not ok(v):
+                find(CRITICAL, f"{key}={_short(v, 40)} is invalid", k)
+                claims_ok = False
+            elif key in run_claims and float(v) != run_claims[key]:
+                find(CRITICAL, f"{key}={v} differs from the run's {run_claims[key]}", k)
+        logged_pairs = Counter(_pair_key(p["geoms"]) for p in c["pairs"])
+        if scene_pairs is not None and logged_pairs != scene_pairs:
+            out["pairs_differ"] += 1
+            missing = sum((scene_pairs - logged_pairs).values())
+            extra = sum((logged_pairs - scene_pairs).values())
+            find(CRITICAL, f"certificate pairs differ from the model's pair set ({missing} missing, "
+                           f"{extra} extra of {sum(scene_pairs.values())})", k)
+        ps = plan_msgs.get(k)
+        if not ps:
             out["missing_plans"] += 1
+            find(UNVERIFIABLE, "no plan logged for this window: cannot recompute", k)
             continue
+        if len(ps) > 1 or scene is None or not claims_ok:
+            continue  # already critical; there is no single trustworthy input to recompute from
         try:
-            policy = _pair_policy(run, c)
-            key = policy if isinstance(policy, str) else tuple(policy)
-            if key not in scenes:
-                kw = {"tolerances": tol}
-                if run.get("facets") is not None:
-                    kw["facets"] = int(run["facets"])
-                scenes[key] = scene_cls.from_model(model, pairs=policy, **kw)
-            scene = scenes[key]
-            plan = _rebuild_plan(model, plans[k])
-            logged_pairs = [tuple(p["geoms"]) for p in c.get("pairs", [])]
-            ckw: dict[str, Any] = {"window": tuple(c["window"]), "tolerances": tol}
-            if logged_pairs and set(logged_pairs) != set(map(tuple, scene.candidate_pairs)):
-                out["pairs_differ"] += 1
-                ckw["pairs"] = logged_pairs
+            plan = _rebuild_plan(model, ps[0])
+            t0, t1 = float(plan.t0), float(plan.t1)
+            w0, w1 = (float(x) for x in c["window"])
+            if not (math.isclose(w0, t0, rel_tol=1e-12, abs_tol=1e-12)
+                    and math.isclose(w1, t1, rel_tol=1e-12, abs_tol=1e-12)):
+                find(CRITICAL, f"window [{w0!r}, {w1!r}] is not the plan's span [{t0!r}, {t1!r}]", k)
             new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
-                                  method=str(c.get("method", "auto")), **ckw)
-        except (MonitorError, ValueError, KeyError, TypeError, IndexError) as exc:
+                          method=method, window=(t0, t1), tolerances=tol)
+        except (MonitorError, ValueError, KeyError, TypeError, IndexError, OverflowError) as exc:
             out["errors"].append({"index": k, "sim_time": c.get("sim_time"),
-                                  "error": f"{type(exc).__name__}: {exc}"})
+                                  "error": f"{type(exc).__name__}: {str(exc)[:300]}"})
+            find(UNVERIFIABLE, f"cannot recompute: {type(exc).__name__}: {str(exc)[:200]}", k)
             continue
         out["checked"] += 1
-        if new.verdict != c["verdict"]:
-            critical = (new.verdict == "certified") != (c["verdict"] == "certified")
-            budget = bool((c.get("stats") or {}).get("budget_exhausted")) and c["verdict"] == "uncertain"
+        if new.verdict != verdict:
+            critical = (new.verdict == "certified") != (verdict == "certified")
+            budget = bool((c.get("stats") or {}).get("budget_exhausted")) and verdict == "uncertain"
             if budget:  # the logged run ran out of its work budget: "uncertain" was the honest answer then
                 critical = False
             out["critical"] += int(critical)
-            out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": c["verdict"],
+            out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": verdict,
                                       "recomputed": new.verdict, "critical": critical,
                                       "logged_clearance": c.get("clearance"),
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
+    out["critical"] += sum(f["severity"] == CRITICAL for f in findings)
+    out["unverifiable"] = sum(f["severity"] == UNVERIFIABLE for f in findings)
     return out
+
+
+def verify_exit_code(ver: dict[str, Any]) -> int:
+    """Exit code of one log's verification.
+
+    1 a critical finding or flip; 2 anything left unverified, an error, or a non-critical
+    disagreement that no logged reason explains (violation <-> uncertain); 0 all re-derived
+    and agreed (a logged "uncertain" whose budget was exhausted may recompute to anything).
+    """
+    if ver.get("error"):
+        return 2
+    if ver.get("critical"):
+        return 1
+    if ver.get("unverifiable") or ver.get("errors") or ver.get("missing_plans") \
+            or ver.get("checked", 0) < ver.get("windows", 0):
+        return 2
+    if any(not m.get("reason") for m in ver.get("mismatches", [])):
+        return 2  # e.g. violation <-> uncertain: not a safety flip, but the window did not agree
+    return 0
 
 
 # --------------------------------------------------------------------------- rendering
@@ -279,75 +673,149 @@ def _fmt(x: Any, spec: str = ".4g") -> str:
     if x is None:
         return "-"
     if isinstance(x, float):
-        return format(x, spec)
+        try:
+            return format(x, spec)
+        except ValueError:
+            return str(x)
     return str(x)
 
 
+def fmt_bound(x: Any, spec: str = ".3g") -> str:
+    """A clearance-like bound as text, keeping its sign.
+
+    ``-inf``/``inf`` for the writers' +-1e308 stand-ins of infinite bounds, ``unknown`` for
+    null (no bound), else ``format(x, spec)``.
+    """
+    if x is None:
+        return "unknown"
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return str(x)[:20]
+    if x <= -1e300:
+        return "-inf"
+    if x >= 1e300:
+        return "inf"
+    return format(float(x), spec)
+
+
 def _fmt_point(p: Any) -> str:
-    return "-" if not p else "(" + ", ".join(f"{v:.4f}" for v in p) + ")"
+    if not p:
+        return "-"
+    try:
+        return "(" + ", ".join(f"{v:.4f}" for v in p) + ")"
+    except (TypeError, ValueError):
+        return str(p)[:40]
 
 
 def render_text(result: dict[str, Any]) -> str:
-    """Human-readable text of a review result (``{"logs": [...], "total": ...}``)."""
+    """Human-readable text of a review result (``{"logs": [...], "total": ...}``).
+
+    Each log is rendered inside its own error handling: an entry that cannot be rendered
+    gets an ``ERROR`` line and ``entry["render_error"]``; the other logs are unaffected.
+    """
     lines: list[str] = []
     for entry in result["logs"]:
-        f = entry.get("file", {})
-        lines.append(f"== {f.get('path', entry.get('path'))}")
-        if entry.get("error"):
-            lines.append(f"   ERROR: {entry['error']}")
-            continue
-        if not f.get("complete"):
-            lines.append(f"   WARNING: incomplete log: {f.get('stop_reason')}; {f.get('unreadable_bytes')} "
-                         f"unreadable byte(s) at the end; showing the recovered part")
-        if f.get("bad_payloads"):
-            lines.append(f"   WARNING: {f['bad_payloads']} undecodable message(s) skipped")
-        run = entry.get("run", {})
-        v = entry["verdicts"]
-        lat = entry["latency_us"]
-        lines += [
-            f"   mujoco {entry.get('versions', {}).get('mujoco', '?')}, margin {_fmt(run.get('margin'))}, "
-            f"epsilon {_fmt(run.get('epsilon'))}, pairs {_fmt(run.get('pairs'))}, "
-            f"predictor {_fmt(run.get('predictor'))}",
-            f"   windows {entry['windows']}: certified {v['certified']}, violation {v['violation']}, "
-            f"uncertain {v['uncertain']}",
-            f"   actions {entry['actions']}, blocked/replaced {entry['blocked_actions']}",
-            f"   us per certification: p50 {_fmt(lat['p50'], '.1f')}, p95 {_fmt(lat['p95'], '.1f')}, "
-            f"max {_fmt(lat['max'], '.1f')} (n={lat['n']})",
-            "   checker mix: " + (", ".join(f"{k} {n}" for k, n in sorted(entry["checker_mix"].items()))
-                                  or "-"),
-        ]
-        rows = entry["violations"]
-        if rows:
-            lines.append(f"   {'sim time':>10} {'verdict':9} {'at t':>10}  {'bodies':28} {'geoms':32} "
-                         f"{'witness point (m)':32} {'distance':>10} {'clearance':>10}")
-            for r in rows:
-                lines.append(
-                    f"   {_fmt(r['sim_time'], '.4f'):>10} {r['verdict']:9} {_fmt(r['time'], '.4f'):>10}  "
-                    f"{' / '.join(r['bodies']) or '-':28} {' / '.join(r['geoms']) or '-':32} "
-                    f"{_fmt_point(r['point']):32} {_fmt(r['distance'], '.3g'):>10} "
-                    f"{_fmt(r['clearance'], '.3g'):>10}")
-        ver = entry.get("verify")
-        if ver:
-            if ver.get("error"):
-                lines.append(f"   verify: ERROR {ver['error']}")
-            else:
-                lines.append(f"   verify ({ver['model_source']}): {ver['checked']} re-derived, "
-                             f"{len(ver['mismatches'])} mismatch(es), {ver['critical']} critical, "
-                             f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s)")
-                for mm in ver["mismatches"]:
-                    lines.append(f"     window {mm['index']} t={_fmt(mm['sim_time'], '.4f')}: logged "
-                                 f"{mm['logged']} -> recomputed {mm['recomputed']}"
-                                 + ("  [CRITICAL]" if mm["critical"] else "")
-                                 + (f"  ({mm['reason']})" if mm.get("reason") else ""))
-                for e in ver["errors"][:10]:
-                    lines.append(f"     window {e['index']}: {e['error']}")
+        part: list[str] = []
+        try:
+            _render_entry(entry, part)
+        except Exception as exc:  # noqa: BLE001 - one unrenderable log never costs the others
+            entry["render_error"] = f"{type(exc).__name__}: {exc}"
+            part.append(f"   ERROR: cannot render this log: {entry['render_error']}")
+        lines += part
     tot = result.get("total")
     if tot and tot["logs"] > 1:
         v = tot["verdicts"]
         lines.append(f"== total over {tot['logs']} logs: windows {tot['windows']}: "
                      f"certified {v['certified']}, violation {v['violation']}, "
                      f"uncertain {v['uncertain']}; blocked {tot['blocked_actions']}")
+    if "exit_code" in result:
+        lines.append(f"exit code {result['exit_code']}: {EXIT_MEANING.get(result['exit_code'], '?')}")
     return "\n".join(lines)
+
+
+EXIT_MEANING = {0: "every window re-derived and agreed (or no --verify) and nothing skipped",
+                1: "CRITICAL: a forged or wrong claim, or a certified <-> not-certified flip",
+                2: "incomplete: something could not be read or re-verified"}
+"""Review exit codes (1 takes precedence over 2)."""
+
+
+def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
+    f = entry.get("file", {})
+    lines.append(f"== {f.get('path', entry.get('path'))}")
+    if entry.get("error"):
+        lines.append(f"   ERROR: {entry['error']}")
+        return
+    if f.get("stop_kind") == "corrupt":
+        lines.append(f"   DAMAGED: {f.get('stop_reason')}; {f.get('unreadable_bytes')} unreadable byte(s); "
+                     f"showing the readable part")
+    elif not f.get("complete"):
+        lines.append(f"   WARNING: incomplete log: {f.get('stop_reason')}; {f.get('unreadable_bytes')} "
+                     f"unreadable byte(s) at the end; showing the recovered part")
+    skipped = (f.get("bad_payloads") or 0) + (f.get("bad_records") or 0) + len(entry.get("bad_messages", []))
+    if skipped:
+        lines.append(f"   SKIPPED: {f.get('bad_payloads') or 0} undecodable message(s), "
+                     f"{f.get('bad_records') or 0} damaged record(s), {len(entry.get('bad_messages', []))} "
+                     f"malformed certificate(s)")
+        for why in (f.get("problems") or [])[:5]:
+            lines.append(f"     {why}")
+        for row in entry.get("bad_messages", [])[:5]:
+            lines.append(f"     certificate index {row['index']}: {row['problem']}")
+    for why in entry.get("integrity", []):
+        lines.append(f"   INTEGRITY: {why}")
+    for row in entry.get("unknown_verdicts", [])[:10]:
+        lines.append(f"   UNKNOWN VERDICT {row['verdict']!r} in window {row['index']} (not counted below)")
+    run = entry.get("run", {})
+    v = entry["verdicts"]
+    lat = entry["latency_us"]
+    lines += [
+        f"   mujoco {entry.get('versions', {}).get('mujoco', '?')}, margin {_fmt(run.get('margin'))}, "
+        f"epsilon {_fmt(run.get('epsilon'))}, pairs {_fmt(run.get('pairs'))}, "
+        f"predictor {_fmt(run.get('predictor'))}",
+        f"   windows {entry['windows']}: certified {v['certified']}, violation {v['violation']}, "
+        f"uncertain {v['uncertain']}",
+        f"   actions {entry['actions']}, blocked/replaced {entry['blocked_actions']}",
+        f"   us per certification: p50 {_fmt(lat['p50'], '.1f')}, p95 {_fmt(lat['p95'], '.1f')}, "
+        f"max {_fmt(lat['max'], '.1f')} (n={lat['n']})",
+        "   checker mix: " + (", ".join(f"{k} {n}" for k, n in sorted(entry["checker_mix"].items()))
+                              or "-"),
+    ]
+    rows = entry["violations"]
+    if rows:
+        lines.append(f"   {'sim time':>10} {'verdict':9} {'at t':>10}  {'bodies':28} {'geoms':32} "
+                     f"{'witness point (m)':32} {'distance':>10} {'clearance':>10}")
+        for r in rows:
+            lines.append(
+                f"   {_fmt(r['sim_time'], '.4f'):>10} {r['verdict']:9} {_fmt(r['time'], '.4f'):>10}  "
+                f"{' / '.join(map(str, r['bodies'])) or '-':28} {' / '.join(map(str, r['geoms'])) or '-':32} "
+                f"{_fmt_point(r['point']):32} {fmt_bound(r['distance']):>10} "
+                f"{fmt_bound(r['clearance']):>10}")
+    ver = entry.get("verify")
+    if ver:
+        if ver.get("error"):
+            lines.append(f"   verify: ERROR {ver['error']}")
+            return
+        lines.append(f"   verify ({ver['model_source']}): {ver['checked']} re-derived, "
+                     f"{len(ver['mismatches'])} mismatch(es), {ver['critical']} critical, "
+                     f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s); "
+                     f"{ver.get('unverifiable', 0)} unverifiable, {ver.get('pairs_differ', 0)} with a "
+                     f"different pair set; {ver.get('windows', '?')} window(s) in the log")
+        mc = ver.get("model_consistency")
+        if mc:
+            lines.append(f"     model: {mc['status']}: {mc['detail']}")
+        for mm in ver["mismatches"]:
+            lines.append(f"     window {mm['index']} t={_fmt(mm['sim_time'], '.4f')}: logged "
+                         f"{mm['logged']} -> recomputed {mm['recomputed']}"
+                         + ("  [CRITICAL]" if mm["critical"] else "")
+                         + (f"  ({mm['reason']})" if mm.get("reason") else ""))
+        findings = ver.get("findings", [])
+        for sev in (CRITICAL, UNVERIFIABLE):
+            rows_f = [x for x in findings if x["severity"] == sev]
+            for x in rows_f[:20]:
+                where = "log" if x["index"] is None else f"window {x['index']}"
+                lines.append(f"     [{sev.upper()}] {where}: {x['reason']}")
+            if len(rows_f) > 20:
+                lines.append(f"     ... and {len(rows_f) - 20} more {sev} finding(s)")
+        for note in ver.get("notes", []):
+            lines.append(f"     note: {note}")
 
 
 def _png(fig: Any) -> str:
@@ -449,4 +917,6 @@ def strip_series(result: dict[str, Any]) -> dict[str, Any]:
     return {**result, "logs": logs}
 
 
-__all__ = ["analyze", "combine", "verify", "render_text", "write_report", "strip_series", "VERDICTS"]
+__all__ = ["analyze", "combine", "verify", "verify_exit_code", "render_text", "write_report", "strip_series",
+           "certificate_problem", "split_certificates", "tolerance_problems", "make_tolerances",
+           "parse_pair_policy", "fmt_bound", "VERDICTS", "METHODS", "EXIT_MEANING"]

@@ -9,7 +9,15 @@ samples (joint speed x lever arm x half the sample spacing) means it does not.
 
 from __future__ import annotations
 
+import io
 import json
+import math
+import os
+import signal
+import tracemalloc
+import zipfile
+from contextlib import contextmanager
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -167,3 +175,130 @@ def test_bad_files_exit_2(tmp_path, capsys):
     assert code == 2 and "does not load" in err
     code, _, err = _run(capsys, ok, "--model", "arm", "--epsilon", "0")
     assert code == 2 and "--epsilon" in err
+
+
+# --------------------------------------------------------------------------- hostile .npz files (issue 15)
+
+
+@contextmanager
+def _bounded(seconds: int, mem_bytes: int):
+    """Hang guard (SIGALRM) and a tracemalloc bound on Python-side allocations."""
+    def boom(*_):
+        raise TimeoutError(f"took longer than {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, boom)
+    signal.alarm(seconds)
+    tracemalloc.start()
+    try:
+        yield
+        peak = tracemalloc.get_traced_memory()[1]
+        assert peak < mem_bytes, f"peak allocation {peak / 2**20:.1f} MiB"
+    finally:
+        tracemalloc.stop()
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _npy_member(shape, dtype="<f8", data=b"") -> bytes:
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": dtype, "fortran_order": False, "shape": shape})
+    return buf.getvalue() + data
+
+
+def _zip(path, members: dict[str, bytes], compression=zipfile.ZIP_STORED):
+    with zipfile.ZipFile(path, "w", compression=compression) as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+    return path
+
+
+def _hostile(tmp_path, kind):
+    good = Path(_per_plan_npz(tmp_path / "good.npz", ["clear"]))
+    raw = good.read_bytes()
+    p = tmp_path / f"{kind}.npz"
+    if kind == "truncated":
+        p.write_bytes(raw[: len(raw) // 2])
+    elif kind == "bad-crc":
+        data = bytearray(raw)
+        i = data.index(b"\x93NUMPY") + 130  # after the 128-byte .npy header: the first member's data
+        data[i] ^= 0xFF
+        p.write_bytes(bytes(data))
+    elif kind == "npy":
+        p = tmp_path / "plans.npy"
+        np.save(p, np.zeros((6, 3)))
+    elif kind == "structured":
+        np.savez(p, plan0_times=np.zeros(6, dtype=[("t", "f8")]), plan0_qpos=_yaw(0.1))
+    elif kind == "2e9-rows":
+        _zip(p, {"plan0_times.npy": _npy_member((2_000_000_000,)),
+                 "plan0_qpos.npy": _npy_member((2_000_000_000, 3))})
+    elif kind == "lying-header":
+        _zip(p, {"plan0_times.npy": _npy_member((6,), data=T.tobytes()[:40]),
+                 "plan0_qpos.npy": _npy_member((6, 3), data=_yaw(0.1).tobytes())})
+    elif kind == "20M-waypoints":  # consistent headers, deflated zeros: ~0.5 MB on disk, 640 MB of data
+        n = 20_000_000
+        with zipfile.ZipFile(p, "w", compression=zipfile.ZIP_DEFLATED) as z:
+            for name, shape in (("plan0_times.npy", (n,)), ("plan0_qpos.npy", (n, 3))):
+                with z.open(name, "w", force_zip64=True) as m:
+                    m.write(_npy_member(shape))
+                    block = bytes(1 << 22)
+                    left = math.prod(shape) * 8
+                    while left:
+                        m.write(block[:min(left, len(block))])
+                        left -= min(left, len(block))
+    elif kind == "huge-index":
+        np.savez(p, plan0_times=T, plan0_qpos=_yaw(0.1), plan999999999999_times=T,
+                 plan999999999999_qpos=_yaw(0.1))
+    elif kind == "leading-zero":
+        np.savez(p, plan0_times=T, plan0_qpos=_yaw(0.1), plan00_times=T, plan00_qpos=_yaw(0.2))
+    elif kind == "object":
+        _zip(p, {"plan0_times.npy": _npy_member((6,), dtype="|O"), "plan0_qpos.npy": _npy_member((6, 3))})
+    elif kind == "fifo":
+        p = tmp_path / "fifo.npz"
+        os.mkfifo(p)
+    return p
+
+
+HOSTILE = {
+    "truncated": "not a readable .npz file",
+    "bad-crc": "Bad CRC-32",
+    "npy": "is a single .npy array, not an .npz library",
+    "structured": "has dtype [('t', '<f8')]; expected integers or floats",
+    "2e9-rows": "header claims shape (2000000000,) (16000000000 bytes) but the member holds 0 bytes",
+    "lying-header": "header claims shape (6,) (48 bytes) but the member holds 40 bytes",
+    "20M-waypoints": "has 20000000 waypoints, more than the limit 100000 per plan",
+    "huge-index": "unknown key(s) ['plan999999999999_qpos', 'plan999999999999_times']",
+    "leading-zero": "unknown key(s) ['plan00_qpos', 'plan00_times']",
+    "object": "has dtype object; expected integers or floats",
+    "fifo": "not a regular file",
+}
+
+
+@pytest.mark.parametrize("kind", sorted(HOSTILE))
+def test_hostile_npz_one_clear_line_bounded(tmp_path, capsys, kind):
+    """Each crafted file: exit 2, one 'error:' line naming the problem, no traceback, within
+    20 s and 64 MiB of Python allocations (the 2e9-row header once allocated 44.7 GiB, the
+    20 M-waypoint file reached 23.6 GB RSS, the huge index hung)."""
+    p = _hostile(tmp_path, kind)
+    with _bounded(20, 64 * 2**20):
+        code, out, err = _run(capsys, p, "--model", "arm")
+    assert code == 2, (out, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    assert HOSTILE[kind] in lines[0] and "Traceback" not in err
+
+
+def test_waypoint_limits_are_the_documented_ones():
+    from monitor.commands import certify as cli
+
+    doc = cli.__doc__
+    limits = (cli.MAX_PLANS, cli.MAX_WAYPOINTS_PER_PLAN, cli.MAX_WAYPOINTS_TOTAL)
+    assert limits == (100_000, 100_000, 1_000_000)
+    assert "100 000 waypoints per" in doc and "1 000 000 waypoints in total" in doc
+
+
+def test_text_output_keeps_the_sign_of_an_infinite_clearance(tmp_path, capsys):
+    p = _per_plan_npz(tmp_path / "p.npz", ["post"])
+    code, out, _ = _run(capsys, p, "--model", "arm")
+    assert code == 1
+    row = next(line for line in out.splitlines() if line.strip().startswith("0 "))
+    assert " -inf " in row and " inf " not in row.replace("-inf", "")

@@ -233,8 +233,11 @@ def test_corrupt_record_and_payload(tmp_path, finished_log, capsys):
     c = read_log(pb)
     assert not c.complete and "claims" in c.stop_reason
     assert c.n_messages == len(ends) // 2 + 1
-    assert main(["review", str(pb)]) == 0
-    assert "incomplete log" in capsys.readouterr().out
+    # the file still ends with the closing magic: its writer finished it, so this is damage
+    # (bit rot), not a killed writer, and review must not exit 0 on the readable half (issue 15)
+    assert c.stop_kind == "corrupt"
+    assert main(["review", str(pb)]) == 2
+    assert "DAMAGED" in capsys.readouterr().out
 
 
 def test_recovery_speed_smoke(tmp_path):

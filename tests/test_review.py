@@ -290,3 +290,69 @@ def test_gated_rollout_log_verifies(tmp_path, capsys):
     assert main(["review", "--verify", "--json", str(path)]) == 0
     ver = json.loads(capsys.readouterr().out)["logs"][0]["verify"]
     assert ver["checked"] >= 15 and ver["mismatches"] == [] and ver["errors"] == []
+
+
+# --------------------------------------------------------------------------- issue 15: rendering, exit codes
+
+
+def test_unrenderable_entry_costs_only_itself(hand_log, capsys):
+    """A crafted entry (clearance "x", point "zz") gets an ERROR line; the genuine log's text stays."""
+    good = review.analyze(read_log(hand_log))
+    bad = review.analyze(read_log(hand_log))
+    bad["file"] = dict(bad["file"], path="crafted.mcap")
+    bad["violations"][0].update(clearance="x", point="zz")
+    bad["verdicts"] = "not a dict"
+    text = review.render_text({"logs": [bad, good], "total": None})
+    assert "ERROR: cannot render this log" in text and bad.get("render_error")
+    assert "windows 10: certified 7, violation 2, uncertain 1" in text
+
+
+def test_help_documents_exit_codes(capsys):
+    with pytest.raises(SystemExit):
+        main(["review", "--help"])
+    out = capsys.readouterr().out
+    for needle in ("0  every log was read whole", "1  CRITICAL", "2  INCOMPLETE", "--tolerances"):
+        assert needle in out
+
+
+def test_unknown_verdict_without_verify_exits_2(tmp_path, capsys):
+    model = mujoco.MjModel.from_xml_string(XML)
+    path = tmp_path / "v.mcap"
+    with MonitorLog(path, model=model, metadata={"pairs": "all"}, foxglove=False) as log:
+        log.write_window(0.0, _plan(model, 0.0, 1.0), _cert(0, "certified", 0.0))
+    rewrite_plan(path, tmp_path / "same.mcap", 0, lambda o: None)
+    data = (tmp_path / "same.mcap").read_bytes()
+    data = data.replace(b'"verdict":"certified"', b'"verdict":"Certified"', 1)  # same length: framing intact
+    (tmp_path / "cap.mcap").write_bytes(data)
+    assert main(["review", str(tmp_path / "cap.mcap")]) == 2
+    captured = capsys.readouterr()
+    assert "UNKNOWN VERDICT 'Certified' in window 0" in captured.out
+    assert "unknown verdict" in captured.err
+
+
+def test_bad_tolerances_option_is_one_line(hand_log, capsys):
+    assert main(["review", "--verify", "--tolerances", '{"abs_pad": -1}', str(hand_log)]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "error: --tolerances: tolerances: abs_pad=-1 is not a finite number >= 0"
+
+
+def test_fmt_bound_keeps_the_sign():
+    assert review.fmt_bound(-1e308) == "-inf" and review.fmt_bound(1e308) == "inf"
+    assert review.fmt_bound(None) == "unknown" and review.fmt_bound(0.0123) == "0.0123"
+
+
+def test_unexplained_noncritical_disagreement_exits_2(tmp_path, monkeypatch, capsys):
+    """Logged "uncertain" (no budget flag) that recomputes to "violation": not a safety flip, but
+    the window did not agree, so not exit 0; with the budget flag it is explained (exit 0)."""
+    pytest.importorskip("monitor.motion.plan")
+    monkeypatch.setattr(review, "_engine", lambda: (_FakeScene, _fake_certify))
+    model = mujoco.MjModel.from_xml_string(XML)
+    for exhausted, want in ((False, 2), (True, 0)):
+        path = tmp_path / f"u{exhausted}.mcap"
+        with MonitorLog(path, model=model, metadata={"pairs": "all"}, foxglove=False) as log:
+            c = _fake_certify(None, _plan(model, 0.0, 0.1), window=(0.0, 0.01)).to_dict()
+            assert c["verdict"] == "violation"
+            c.update(verdict="uncertain", stats={"budget_exhausted": exhausted})
+            log.write_window(0.0, _plan(model, 0.0, 0.1), c)
+        assert main(["review", "--verify", str(path)]) == want
+        assert "logged uncertain -> recomputed violation" in capsys.readouterr().out

@@ -17,7 +17,13 @@ model's ``qpos`` layout (``nq`` columns, quaternions (w, x, y, z)). Either
   ``mocap_quat`` (P, nmocap, 4);
 
 and in both layouts an optional ``names`` (P,) string array. Any other key is an
-error (a misspelt key is never silently ignored). Example::
+error (a misspelt key is never silently ignored). Arrays are numeric (integer or
+float; no structured, object or complex dtypes); ``names`` is a string array.
+
+Limits (checked from the array headers before any data is read, so a crafted file
+cannot make the command allocate): at most 100 000 plans, 100 000 waypoints per
+plan, 1 000 000 waypoints in total, 256 MiB of array data in total; plan indices
+have at most 6 digits and no leading zeros. Example::
 
     np.savez("plans.npz", times=np.linspace(0, 1, 11), qpos=qpos_PKn)
 
@@ -38,8 +44,17 @@ from typing import Any
 
 import numpy as np
 
-_PER_PLAN = re.compile(r"^plan(\d+)_(times|qpos|mocap_pos|mocap_quat)$")
+_PER_PLAN = re.compile(r"^plan(0|[1-9]\d{0,5})_(times|qpos|mocap_pos|mocap_quat)$")
 _STACKED = ("times", "qpos", "mocap_pos", "mocap_quat")
+
+MAX_PLANS = 100_000
+"""Most plans in one ``.npz`` library."""
+MAX_WAYPOINTS_PER_PLAN = 100_000
+"""Most waypoints (rows of times/qpos) in one plan."""
+MAX_WAYPOINTS_TOTAL = 1_000_000
+"""Most waypoints over all plans of one library (a 20 M-waypoint file is refused up front)."""
+MAX_NPZ_DATA_BYTES = 256 * 1024 * 1024
+"""Most array data (bytes, as the headers declare it) read from one ``.npz``."""
 
 
 def add_parser(p: argparse.ArgumentParser) -> None:
@@ -88,8 +103,111 @@ def resolve_model_path(spec: str) -> Path:
     raise InvalidInputError(f"model {spec!r}: no such MJCF file or shipped scene")
 
 
+def _read_npz(path: str | Path) -> dict[str, np.ndarray]:
+    """Arrays of an ``.npz`` read member by member with every header checked before its data.
+
+    Raises:
+        InvalidInputError: not a regular file, an ``.npy`` instead of an ``.npz``, a damaged
+            zip (truncated, bad CRC), a member that is not an ``.npy`` array, a non-numeric
+            dtype, a header whose size disagrees with the member, or data beyond the limits.
+    """
+    import zipfile
+
+    from monitor.errors import InvalidInputError
+
+    p = Path(path)
+    if not p.is_file():
+        raise InvalidInputError(f"{path}: no such file (or not a regular file)")
+    with open(p, "rb") as f:
+        head = f.read(6)
+    if head == b"\x93NUMPY":
+        raise InvalidInputError(f"{path}: is a single .npy array, not an .npz library (save the plans with "
+                                f"np.savez(..., times=..., qpos=...))")
+    arrays: dict[str, np.ndarray] = {}
+    try:
+        with zipfile.ZipFile(p) as z:
+            members = z.infolist()
+            if len(members) > 4 * MAX_PLANS + 1:
+                raise InvalidInputError(f"{path}: {len(members)} arrays, more than the limit "
+                                        f"({4 * MAX_PLANS + 1})")
+            headers = [_npz_header(path, z, info) for info in members]  # pass 1: headers only
+            _check_sizes(path, headers)
+            for info, (key, shape, fortran, dtype, offset) in zip(members, headers):  # pass 2: data
+                nbytes = info.file_size - offset
+                with z.open(info) as m:
+                    m.read(offset)
+                    data = m.read(nbytes)
+                    if len(data) != nbytes or m.read(1):
+                        raise InvalidInputError(f"{path}: {key!r} is truncated")
+                order = "F" if fortran else "C"
+                arrays[key] = np.frombuffer(data, dtype=dtype).reshape(shape, order=order).copy()
+    except InvalidInputError:
+        raise
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, ValueError, EOFError, KeyError,
+            NotImplementedError, RuntimeError) as exc:  # RuntimeError: encrypted members
+        raise InvalidInputError(f"{path}: not a readable .npz file ({type(exc).__name__}: "
+                                f"{str(exc)[:200]})") from exc
+    return arrays
+
+
+def _npz_header(path: Any, z: Any, info: Any) -> tuple[str, tuple[int, ...], bool, np.dtype, int]:
+    """(key, shape, fortran order, dtype, data offset) of one ``.npz`` member, from its header only."""
+    from monitor.errors import InvalidInputError
+
+    if not info.filename.endswith(".npy"):
+        raise InvalidInputError(f"{path}: member {info.filename[:60]!r} is not an .npy array")
+    key = info.filename[:-4]
+    with z.open(info) as m:
+        version = np.lib.format.read_magic(m)
+        if version == (1, 0):
+            shape, fortran, dtype = np.lib.format.read_array_header_1_0(m)
+        elif version == (2, 0):
+            shape, fortran, dtype = np.lib.format.read_array_header_2_0(m)
+        else:
+            raise InvalidInputError(f"{path}: {key[:60]!r} uses .npy format {version}")
+        offset = m.tell()
+    want = "US" if key == "names" else "fiu"
+    odd = dtype.fields is not None or dtype.subdtype is not None
+    if odd or dtype.kind not in want or dtype.itemsize > 4096:
+        raise InvalidInputError(f"{path}: {key[:60]!r} has dtype {dtype}; expected "
+                                f"{'strings' if key == 'names' else 'integers or floats'}")
+    nbytes = math.prod(int(n) for n in shape) * dtype.itemsize
+    if nbytes != info.file_size - offset:
+        raise InvalidInputError(f"{path}: {key[:60]!r} header claims shape {shape} ({nbytes} bytes) but the "
+                                f"member holds {info.file_size - offset} bytes")
+    return key, tuple(int(n) for n in shape), bool(fortran), dtype, offset
+
+
+def _check_sizes(path: Any, headers: list[tuple[str, tuple[int, ...], bool, np.dtype, int]]) -> None:
+    """Waypoint and byte limits from the headers alone (before any array data is read)."""
+    from monitor.errors import InvalidInputError
+
+    total_bytes = total_waypoints = 0
+    for key, shape, _, dtype, _ in headers:
+        total_bytes += math.prod(shape) * dtype.itemsize
+        kind = key.rsplit("_", 1)[-1] if key.startswith("plan") else key
+        if kind not in ("times", "qpos"):
+            continue
+        lead = shape[:-1] if kind == "qpos" else shape  # (..., K) waypoints
+        per_plan = lead[-1] if lead else 1
+        if per_plan > MAX_WAYPOINTS_PER_PLAN:
+            raise InvalidInputError(f"{path}: {key!r} has {per_plan} waypoints, more than the limit "
+                                    f"{MAX_WAYPOINTS_PER_PLAN} per plan")
+        if kind == "times":
+            total_waypoints += math.prod(lead) if key.startswith("plan") or len(shape) > 1 else 0
+        if math.prod(lead) > MAX_WAYPOINTS_TOTAL:
+            raise InvalidInputError(f"{path}: {key!r} holds {math.prod(lead)} waypoints, more than the limit "
+                                    f"{MAX_WAYPOINTS_TOTAL} in total")
+    if total_waypoints > MAX_WAYPOINTS_TOTAL:
+        raise InvalidInputError(f"{path}: {total_waypoints} waypoints in total, more than the limit "
+                                f"{MAX_WAYPOINTS_TOTAL}")
+    if total_bytes > MAX_NPZ_DATA_BYTES:
+        raise InvalidInputError(f"{path}: the arrays hold {total_bytes} bytes, more than the limit "
+                                f"{MAX_NPZ_DATA_BYTES}")
+
+
 def load_plan_arrays(path: str | Path) -> list[dict[str, Any]]:
-    """Read the plans of an ``.npz`` library (layout in the module docstring).
+    """Read the plans of an ``.npz`` library (layout and limits in the module docstring).
 
     Args:
         path: the ``.npz`` file.
@@ -99,23 +217,21 @@ def load_plan_arrays(path: str | Path) -> list[dict[str, Any]]:
         ``mocap_pos`` ((nmocap, 3) or None), ``mocap_quat`` ((nmocap, 4) or None).
 
     Raises:
-        InvalidInputError: unreadable file, both or neither layout, a gap in the
-            plan numbering, unknown keys, or inconsistent stacked shapes.
+        InvalidInputError: unreadable or damaged file, both or neither layout, a gap in
+            the plan numbering, unknown keys, inconsistent stacked shapes, non-numeric
+            arrays, or more plans/waypoints/bytes than the limits.
     """
     from monitor.errors import InvalidInputError
 
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: np.asarray(z[k]) for k in z.files}
-    except (OSError, ValueError, EOFError) as exc:
-        raise InvalidInputError(f"{path}: not a readable .npz file ({exc})") from exc
+    arrays = _read_npz(path)
     names = arrays.pop("names", None)
     per = {k: v for k, v in arrays.items() if _PER_PLAN.match(k)}
     stacked = {k: v for k, v in arrays.items() if k in _STACKED}
     unknown = sorted(set(arrays) - set(per) - set(stacked))
     if unknown:
-        raise InvalidInputError(f"{path}: unknown key(s) {unknown}; expected plan<i>_times/plan<i>_qpos "
-                                f"(+ _mocap_pos/_mocap_quat), or stacked times/qpos, and optional names")
+        raise InvalidInputError(f"{path}: unknown key(s) {[k[:60] for k in unknown[:5]]}; expected "
+                                f"plan<i>_times/plan<i>_qpos (+ _mocap_pos/_mocap_quat; i < {MAX_PLANS}, no "
+                                f"leading zeros), or stacked times/qpos, and optional names")
     if per and stacked:
         raise InvalidInputError(f"{path}: mixes per-plan keys ({sorted(per)[0]}, ...) and stacked keys "
                                 f"({sorted(stacked)}); use one layout")
@@ -125,6 +241,18 @@ def load_plan_arrays(path: str | Path) -> list[dict[str, Any]]:
         plans = _stacked(path, stacked)
     else:
         raise InvalidInputError(f"{path}: no plans (expected plan0_times/plan0_qpos or stacked times/qpos)")
+    if len(plans) > MAX_PLANS:
+        raise InvalidInputError(f"{path}: {len(plans)} plans, more than the limit {MAX_PLANS}")
+    total = 0
+    for p in plans:
+        k = int(np.shape(p["times"])[0]) if np.ndim(p["times"]) else 1
+        if k > MAX_WAYPOINTS_PER_PLAN:
+            raise InvalidInputError(f"{path}: {p['name']} has {k} waypoints, more than the limit "
+                                    f"{MAX_WAYPOINTS_PER_PLAN} per plan")
+        total += k
+    if total > MAX_WAYPOINTS_TOTAL:
+        raise InvalidInputError(f"{path}: {total} waypoints in total, more than the limit "
+                                f"{MAX_WAYPOINTS_TOTAL}")
     if names is not None:
         names = np.atleast_1d(names)
         if names.shape != (len(plans),) or names.dtype.kind not in "US":
@@ -143,7 +271,10 @@ def _per_plan(path: Any, per: dict[str, np.ndarray]) -> list[dict[str, Any]]:
         m = _PER_PLAN.match(k)
         by_index.setdefault(int(m.group(1)), {})[m.group(2)] = v
     n = max(by_index) + 1
-    missing = [i for i in range(n) if i not in by_index]
+    if n > len(by_index):  # a gap: found without walking a range as long as the largest index
+        missing = [i for i in range(len(by_index) + 1) if i not in by_index]
+    else:
+        missing = []
     if missing:
         raise InvalidInputError(f"{path}: plan numbering has gaps: no plan{missing[0]}_* keys "
                                 f"(plans must be numbered 0..{n - 1})")
@@ -248,7 +379,7 @@ def _mix(cert: Any) -> str:
 def _line(i: int, name: str, cert: Any, us: float) -> str:
     w = cert.witness
     wit = "-" if w is None else f"t={w.time:.4f} {w.geoms[0]}/{w.geoms[1]} d={w.distance:.3g}"
-    clr = f"{cert.clearance:.4g}" if math.isfinite(cert.clearance) else "inf"
+    clr = f"{cert.clearance:.4g}"  # keeps the sign: "-inf" when no lower bound is known
     return (f"{i:>4} {name[:16]:16} [{cert.window[0]:.4f}, {cert.window[1]:.4f}] {cert.verdict:10} "
             f"{clr:>10} {us / 1e3:9.1f}  {_mix(cert):28} {wit}")
 
@@ -281,6 +412,10 @@ def run(args: argparse.Namespace) -> int:
         wall = time.perf_counter() - t_start
     except (MonitorError, OSError) as exc:  # includes DependencyNotInstalled (no Ray)
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"error: {args.plans}: out of memory while certifying (see the limits in 'certify --help')",
+              file=sys.stderr)
         return 2
 
     if args.log:
@@ -319,4 +454,5 @@ def _write_log(args: argparse.Namespace, model: Any, model_path: Path, plans: li
             log.write_window(max(float(plan.times[0]), 0.0), plan, cert)
 
 
-__all__ = ["add_parser", "run", "load_plan_arrays", "build_plan", "certify_task", "resolve_model_path"]
+__all__ = ["add_parser", "run", "load_plan_arrays", "build_plan", "certify_task", "resolve_model_path",
+           "MAX_PLANS", "MAX_WAYPOINTS_PER_PLAN", "MAX_WAYPOINTS_TOTAL", "MAX_NPZ_DATA_BYTES"]

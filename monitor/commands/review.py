@@ -1,9 +1,22 @@
 """``python -m monitor review LOG.mcap [LOG2.mcap ...]``: summarise, re-verify and report logs.
 
-Exit codes: 0 fine; 1 ``--verify`` found a window whose verdict flips between
-certified and not certified; 2 an input is unreadable (missing, not MCAP, no
-certificates recovered) or the verification could not run. Truncated logs (a
-killed writer) are reviewed from their recovered part with a warning, exit 0.
+Exit codes (1 takes precedence over 2, 2 over 0):
+
+  0  every log was read whole (a killed writer's cut tail excepted), nothing was
+     skipped, and with --verify every window was re-derived from the attached
+     model and the logged plan and agreed with every claim in the log;
+  1  CRITICAL: --verify found a forged or wrong claim (verdict flip between certified
+     and not certified, a certificate pair set or window that differs from the model
+     and the plan, a duplicated window index, an unknown verdict/method, an invalid
+     margin/epsilon/tolerance, model.xml and model.mjb that differ, ...);
+  2  INCOMPLETE: an input is unreadable (missing, not MCAP, no certificate recovered),
+     damaged (a corrupt record, a file closed by its writer that cannot be read to its
+     footer), bad messages were skipped, an unknown verdict was seen without --verify,
+     or with --verify some window could not be re-verified (no plan, an error, --limit,
+     no model.mjb to cross-check model.xml against, ...).
+
+Truncated logs (a killed writer: the file ends inside a record and has no closing
+magic) are reviewed from their recovered part with a warning and do not change the code.
 
 A LOG argument may be a directory: its ``*.mcap`` files are reviewed (sorted).
 ``--ray`` re-verifies the logs in parallel, one Ray task per log
@@ -21,13 +34,25 @@ from typing import Any
 
 def add_parser(p: argparse.ArgumentParser) -> None:
     """Add the review options to the subcommand parser ``p``."""
+    import re
+
+    p.description = re.sub(r":\w+:`~?([^`]+)`", r"\1", __doc__).replace("``", "'")  # no raw reST
+    p.formatter_class = argparse.RawDescriptionHelpFormatter
     p.add_argument("logs", nargs="+", metavar="LOG.mcap", help="monitor MCAP log(s)")
     p.add_argument("--verify", action="store_true",
                    help="recompute every certificate from the attached model and logged plan")
     p.add_argument("--model-source", choices=("auto", "xml", "mjb"), default="auto",
                    help="model attachment used by --verify "
-                        "(auto: exact MJB if same MuJoCo version, else XML)")
-    p.add_argument("--limit", type=int, default=None, help="--verify only the first N windows of each log")
+                        "(auto: the exact MJB if it loads in this MuJoCo, else the XML; both are "
+                        "cross-checked when both load)")
+    p.add_argument("--limit", type=int, default=None,
+                   help="--verify only the first N windows of each log (the rest are unverified: exit 2)")
+    p.add_argument("--expect-pairs", choices=("mujoco", "all"), default=None,
+                   help="--verify requires this pair policy (a log claiming another one, e.g. a short "
+                        "explicit list, is critical); default: the logged policy, reported")
+    p.add_argument("--tolerances", metavar="JSON", default=None,
+                   help="tolerance fields for --verify, e.g. '{\"abs_pad\": 1e-10}' (default: the library's; "
+                        "logged tolerances are only compared, never used)")
     p.add_argument("--ray", action="store_true",
                    help="re-verify the logs in parallel as Ray tasks (implies --verify; uses a running "
                         "ray.init(), else starts a local instance; needs the 'ray' extra)")
@@ -38,46 +63,87 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", dest="progress", action="store_false", help="never show progress bars")
 
 
+def _read_code(entry: dict[str, Any]) -> int:
+    """2 when anything was damaged or skipped while reading, or an unknown verdict was seen.
+
+    Sets ``entry["problem"]`` (one line for stderr) when it returns 2.
+    """
+    f = entry.get("file", {})
+    why = []
+    if f.get("stop_kind") == "corrupt":
+        why.append(f"damaged file ({f.get('stop_reason')})")
+    n_skipped = ((f.get("bad_payloads") or 0) + (f.get("bad_records") or 0)
+                 + len(entry.get("bad_messages", [])))
+    if n_skipped:
+        why.append(f"{n_skipped} bad message(s)/record(s) skipped")
+    if entry.get("unknown_verdicts"):
+        why.append(f"{len(entry['unknown_verdicts'])} certificate(s) with an unknown verdict")
+    if entry.get("integrity"):
+        why.append(entry["integrity"][0])
+    if why:
+        entry["problem"] = f"{f.get('path')}: " + "; ".join(why)
+        return 2
+    return 0
+
+
 def _review_one(path: str, args: argparse.Namespace,
                 verified: dict[str, Any] | None = None) -> tuple[dict[str, Any], int]:
     from monitor.errors import LogFormatError, MonitorError
     from monitor.log.reader import read_log
-    from monitor.review import analyze, verify
+    from monitor.review import analyze, verify, verify_exit_code
 
     try:
         contents = read_log(path, progress=args.progress)
     except (LogFormatError, OSError) as exc:
         return {"path": path, "file": {"path": path}, "error": str(exc)}, 2
     entry = analyze(contents)
-    code = 0
-    if entry["windows"] == 0:
+    code = _read_code(entry)
+    if entry["windows"] == 0 and not entry["unknown_verdicts"] and not entry["bad_messages"]:
         why = contents.stop_reason or "no /monitor/certificate messages"
         entry["error"] = (f"{path}: no certificate could be recovered ({contents.n_messages} message(s) "
                           f"read, {contents.unreadable_bytes} unreadable byte(s); {why})")
         return entry, 2
     if verified is not None:  # computed in parallel (--ray): same dict as verify(), or {"error": ...}
         entry["verify"] = verified
-        code = 2 if verified.get("error") else (1 if verified["critical"] else 0)
     elif args.verify:
         try:
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
-                                     limit=args.limit)
-            if entry["verify"]["critical"]:
-                code = 1
+                                     limit=args.limit, tolerances=getattr(args, "tolerance_values", None),
+                                     expect_pairs=getattr(args, "expect_pairs", None))
         except ImportError as exc:
             entry["verify"] = {"error": f"verification needs the certification engine: {exc}"}
-            code = 2
         except (MonitorError, ValueError) as exc:
             entry["verify"] = {"error": str(exc)}
-            code = 2
+    if "verify" in entry:
+        code = _worst(code, verify_exit_code(entry["verify"]))
     return entry, code
 
 
+def _worst(*codes: int) -> int:
+    """Combine exit codes: 1 (critical) over 2 (incomplete) over 0."""
+    return 1 if 1 in codes else (2 if 2 in codes else 0)
+
+
 def run(args: argparse.Namespace) -> int:
-    """Run the review; returns the exit code (0 ok, 1 verify mismatch, 2 unreadable input)."""
+    """Run the review; returns the exit code (module docstring: 0 ok, 1 critical, 2 incomplete)."""
     from monitor.distributed import expand_logs
     from monitor.review import combine, render_text, strip_series, write_report
 
+    args.tolerance_values = None
+    if getattr(args, "tolerances", None):
+        from monitor.errors import InvalidInputError
+        from monitor.log.reader import loads_strict
+        from monitor.review import make_tolerances
+
+        try:
+            args.tolerance_values = loads_strict(args.tolerances)
+            make_tolerances(args.tolerance_values)
+        except (ValueError, InvalidInputError) as exc:
+            print(f"error: --tolerances: {exc}", file=sys.stderr)
+            return 2
+    if (args.tolerance_values or getattr(args, "expect_pairs", None)) and getattr(args, "ray", False):
+        print("error: --tolerances and --expect-pairs are not supported with --ray yet", file=sys.stderr)
+        return 2
     paths = expand_logs(args.logs)
     if not paths:
         print(f"error: no .mcap logs in {' '.join(map(str, args.logs))}", file=sys.stderr)
@@ -108,19 +174,32 @@ def run(args: argparse.Namespace) -> int:
         entries.append(entry)
         codes.append(code)
     ok = [e for e in entries if not e.get("error")]
-    result = {"logs": entries, "total": combine(ok) if ok else None, "exit_code": max(codes)}
+    try:
+        total = combine(ok) if ok else None
+    except Exception as exc:  # noqa: BLE001 - totals are a convenience, never a traceback
+        total, codes = None, codes + [2]
+        print(f"error: cannot total the logs: {type(exc).__name__}: {exc}", file=sys.stderr)
+    result = {"logs": entries, "total": total, "exit_code": _worst(*codes)}
     if args.report:
         try:
             n = write_report(result, args.report)
             print(f"wrote {args.report} ({n} plots)", file=sys.stderr)
-        except OSError as exc:
-            print(f"error: cannot write report {args.report}: {exc}", file=sys.stderr)
+        except Exception as exc:  # noqa: BLE001 - OSError, or an entry the report cannot draw
+            print(f"error: cannot write report {args.report}: {type(exc).__name__}: {exc}", file=sys.stderr)
             codes.append(2)
+            result["exit_code"] = _worst(*codes)
     if args.json:
         print(json.dumps(strip_series(result), indent=1, default=str))
     else:
-        print(render_text(result))
+        text = render_text(result)
+        if any(e.get("render_error") for e in entries):
+            codes.append(2)
+            result["exit_code"] = _worst(*codes)
+            text = render_text(result)
+        print(text)
     for e in entries:
         if e.get("error"):
             print(f"error: {e['error']}", file=sys.stderr)
-    return max(codes)
+        elif e.get("problem"):
+            print(f"error: {e['problem']}", file=sys.stderr)
+    return _worst(*codes)
