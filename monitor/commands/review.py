@@ -31,6 +31,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ray", action="store_true",
                    help="re-verify the logs in parallel as Ray tasks (implies --verify; uses a running "
                         "ray.init(), else starts a local instance; needs the 'ray' extra)")
+    p.add_argument("--reindex", action="store_true",
+                   help="first rewrite each LOG in place as a chunked, indexed MCAP (finalises the "
+                        "journal a killed writer left; a record cut by the kill is dropped), then review it")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON instead of text")
     p.add_argument("--report", metavar="OUT.html", default=None, help="write a self-contained HTML report")
     p.add_argument("--progress", dest="progress", action="store_true", default=None,
@@ -73,6 +76,25 @@ def _review_one(path: str, args: argparse.Namespace,
     return entry, code
 
 
+def _reindex(paths: list[str]) -> list[int]:
+    """``--reindex``: finalise every log in place; a message per file on stderr; exit codes."""
+    from monitor.errors import LogFormatError
+    from monitor.log.writer import finalise_log
+
+    codes = []
+    for path in paths:
+        try:
+            r = finalise_log(path)
+        except (LogFormatError, OSError) as exc:
+            print(f"error: cannot reindex {path}: {exc}", file=sys.stderr)
+            codes.append(2)
+            continue
+        lost = "" if r.source_complete else f"; {r.dropped_bytes} trailing byte(s) of a cut record dropped"
+        print(f"reindexed {path}: {r.windows} window(s), {r.messages} message(s){lost}", file=sys.stderr)
+        codes.append(0)
+    return codes
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the review; returns the exit code (0 ok, 1 verify mismatch, 2 unreadable input)."""
     from monitor.distributed import expand_logs
@@ -82,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
     if not paths:
         print(f"error: no .mcap logs in {' '.join(map(str, args.logs))}", file=sys.stderr)
         return 2
+    reindex_codes = _reindex(paths) if getattr(args, "reindex", False) else []
     verified: dict[str, Any] = {}
     if getattr(args, "ray", False):
         from monitor.distributed import verify_logs
@@ -107,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
                            "error": f"{path}: unexpected {type(exc).__name__}: {exc}"}, 2
         entries.append(entry)
         codes.append(code)
+    codes.extend(reindex_codes)
     ok = [e for e in entries if not e.get("error")]
     result = {"logs": entries, "total": combine(ok) if ok else None, "exit_code": max(codes)}
     if args.report:
