@@ -460,7 +460,8 @@ class MonitorLog:
 
     def write_window(self, sim_time: float, plan: Any, certificate: Any, proposed_action: Any = None,
                      applied_action: Any = None, replaced: bool = False,
-                     wall_time: float | None = None, episode: int | None = None) -> int:
+                     wall_time: float | None = None, episode: int | None = None,
+                     reason: str | None = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -475,6 +476,8 @@ class MonitorLog:
                 ``log_time`` is this in ns, raised to 1 ns past the previous window's if needed.
             episode: episode index (>= the current one); default: the current episode,
                 or the next one when ``sim_time`` is earlier than the previous window's.
+            reason: why the action was replaced (e.g. ``"braking tail uncertain"``); default:
+                the window's verdict when it is not certified, else a generic text.
 
         Returns:
             The window index in this log.
@@ -522,13 +525,17 @@ class MonitorLog:
                 "margin": cert.get("margin"), "earliest_time": cert.get("earliest_time"),
                 "clearance": cert.get("clearance"),
                 "witness": cert.get("witness"), "pairs": bad, "replaced": bool(replaced)}))
+        if replaced and reason is None:
+            reason = (cert["verdict"] if cert["verdict"] != "certified"
+                      else "replaced although the window is certified (e.g. its braking tail is not)")
         if proposed_action is not None or applied_action is not None or replaced:
             self._put(topics.ACTION, log_ns, sim_ns, _dumps({
+                "reason": str(reason) if replaced else None,
                 **head, "proposed": None if proposed_action is None else np.ravel(proposed_action),
                 "applied": None if applied_action is None else np.ravel(applied_action),
                 "replaced": bool(replaced)}))
         if cert["verdict"] != "certified" or replaced:
-            level, text = log_line(k, self._episode, t, cert, bool(replaced))
+            level, text = log_line(k, self._episode, t, cert, reason if replaced else None)
             self._put(topics.LOG, log_ns, sim_ns, _dumps({
                 "timestamp": {"sec": log_ns // 1_000_000_000, "nsec": log_ns % 1_000_000_000},
                 "level": level, "message": text, "name": "monitor", "file": "", "line": 0, **head}))
@@ -590,8 +597,11 @@ def _fmt(x: Any, unit: str = "") -> str:
 
 
 def log_line(index: int, episode: int, sim_time: float, cert: dict[str, Any],
-             replaced: bool) -> tuple[int, str]:
-    """(foxglove.Log level, one-line message) for a non-certified window or a replaced action."""
+             replaced_reason: str | None) -> tuple[int, str]:
+    """(foxglove.Log level, one-line message) for a non-certified window or a replaced action.
+
+    ``replaced_reason`` is None when the action was not replaced.
+    """
     where = f"window {index} (episode {episode}, t={sim_time:.4f} s)"
     verdict = cert.get("verdict")
     wit = cert.get("witness")
@@ -607,8 +617,8 @@ def log_line(index: int, episode: int, sim_time: float, cert: dict[str, Any],
         level = LOG_LEVEL_ERROR if verdict == "violation" else LOG_LEVEL_WARNING
     else:
         text, level = f"{where}: certified", LOG_LEVEL_WARNING
-    if replaced:
-        text += f"; action replaced (reason: {verdict})"
+    if replaced_reason is not None:
+        text += f"; action replaced ({replaced_reason})"
     return level, text
 
 
