@@ -244,7 +244,7 @@ def _resolve_source(source: Any) -> tuple[str, Any, str]:
 
 def _register_envs(env_id: str) -> None:
     if env_id.startswith("monitor/"):
-        import envs  # noqa: F401  (registers monitor/*)
+        import monitor.envs  # noqa: F401  (registers monitor/*)
 
 
 def _is_env_id(s: str) -> bool:

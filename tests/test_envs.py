@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import envs  # noqa: F401  (registers the ids)
+import monitor.envs  # noqa: F401  (registers the ids)
 from monitor._paths import scene_path
 
 OWN_ENVS = ["monitor/Arm-v0", "monitor/Tunnel-v0"]
@@ -18,7 +18,7 @@ OWN_ENVS = ["monitor/Arm-v0", "monitor/Tunnel-v0"]
 
 def _agv_available() -> bool:
     try:
-        import envs.agv_v0  # noqa: F401
+        import monitor.envs.agv_v0  # noqa: F401
 
         scene_path("agv_trays")
     except (ImportError, FileNotFoundError):

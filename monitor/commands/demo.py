@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; returns 0 on success."""
     import gymnasium as gym
 
-    import envs  # noqa: F401  (registers monitor/Arm-v0)
+    import monitor.envs  # noqa: F401  (registers monitor/Arm-v0)
     from monitor.gym_gate import SafetyGate
 
     t_start = time.perf_counter()
