@@ -71,6 +71,7 @@ def test_wheel_layout_and_dependencies(wheel_build):
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith((".dist-info", ".data"))}
     assert tops == {"monitor"}  # no top-level envs/ or models/
     assert "monitor/envs/__init__.py" in names and "monitor/envs/arm_v0.py" in names
+    assert "monitor/log/foxglove_layout.json" in names
     for schema in (REPO / "monitor" / "log" / "schemas").glob("*.json"):
         assert f"monitor/log/schemas/{schema.name}" in names
     for d in (REPO / "models").iterdir():
