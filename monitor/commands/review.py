@@ -134,9 +134,14 @@ def run(args: argparse.Namespace) -> int:
     ok = [e for e in entries if not e.get("error")]
     result = {"logs": entries, "total": combine(ok) if ok else None, "exit_code": max(codes)}
     if args.report:
+        from monitor.errors import DependencyNotInstalled
+
         try:
             n = write_report(result, args.report)
             print(f"wrote {args.report} ({n} plots)", file=sys.stderr)
+        except DependencyNotInstalled as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            codes.append(2)
         except OSError as exc:
             print(f"error: cannot write report {args.report}: {exc}", file=sys.stderr)
             codes.append(2)
