@@ -413,7 +413,7 @@ def _plots(entry: dict[str, Any]) -> list[tuple[str, str]]:
     colors = {"certified": "tab:green", "uncertain": "tab:orange", "violation": "tab:red"}
     blocked = entry.get("blocked", [])
     reasons = sorted({str(b.get("reason") or "replaced") for b in blocked})
-    fig, axes = plt.subplots(2, 1, figsize=(13, 2.2 + 0.35 * max(len(reasons), 1) + 1.2), sharex=True,
+    fig, axes = plt.subplots(2, 1, figsize=(17, 2.2 + 0.35 * max(len(reasons), 1) + 1.2), sharex=True,
                              gridspec_kw={"height_ratios": [3, max(len(reasons), 1) + 1]})
     ax = axes[0]
     for i, v in enumerate(VERDICTS):
@@ -506,7 +506,7 @@ _CSS = ("body{font-family:sans-serif;margin:1em 2em;max-width:none}"
         "table{border-collapse:collapse;margin:0.5em 0}"
         "td,th{border:1px solid #ccc;padding:2px 8px;font-size:90%;text-align:left}"
         "th{background:#f0f0f0}pre{background:#f6f6f6;padding:1em;overflow-x:auto}"
-        "img{max-width:100%;height:auto;display:block}.bad{color:#b00}"
+        "img{max-width:100%;height:auto;display:block}img.wide{width:100%}.bad{color:#b00}"
         ".grid{display:grid;grid-template-columns:repeat(auto-fit,minmax(560px,1fr));gap:1em}")
 
 
@@ -534,7 +534,7 @@ def write_report(result: dict[str, Any], path: str) -> int:
         if entry.get("verify"):
             parts.append("<h3>Re-verification (--verify)</h3>" + _verify_html(entry["verify"]))
         plots = _plots(entry)
-        parts.append(f"<h3>{esc(plots[0][0])}</h3><img alt='{esc(plots[0][0])}' "
+        parts.append(f"<h3>{esc(plots[0][0])}</h3><img class='wide' alt='{esc(plots[0][0])}' "
                      f"src='data:image/png;base64,{plots[0][1]}'/><div class='grid'>")
         for title, b64 in plots[1:]:
             parts.append(f"<div><h3>{esc(title)}</h3><img alt='{esc(title)}' "
