@@ -260,3 +260,21 @@ def test_finalise_is_idempotent_on_a_finished_log(tmp_path):
     assert res.source_complete and res.dropped_bytes == 0 and res.windows == 2 * len(VERDICTS)
     assert b.complete and b.certificates() == a.certificates() and b.run == a.run
     assert b.attachments == a.attachments
+
+
+def test_stl_assets_hold_the_compiled_mesh_exactly(tmp_path):
+    """Attached STL (written by trimesh) parsed with numpy: triangles equal the compiled mesh bit for bit."""
+    xml = ("<mujoco><asset><mesh name='w' vertex='0 0 0 .1 0 0 0 .1 0 0 0 .1 .07 .07 .07'/></asset><worldbody>"
+           "<body><geom type='mesh' mesh='w'/></body></worldbody></mujoco>")
+    model = mujoco.MjModel.from_xml_string(xml)
+    with MonitorLog(tmp_path / "m.mcap", model=model, foxglove=False):
+        pass
+    att = read_log(tmp_path / "m.mcap").attachments
+    (name,) = [k for k in att if k.startswith(topics.ASSET_PREFIX)]
+    blob = att[name]
+    (n,) = np.frombuffer(blob[80:84], "<u4")
+    rec = np.frombuffer(blob[84:], dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    assert len(rec) == n == model.mesh_facenum[0] and len(blob) == 84 + 50 * n
+    V = model.mesh_vert[: model.mesh_vertnum[0]]
+    F = model.mesh_face[: model.mesh_facenum[0]]
+    assert np.array_equal(rec["v"], V[F])

@@ -165,17 +165,16 @@ class ModelExport:
 
 
 def _stl_bytes(V: np.ndarray, F: np.ndarray) -> bytes:
-    """Binary STL of triangles F (n, 3) over vertices V (m, 3) (float32, exact for mesh_vert)."""
-    V = np.asarray(V, np.float32)
-    F = np.asarray(F, np.int64)
-    tri = V[F]  # (n, 3, 3)
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).astype(np.float64)
-    ln = np.linalg.norm(n, axis=1, keepdims=True)
-    n = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0).astype(np.float32)
-    rec = np.zeros(len(F), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-    rec["n"], rec["v"] = n, tri
-    header = b"monitor: compiled MuJoCo mesh".ljust(80, b" ")
-    return header + np.uint32(len(F)).tobytes() + rec.tobytes()
+    """Binary STL of triangles F (n, 3) over vertices V (m, 3), written by trimesh.
+
+    Binary STL stores float32 coordinates, so MuJoCo's float32 ``mesh_vert`` round-trips
+    exactly; ``process=False`` keeps every vertex and face as compiled (no merging).
+    """
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=np.asarray(V, np.float64), faces=np.asarray(F, np.int64), process=False,
+                           validate=False)
+    return mesh.export(file_type="stl")
 
 
 def _mesh_arrays(model: Any, i: int) -> tuple[np.ndarray, np.ndarray]:
