@@ -264,8 +264,8 @@ def test_finalise_is_idempotent_on_a_finished_log(tmp_path):
 
 def test_stl_assets_hold_the_compiled_mesh_exactly(tmp_path):
     """Attached STL (written by trimesh) parsed with numpy: triangles equal the compiled mesh bit for bit."""
-    xml = ("<mujoco><asset><mesh name='w' vertex='0 0 0 .1 0 0 0 .1 0 0 0 .1 .07 .07 .07'/></asset><worldbody>"
-           "<body><geom type='mesh' mesh='w'/></body></worldbody></mujoco>")
+    xml = ("<mujoco><asset><mesh name='w' vertex='0 0 0 .1 0 0 0 .1 0 0 0 .1 .07 .07 .07'/></asset>"
+           "<worldbody><body><geom type='mesh' mesh='w'/></body></worldbody></mujoco>")
     model = mujoco.MjModel.from_xml_string(xml)
     with MonitorLog(tmp_path / "m.mcap", model=model, foxglove=False):
         pass
