@@ -68,3 +68,11 @@ def test_rollouts_step_progress_on_stderr(capsys):
     assert "episode 0 (seed 3)" in err and "/6 [" in err and "gated rollouts" in err
     rollouts("tunnel", RandomPolicy(hold=5), episodes=1, steps=3, seeds=3, workers=1, progress=False)
     assert capsys.readouterr().err == ""
+
+
+def test_demo_progress_bar_on_stderr():
+    r = subprocess.run([sys.executable, "-m", "monitor", "demo", "--steps", "2", "--no-log", "--progress"],
+                       cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "gated steps" in r.stderr and "/2 [" in r.stderr
+    assert "gated steps" not in r.stdout and "monitor demo:" in r.stdout
