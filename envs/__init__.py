@@ -11,7 +11,7 @@ Importing this package registers (string entry points, one module per version):
 Example::
 
     import gymnasium as gym
-    import envs  # noqa: F401  (registers the ids)
+    import monitor.envs  # noqa: F401  (registers the ids)
     env = gym.make("monitor/Arm-v0")
 """
 
@@ -20,9 +20,9 @@ from __future__ import annotations
 import gymnasium
 
 _REGISTRY = {
-    "monitor/Arm-v0": dict(entry_point="envs.arm_v0:ArmEnv", max_episode_steps=500),
-    "monitor/Tunnel-v0": dict(entry_point="envs.tunnel_v0:TunnelEnv", max_episode_steps=100),
-    "monitor/AGV-v0": dict(entry_point="envs.agv_v0:AgvEnv", max_episode_steps=400),
+    "monitor/Arm-v0": dict(entry_point="monitor.envs.arm_v0:ArmEnv", max_episode_steps=500),
+    "monitor/Tunnel-v0": dict(entry_point="monitor.envs.tunnel_v0:TunnelEnv", max_episode_steps=100),
+    "monitor/AGV-v0": dict(entry_point="monitor.envs.agv_v0:AgvEnv", max_episode_steps=400),
 }
 
 

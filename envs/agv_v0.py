@@ -28,7 +28,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from envs.assets import scene
+from monitor.envs.assets import scene
 
 
 class AgvEnv(gymnasium.Env):

@@ -18,7 +18,7 @@ import numpy as np
 from gymnasium import spaces, utils
 from gymnasium.envs.mujoco.mujoco_env import MujocoEnv
 
-from envs.assets import scene
+from monitor.envs.assets import scene
 from monitor.gate import Rollout
 
 TIMESTEP = 0.002

@@ -232,7 +232,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
     verdicts = Counter({v: 0 for v in VERDICTS})
     mix: Counter = Counter()
     lat: list[float] = []
-    series = {"sim_time": [], "verdict": [], "clearance": [], "latency_us": [], "margin": []}
+    series = {"sim_time": [], "verdict": [], "clearance": [], "latency_us": [], "margin": [], "episode": [],
+              "index": []}
     rows = []
     for c in certs:
         v = c.get("verdict")
@@ -251,6 +252,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         series["clearance"].append(float(cl) if isinstance(cl, (int, float)) else None)
         series["latency_us"].append(us)
         series["margin"].append(c.get("margin"))
+        series["episode"].append(int(c.get("episode", 0)))
+        series["index"].append(int(c.get("index", len(series["index"]))))
         if v != "certified":
             rows.append(_violation_row(c))
     actions = [a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))]
@@ -281,7 +284,14 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         "checker_mix": dict(mix),
         "violations": rows,
         "series": series,
+        "blocked": _blocked_rows(actions),
     }
+
+
+def _blocked_rows(actions: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Replaced actions: index, episode, sim_time, reason (version-1 logs: reason None)."""
+    return [{"index": a.get("index"), "episode": a.get("episode", 0), "sim_time": a.get("sim_time"),
+             "reason": a.get("reason")} for a in actions if a.get("replaced")]
 
 
 def combine(summaries: list[dict[str, Any]]) -> dict[str, Any]:
@@ -818,55 +828,111 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
             lines.append(f"     note: {note}")
 
 
-def _png(fig: Any) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
-    import matplotlib.pyplot as plt
+def _pyplot() -> Any:
+    """matplotlib.pyplot with the Agg backend; DependencyNotInstalled names the extra when missing."""
+    try:
+        import matplotlib
+    except ImportError as exc:
+        from monitor.errors import DependencyNotInstalled
 
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
-
-
-def _plots(entry: dict[str, Any]) -> list[tuple[str, str]]:
-    import matplotlib
-
+        raise DependencyNotInstalled("the HTML report (--report) needs matplotlib: "
+                                     "pip install 'monitor[report]'") from exc
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+def _png(fig: Any) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
+    _pyplot().close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+WARMUP_WINDOWS = 1
+"""Windows at the start of a log whose latency is reported apart from the histogram: the
+first certification of a process compiles the numba kernels (seconds, not microseconds)."""
+
+
+def split_warmup(latency_us: list[float | None]) -> tuple[list[float], list[float]]:
+    """(warm-up latencies, the rest) in µs, dropping unknown values."""
+    head = [x for x in latency_us[:WARMUP_WINDOWS] if x is not None]
+    rest = [x for x in latency_us[WARMUP_WINDOWS:] if x is not None]
+    return head, rest
+
+
+def _x_axis(entry: dict[str, Any]) -> tuple[np.ndarray, str, list[int]]:
+    """The x values, label and episode starts: sim time for one episode, window index for several."""
     s = entry["series"]
-    t = np.asarray(s["sim_time"], float)
+    eps = s.get("episode") or [0] * len(s["sim_time"])
+    if len(set(eps)) > 1:
+        idx = np.asarray(s.get("index") or range(len(eps)), float)
+        starts = [int(idx[i]) for i in range(1, len(eps)) if eps[i] != eps[i - 1]]
+        return idx, "window index (dashed: episode starts)", starts
+    return np.asarray(s["sim_time"], float), "simulation time (s)", []
+
+
+def _plots(entry: dict[str, Any]) -> list[tuple[str, str]]:
+    plt = _pyplot()
+    s = entry["series"]
+    x, xlabel, starts = _x_axis(entry)
     out = []
     colors = {"certified": "tab:green", "uncertain": "tab:orange", "violation": "tab:red"}
-    fig, ax = plt.subplots(figsize=(8, 2.2))
+    blocked = entry.get("blocked", [])
+    reasons = sorted({str(b.get("reason") or "replaced") for b in blocked})
+    fig, axes = plt.subplots(2, 1, figsize=(17, 2.2 + 0.35 * max(len(reasons), 1) + 1.2), sharex=True,
+                             gridspec_kw={"height_ratios": [3, max(len(reasons), 1) + 1]})
+    ax = axes[0]
     for i, v in enumerate(VERDICTS):
-        sel = [j for j, x in enumerate(s["verdict"]) if x == v]
-        ax.scatter(t[sel], np.full(len(sel), i), s=8, color=colors[v], label=v)
+        sel = [j for j, y in enumerate(s["verdict"]) if y == v]
+        ax.scatter(x[sel], np.full(len(sel), i), s=8, color=colors[v], label=v)
     ax.set_yticks(range(3), VERDICTS)
-    ax.set_xlabel("simulation time (s)")
-    ax.set_title("verdict timeline")
-    out.append(("Verdict timeline", _png(fig)))
-    fig, ax = plt.subplots(figsize=(8, 3))
+    ax.set_title("verdict timeline and blocked actions")
+    ax = axes[1]
+    if blocked:
+        pos = {int(k): float(v) for k, v in zip(s.get("index") or [], x)}
+        bx = [pos.get(int(b["index"]), np.nan) if b.get("index") is not None else np.nan for b in blocked]
+        by = [reasons.index(str(b.get("reason") or "replaced")) for b in blocked]
+        ax.scatter(bx, by, s=10, marker="|", color="tab:red")
+        ax.set_yticks(range(len(reasons)), [r if len(r) <= 48 else r[:45] + "..." for r in reasons])
+    else:
+        ax.set_yticks([0], ["no blocked actions"])
+    ax.set_ylim(-0.7, max(len(reasons), 1) - 0.3)
+    ax.set_xlabel(xlabel)
+    for a in axes:
+        for st in starts:
+            a.axvline(st, color="grey", ls="--", lw=0.6)
+    out.append(("Verdict timeline and blocked actions (with the reason for each block)", _png(fig)))
+    fig, ax = plt.subplots(figsize=(13, 3))
     cl = np.array([np.nan if c is None else c for c in s["clearance"]], float)
-    cl[cl < -1e300] = np.nan
-    ax.plot(t, cl, ".-", ms=3, lw=0.8, label="certified clearance lower bound")
+    cl[cl < -1e300] = np.nan  # version-1 logs wrote unknown as -1e308
+    ax.plot(x, cl, ".-", ms=3, lw=0.8, label="certified clearance lower bound (gaps: unknown)")
     margins = [m for m in s["margin"] if isinstance(m, (int, float))]
     if margins:
         ax.axhline(float(np.max(margins)), color="tab:red", ls="--", lw=0.8, label="margin")
-    ax.set_xlabel("simulation time (s)")
+    for st in starts:
+        ax.axvline(st, color="grey", ls="--", lw=0.6)
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("clearance (m)")
     ax.legend(loc="best", fontsize=8)
     ax.set_title("clearance over time")
     out.append(("Clearance over time", _png(fig)))
-    fig, ax = plt.subplots(figsize=(8, 3))
-    lat = [x for x in s["latency_us"] if x is not None]
-    if lat:
-        ax.hist(lat, bins=min(50, max(5, len(lat) // 5)), color="tab:blue")
-    ax.set_xlabel("µs per certification")
+    fig, ax = plt.subplots(figsize=(13, 3))
+    head, lat = split_warmup(s["latency_us"])
+    lat_pos = [v for v in lat if v > 0]
+    if lat_pos:
+        lo, hi = min(lat_pos), max(lat_pos)
+        bins = np.geomspace(lo, hi * 1.0001, min(50, max(5, len(lat_pos) // 5)) + 1) if hi > lo else 5
+        ax.hist(lat_pos, bins=bins, color="tab:blue")
+        ax.set_xscale("log")
+    ax.set_xlabel("µs per certification (log scale)")
     ax.set_ylabel("windows")
-    ax.set_title("certification latency")
-    out.append(("Latency histogram", _png(fig)))
+    warm = f"; first window (JIT warm-up) {head[0] / 1e6:.3g} s, not shown" if head else ""
+    ax.set_title(f"certification latency, {len(lat_pos)} windows{warm}")
+    out.append(("Latency histogram (warm-up reported apart)", _png(fig)))
     mix = entry["checker_mix"]
-    fig, ax = plt.subplots(figsize=(6, 2.5))
+    fig, ax = plt.subplots(figsize=(8, 2.5))
     if mix:
         ax.barh(list(mix), list(mix.values()), color="tab:purple")
     ax.set_xlabel("pairs")
@@ -875,36 +941,89 @@ def _plots(entry: dict[str, Any]) -> list[tuple[str, str]]:
     return out
 
 
+def _table(header: list[str], rows: list[list[Any]], cls: str = "") -> str:
+    esc = html.escape
+    head = "".join(f"<th>{esc(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{esc(str(x))}</td>" for x in r) + "</tr>" for r in rows)
+    return f"<table class='{cls}'><tr>{head}</tr>{body}</table>"
+
+
+def _verify_html(ver: dict[str, Any]) -> str:
+    if ver.get("error"):
+        return f"<p class='bad'>verification could not run: {html.escape(str(ver['error']))}</p>"
+    parts = [_table(["model", "re-derived", "mismatches", "critical flips", "without plan", "errors",
+                     "pair set differs"],
+                    [[ver.get("model_source"), ver.get("checked"), len(ver.get("mismatches", [])),
+                      ver.get("critical"), ver.get("missing_plans"), len(ver.get("errors", [])),
+                      ver.get("pairs_differ", 0)]], "summary")]
+    if ver.get("mismatches"):
+        parts.append("<h4>Windows whose verdict changed</h4>" + _table(
+            ["window", "sim time", "logged", "recomputed", "critical", "logged clearance", "clearance",
+             "note"],
+            [[m["index"], _fmt(m["sim_time"], ".4f"), m["logged"], m["recomputed"],
+              "CRITICAL" if m["critical"] else "", _fmt(m.get("logged_clearance"), ".3g"),
+              _fmt(m.get("clearance"), ".3g"), m.get("reason") or ""] for m in ver["mismatches"]]))
+    if ver.get("errors"):
+        parts.append("<h4>Windows that could not be re-verified</h4>" + _table(
+            ["window", "sim time", "error"],
+            [[e["index"], _fmt(e.get("sim_time"), ".4f"), e["error"]] for e in ver["errors"]]))
+    return "".join(parts)
+
+
+_CSS = ("body{font-family:sans-serif;margin:1em 2em;max-width:none}"
+        "table{border-collapse:collapse;margin:0.5em 0}"
+        "td,th{border:1px solid #ccc;padding:2px 8px;font-size:90%;text-align:left}"
+        "th{background:#f0f0f0}pre{background:#f6f6f6;padding:1em;overflow-x:auto}"
+        "img{max-width:100%;height:auto;display:block}img.wide{width:100%}.bad{color:#b00}"
+        ".grid{display:grid;grid-template-columns:repeat(auto-fit,minmax(560px,1fr));gap:1em}")
+
+
 def write_report(result: dict[str, Any], path: str) -> int:
-    """Write a self-contained HTML page (summary, tables, embedded PNG plots).
+    """Write a self-contained HTML page (summary, tables, embedded PNG plots) using the page width.
 
     Returns:
         Number of embedded plots.
+
+    Raises:
+        DependencyNotInstalled: matplotlib is missing (``pip install 'monitor[report]'``).
     """
     esc = html.escape
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>monitor review</title>",
-             "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-             "td,th{border:1px solid #ccc;padding:2px 6px;font-size:90%}pre{background:#f6f6f6;padding:1em}"
-             "</style></head><body><h1>monitor review</h1>",
+    _pyplot()  # fail before writing anything when matplotlib is missing
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>"
+             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+             "<title>monitor review</title>",
+             f"<style>{_CSS}</style></head><body><h1>monitor review</h1>",
              f"<pre>{esc(render_text(result))}</pre>"]
     n_plots = 0
     for entry in result["logs"]:
         if entry.get("error") or "series" not in entry:
             continue
         parts.append(f"<h2>{esc(entry['file']['path'])}</h2>")
-        for title, b64 in _plots(entry):
-            parts.append(f"<h3>{esc(title)}</h3><img alt='{esc(title)}' src='data:image/png;base64,{b64}'/>")
-            n_plots += 1
+        if entry.get("verify"):
+            parts.append("<h3>Re-verification (--verify)</h3>" + _verify_html(entry["verify"]))
+        plots = _plots(entry)
+        parts.append(f"<h3>{esc(plots[0][0])}</h3><img class='wide' alt='{esc(plots[0][0])}' "
+                     f"src='data:image/png;base64,{plots[0][1]}'/><div class='grid'>")
+        for title, b64 in plots[1:]:
+            parts.append(f"<div><h3>{esc(title)}</h3><img alt='{esc(title)}' "
+                         f"src='data:image/png;base64,{b64}'/></div>")
+        parts.append("</div>")
+        n_plots += len(plots)
+        head, _ = split_warmup(entry["series"]["latency_us"])
+        if head:
+            parts.append(f"<p>First window (includes the JIT warm-up): {head[0] / 1e6:.3g} s; "
+                         f"not in the histogram.</p>")
+        if entry.get("blocked"):
+            parts.append(f"<h3>Blocked actions ({len(entry['blocked'])})</h3>" + _table(
+                ["window", "episode", "sim time", "reason"],
+                [[b["index"], b.get("episode", 0), _fmt(b["sim_time"], ".4f"), b.get("reason") or "-"]
+                 for b in entry["blocked"][:500]]))
         if entry["violations"]:
-            parts.append("<h3>Violations and uncertain windows</h3><table><tr><th>sim time</th>"
-                         "<th>verdict</th><th>at t</th><th>bodies</th><th>geoms</th><th>witness point</th>"
-                         "<th>distance</th><th>clearance</th></tr>")
-            for r in entry["violations"]:
-                parts.append("<tr>" + "".join(f"<td>{esc(x)}</td>" for x in (
-                    _fmt(r["sim_time"], ".4f"), r["verdict"], _fmt(r["time"], ".4f"), " / ".join(r["bodies"]),
-                    " / ".join(r["geoms"]), _fmt_point(r["point"]), _fmt(r["distance"], ".3g"),
-                    _fmt(r["clearance"], ".3g"))) + "</tr>")
-            parts.append("</table>")
+            parts.append("<h3>Violations and uncertain windows</h3>" + _table(
+                ["sim time", "verdict", "at t", "bodies", "geoms", "witness point", "distance", "clearance"],
+                [[_fmt(r["sim_time"], ".4f"), r["verdict"], _fmt(r["time"], ".4f"), " / ".join(r["bodies"]),
+                  " / ".join(r["geoms"]), _fmt_point(r["point"]), _fmt(r["distance"], ".3g"),
+                  _fmt(r["clearance"], ".3g")] for r in entry["violations"]]))
     parts.append("</body></html>")
     with open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(parts))
@@ -919,4 +1038,5 @@ def strip_series(result: dict[str, Any]) -> dict[str, Any]:
 
 __all__ = ["analyze", "combine", "verify", "verify_exit_code", "render_text", "write_report", "strip_series",
            "certificate_problem", "split_certificates", "tolerance_problems", "make_tolerances",
-           "parse_pair_policy", "fmt_bound", "VERDICTS", "METHODS", "EXIT_MEANING"]
+           "parse_pair_policy", "fmt_bound", "split_warmup", "VERDICTS", "METHODS", "EXIT_MEANING",
+           "WARMUP_WINDOWS"]

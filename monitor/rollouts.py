@@ -244,7 +244,7 @@ def _resolve_source(source: Any) -> tuple[str, Any, str]:
 
 def _register_envs(env_id: str) -> None:
     if env_id.startswith("monitor/"):
-        import envs  # noqa: F401  (registers monitor/*)
+        import monitor.envs  # noqa: F401  (registers monitor/*)
 
 
 def _is_env_id(s: str) -> bool:
@@ -300,6 +300,21 @@ def run_episode(job: dict[str, Any]) -> EpisodeResult:
         verdict_digest=_digest(verdicts), log=job["log"])
 
 
+def _step_bar(job: dict[str, Any]) -> Any:
+    """A tqdm bar (stderr) over the steps of one episode; None when off.
+
+    ``job["step_progress"]``: False (off: pools and Ray, where bars of parallel
+    episodes would overwrite each other), True (on) or None (on when stderr is a terminal).
+    """
+    flag = job.get("step_progress", False)
+    if flag is False:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=int(job["steps"]), desc=f"episode {job['episode']} (seed {job['seed']})", unit="step",
+                leave=False, file=sys.stderr, disable=None if flag is None else not flag)
+
+
 def _model_episode(job: dict[str, Any], policy: Any, rng: np.random.Generator, seed: int
                    ) -> tuple[list[str], dict[str, Any], bool]:
     import mujoco
@@ -320,14 +335,21 @@ def _model_episode(job: dict[str, Any], policy: Any, rng: np.random.Generator, s
         kw.setdefault("log_options", {"model_source": job["source"]})
     verdicts: list[str] = []
     ended = False
-    with Gate(model, log=job["log"], **kw) as gate:
-        for _ in range(int(job["steps"])):
-            report = gate.step(data, policy(data, rng))
-            verdicts.append(report.verdict)
-            if report.terminated:
-                ended = True
-                break
-        stats = dict(gate.stats)
+    bar = _step_bar(job)
+    try:
+        with Gate(model, log=job["log"], **kw) as gate:
+            for _ in range(int(job["steps"])):
+                report = gate.step(data, policy(data, rng))
+                verdicts.append(report.verdict)
+                if bar is not None:
+                    bar.update(1)
+                if report.terminated:
+                    ended = True
+                    break
+            stats = dict(gate.stats)
+    finally:
+        if bar is not None:
+            bar.close()
     return verdicts, stats, ended
 
 
@@ -341,6 +363,7 @@ def _env_episode(job: dict[str, Any], policy: Any, rng: np.random.Generator, see
     env = SafetyGate(gymnasium.make(job["source"]), log=job["log"], **job["gate_kwargs"])
     verdicts: list[str] = []
     ended = False
+    bar = _step_bar(job)
     try:
         obs, _ = env.reset(seed=seed)
         env.action_space.seed(seed)
@@ -349,11 +372,15 @@ def _env_episode(job: dict[str, Any], policy: Any, rng: np.random.Generator, see
         for _ in range(int(job["steps"])):
             obs, _, terminated, truncated, info = env.step(policy(obs, rng))
             verdicts.append(str(info["safety"]["verdict"]))
+            if bar is not None:
+                bar.update(1)
             if terminated or truncated:
                 ended = True
                 break
         stats = dict(env.gate.stats)
     finally:
+        if bar is not None:
+            bar.close()
         env.close()
     return verdicts, stats, ended
 
@@ -397,7 +424,8 @@ def rollouts(model_or_env_id: Any, policy: Callable[[Any, np.random.Generator], 
             On a multi-node Ray cluster this must be shared storage.
         gate_kwargs: keyword arguments for :class:`monitor.Gate` (plain MuJoCo) or
             :class:`monitor.SafetyGate` (env ids), e.g. ``{"margin": 0.005, "frame_skip": 10}``.
-        progress: progress bar over episodes (None: on a terminal).
+        progress: progress bar over episodes, and over the steps of each episode when they run
+            one at a time in this process (backend "local", workers=1); None: on a terminal.
 
     Returns:
         the :class:`RolloutSummary`.
@@ -435,8 +463,10 @@ def rollouts(model_or_env_id: Any, policy: Callable[[Any, np.random.Generator], 
     if log_dir is not None:
         log_dir = Path(log_dir).resolve()
         log_dir.mkdir(parents=True, exist_ok=True)
+    # a step bar inside the episode only when episodes run one at a time in this process
+    step_progress = progress if backend == "local" and (workers or 1) == 1 else False
     jobs = [{"kind": kind, "source": ref, "policy": policy, "steps": int(steps), "seed": s, "episode": i,
-             "gate_kwargs": gate_kwargs,
+             "gate_kwargs": gate_kwargs, "step_progress": step_progress,
              "log": None if log_dir is None else str(log_dir / f"episode-{i:04d}-seed{s}.mcap")}
             for i, s in enumerate(seed_list)]
     if backend == "ray":

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import envs  # noqa: F401  (registers the ids)
+import monitor.envs  # noqa: F401  (registers the ids)
 from monitor._paths import scene_path
 
 OWN_ENVS = ["monitor/Arm-v0", "monitor/Tunnel-v0"]

@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-import envs  # noqa: F401
+import monitor.envs  # noqa: F401
 from monitor._paths import scene_path
 from monitor.certify.certificate import Certificate, Witness
 from monitor.errors import InvalidInputError

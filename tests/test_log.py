@@ -101,8 +101,8 @@ def test_round_trip_messages_metadata_timestamps(tmp_path):
     assert len(got) == len(certs)
     for k, (msg, cert) in enumerate(zip(got, certs)):
         assert msg["index"] == k
-        assert msg["_log_time"] == int(round(0.01 * k * 1e9))
-        assert msg["wall_time"] == 1e9 + k
+        assert msg["_log_time"] == int(round((1e9 + k) * 1e9))  # wall clock, ns
+        assert msg["wall_time"] == 1e9 + k and msg["episode"] == 0 and msg["sim_time"] == 0.01 * k
         back = Certificate.from_dict(msg)
         assert back.to_dict() == cert.to_dict()
     pl = c.plans_by_index()
@@ -138,7 +138,7 @@ def test_official_reader_and_json_schemas(tmp_path):
         schemas = {sid: json.loads(x.data) for sid, x in s.schemas.items() if x.encoding == "jsonschema"}
         n = 0
         for schema, ch, msg in r.iter_messages():
-            assert msg.log_time == msg.publish_time
+            assert msg.publish_time < msg.log_time  # sim time vs wall clock
             if ch.message_encoding == "json":
                 jsonschema.validate(json.loads(msg.data), schemas[schema.id])
                 n += 1
@@ -164,7 +164,7 @@ def test_foxglove_messages_decode_and_quaternions(tmp_path):
     with open(path, "rb") as f:
         r = make_reader(f, decoder_factories=[DecoderFactory()])
         for _, ch, msg, dec in r.iter_decoded_messages(topics=list(topics.FOXGLOVE_TOPICS)):
-            k = int(round(msg.log_time / 1e7))
+            k = int(round(msg.publish_time / 1e7))  # publish_time = sim time (ns)
             if ch.topic == topics.TRANSFORMS:
                 data.qpos[:] = plans[k].qpos[0]
                 data.mocap_pos[:] = plans[k].mocap_pos

@@ -1,4 +1,4 @@
-"""Packaging: the wheel ships every models/ scene (as monitor.models) and the envs package,
+"""Packaging: the wheel ships every models/ scene (as monitor.models) and envs/ as monitor.envs,
 an installed copy finds its scenes, and a source checkout finds models/ too."""
 
 from __future__ import annotations
@@ -39,9 +39,10 @@ def test_wheel_contents(wheel):
         # assets next to a scene (meshes) ship too
         for asset in (REPO / "models" / rel.parent).glob("*.stl"):
             assert f"monitor/models/{rel.parent.as_posix()}/{asset.name}" in names
-    assert "envs/__init__.py" in names
+    assert "monitor/envs/__init__.py" in names
     for py in (REPO / "envs").glob("*.py"):
-        assert f"envs/{py.name}" in names
+        assert f"monitor/envs/{py.name}" in names
+    assert not any(n.startswith("envs/") for n in names)  # no generic top-level package
     assert "monitor/__init__.py" in names and "monitor/scene.py" in names
     assert "monitor/geometry/polytope.py" in names
 

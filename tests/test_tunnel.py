@@ -6,8 +6,8 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-import envs  # noqa: F401
-from envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS
+import monitor.envs  # noqa: F401
+from monitor.envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS
 from monitor.gym_gate import SafetyGate
 
 FIRE = np.array([5.0], dtype=np.float32)

@@ -11,7 +11,7 @@ from monitor.certify.certificate import VERDICTS
 
 def make_gated_tunnel():
     """The tunnel env (one candidate pair: cheap to certify), random velocity commands."""
-    import envs  # noqa: F401  (registers the id in a subprocess too)
+    import monitor.envs  # noqa: F401  (registers the id in a subprocess too)
     from monitor.gym_gate import SafetyGate
 
     return SafetyGate(gym.make("monitor/Tunnel-v0", max_episode_steps=30, reset_noise=0.05), margin=0.002)

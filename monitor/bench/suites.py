@@ -930,7 +930,7 @@ def suite_gate(cfg: BenchConfig) -> dict[str, Any]:
     for env_id in env_ids:
         try:
             if env_id.startswith("monitor/"):
-                import envs  # noqa: F401
+                import monitor.envs  # noqa: F401
             variants = {"ungated": gym.make(env_id)}
             g = SafetyGate(gym.make(env_id), pairs="all")
             variants["states_only"] = PredictOnly(gym.make(env_id), g.gate, states_only=True)

@@ -10,6 +10,7 @@ replaced by a hold-position fallback. The run is written to an MCAP log
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", type=Path, default=None,
                    help="log file, or a folder for logs/<env-id>-<UTC timestamp>.mcap (default: logs/)")
     p.add_argument("--margin", type=float, default=0.005, help="clearance (m) that counts as safe")
+    p.add_argument("--progress", dest="progress", action="store_true", default=None,
+                   help="always show the progress bar on stderr (default: only on a terminal)")
+    p.add_argument("--no-progress", dest="progress", action="store_false", help="never show the progress bar")
 
 
 class ScriptedPolicy:
@@ -74,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; returns 0 on success."""
     import gymnasium as gym
 
-    import envs  # noqa: F401  (registers monitor/Arm-v0)
+    import monitor.envs  # noqa: F401  (registers monitor/Arm-v0)
     from monitor.gym_gate import SafetyGate
 
     t_start = time.perf_counter()
@@ -104,17 +108,27 @@ def run(args: argparse.Namespace) -> int:
     obstacle_geoms = {g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in obstacle_bodies}
 
     policy = ScriptedPolicy(np.random.default_rng(args.seed), env.action_space.low, env.action_space.high)
+    from tqdm import tqdm
+
+    progress = getattr(args, "progress", None)
+    bar = tqdm(total=args.steps, desc="gated steps", unit="step", file=sys.stderr, leave=False,
+               disable=None if progress is None else not progress)
+    bar.set_postfix_str("first step compiles the numba kernels (cached afterwards)")
     obs, _ = gated.reset(seed=args.seed)
     contacts = 0
     aims: dict[str, int] = {}
-    for _ in range(args.steps):
+    for k in range(args.steps):
         action = policy(obs)
         obs, _, terminated, truncated, info = gated.step(action)
         if info["safety"]["replaced"]:
             aims[policy.aim] = aims.get(policy.aim, 0) + 1
         contacts += _obstacle_contacts(m, u.data, arm_geoms, obstacle_geoms)
+        bar.update(1)
+        if k == 0:
+            bar.set_postfix_str("")
         if terminated or truncated:
             obs, _ = gated.reset()
+    bar.close()
     s = gated.gate.summary()
     gated.close()
 

@@ -56,6 +56,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ray", action="store_true",
                    help="re-verify the logs in parallel as Ray tasks (implies --verify; uses a running "
                         "ray.init(), else starts a local instance; needs the 'ray' extra)")
+    p.add_argument("--reindex", action="store_true",
+                   help="first rewrite each LOG in place as a chunked, indexed MCAP (finalises the "
+                        "journal a killed writer left; a record cut by the kill is dropped), then review it")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON instead of text")
     p.add_argument("--report", metavar="OUT.html", default=None, help="write a self-contained HTML report")
     p.add_argument("--progress", dest="progress", action="store_true", default=None,
@@ -124,6 +127,25 @@ def _worst(*codes: int) -> int:
     return 1 if 1 in codes else (2 if 2 in codes else 0)
 
 
+def _reindex(paths: list[str]) -> list[int]:
+    """``--reindex``: finalise every log in place; a message per file on stderr; exit codes."""
+    from monitor.errors import LogFormatError
+    from monitor.log.writer import finalise_log
+
+    codes = []
+    for path in paths:
+        try:
+            r = finalise_log(path)
+        except (LogFormatError, OSError) as exc:
+            print(f"error: cannot reindex {path}: {exc}", file=sys.stderr)
+            codes.append(2)
+            continue
+        lost = "" if r.source_complete else f"; {r.dropped_bytes} trailing byte(s) of a cut record dropped"
+        print(f"reindexed {path}: {r.windows} window(s), {r.messages} message(s){lost}", file=sys.stderr)
+        codes.append(0)
+    return codes
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the review; returns the exit code (module docstring: 0 ok, 1 critical, 2 incomplete)."""
     from monitor.distributed import expand_logs
@@ -148,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
     if not paths:
         print(f"error: no .mcap logs in {' '.join(map(str, args.logs))}", file=sys.stderr)
         return 2
+    reindex_codes = _reindex(paths) if getattr(args, "reindex", False) else []
     verified: dict[str, Any] = {}
     if getattr(args, "ray", False):
         from monitor.distributed import verify_logs
@@ -173,6 +196,7 @@ def run(args: argparse.Namespace) -> int:
                            "error": f"{path}: unexpected {type(exc).__name__}: {exc}"}, 2
         entries.append(entry)
         codes.append(code)
+    codes.extend(reindex_codes)
     ok = [e for e in entries if not e.get("error")]
     try:
         total = combine(ok) if ok else None
@@ -181,9 +205,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: cannot total the logs: {type(exc).__name__}: {exc}", file=sys.stderr)
     result = {"logs": entries, "total": total, "exit_code": _worst(*codes)}
     if args.report:
+        from monitor.errors import DependencyNotInstalled
+
         try:
             n = write_report(result, args.report)
             print(f"wrote {args.report} ({n} plots)", file=sys.stderr)
+        except DependencyNotInstalled as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            codes.append(2)
+            result["exit_code"] = _worst(*codes)
         except Exception as exc:  # noqa: BLE001 - OSError, or an entry the report cannot draw
             print(f"error: cannot write report {args.report}: {type(exc).__name__}: {exc}", file=sys.stderr)
             codes.append(2)

@@ -6,8 +6,8 @@ their protobuf schemas (one file, one flush policy). Layout:
 * ``/monitor/scene`` (``foxglove.SceneUpdate``): at the first window, one entity per
   geom in its **body frame** (``frame_id`` = body name; geometry is static in it).
 * ``/monitor/markers`` (``foxglove.SceneUpdate``): at every violation/uncertain
-  window, a red witness marker (sphere + label) in ``world`` with a lifetime of the
-  window length.
+  window, a red witness marker (sphere + label) in ``world`` that stays until the next
+  certified window deletes it (entity id ``witness``).
 * ``/monitor/tf`` (``foxglove.FrameTransforms``): at every window, world -> body
   transforms of every body at the plan's first waypoint.
 
@@ -25,7 +25,6 @@ from foxglove.messages import (
     Color,
     CubePrimitive,
     CylinderPrimitive,
-    Duration,
     FrameTransform,
     FrameTransforms,
     KeyValuePair,
@@ -33,6 +32,8 @@ from foxglove.messages import (
     Pose,
     Quaternion,
     SceneEntity,
+    SceneEntityDeletion,
+    SceneEntityDeletionType,
     SceneUpdate,
     SpherePrimitive,
     TextPrimitive,
@@ -146,6 +147,7 @@ class FoxgloveScene:
         self.model = model
         self._data = mujoco.MjData(model)
         self._geometry_sent = False
+        self._marker_shown = False
         self._frames = [body_frame(model, b) for b in range(model.nbody)]
 
     @staticmethod
@@ -202,17 +204,15 @@ class FoxgloveScene:
         verdict = cert.get("verdict")
         if verdict == "certified":
             return None
-        w0, w1 = cert.get("window", [0.0, 0.0])
-        life_ns = max(int(round((float(w1) - float(w0)) * 1e9)), 1)
         ts = _stamp(t_ns)
-        lifetime = Duration(sec=life_ns // 1_000_000_000, nsec=life_ns % 1_000_000_000)
         wit = cert.get("witness")
         ents = []
         if wit:
             p = wit["point"]
-            label = f"{verdict}: {wit['geoms'][0]} / {wit['geoms'][1]} at t={wit['time']:.4f}s"
+            wt = "unknown" if wit.get("time") is None else f"{wit['time']:.4f}"
+            label = f"{verdict}: {wit['geoms'][0]} / {wit['geoms'][1]} at t={wt}s"
             ents.append(SceneEntity(
-                timestamp=ts, frame_id=WORLD_FRAME, id="witness", lifetime=lifetime,
+                timestamp=ts, frame_id=WORLD_FRAME, id="witness",
                 spheres=[SpherePrimitive(pose=Pose(position=_vec(p), orientation=Quaternion(w=1.0)),
                                          size=Vector3(x=0.03, y=0.03, z=0.03), color=_COLORS["witness"])],
                 texts=[TextPrimitive(pose=Pose(position=_vec(np.asarray(p) + [0, 0, 0.05]),
@@ -222,7 +222,7 @@ class FoxgloveScene:
                 metadata=[KeyValuePair(key="distance", value=str(wit.get("distance")))]))
         else:
             ents.append(SceneEntity(
-                timestamp=ts, frame_id=WORLD_FRAME, id="witness", lifetime=lifetime,
+                timestamp=ts, frame_id=WORLD_FRAME, id="witness",
                 texts=[TextPrimitive(pose=Pose(position=Vector3(z=0.5), orientation=Quaternion(w=1.0)),
                                      billboard=True, font_size=14.0, scale_invariant=True,
                                      color=_COLORS["uncertain"],
@@ -241,6 +241,12 @@ class FoxgloveScene:
         marks = self.witness_markers(t_ns, cert)
         if marks is not None:
             out.append((topics.MARKERS, marks.encode()))
+            self._marker_shown = True
+        elif self._marker_shown:  # first certified window after a marker: remove it
+            gone = SceneEntityDeletion(timestamp=_stamp(t_ns), type=SceneEntityDeletionType.MatchingId,
+                                       id="witness")
+            out.append((topics.MARKERS, SceneUpdate(deletions=[gone]).encode()))
+            self._marker_shown = False
         return out
 
 

@@ -244,6 +244,19 @@ def _decode_metadata_value(v: str) -> Any:
         return v
 
 
+def _decode_metadata(values: dict[str, str]) -> dict[str, Any]:
+    """Decode one metadata record's values.
+
+    Version 2 records list their JSON-text keys under ``_json_keys`` (other values are
+    plain strings); version 1 records stored every value as JSON text.
+    """
+    if topics.METADATA_JSON_KEYS in values:
+        json_keys = set(filter(None, values[topics.METADATA_JSON_KEYS].split(",")))
+        return {k: _decode_metadata_value(v) if k in json_keys else v
+                for k, v in values.items() if k != topics.METADATA_JSON_KEYS}
+    return {k: _decode_metadata_value(v) for k, v in values.items()}
+
+
 class _Walker:
     """Length-checked record walk over a binary file object (or an in-memory chunk)."""
 
@@ -515,7 +528,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                         continue
                     digest.metadata(rec.name, rec.metadata)
                     merged = out.metadata.setdefault(rec.name, {})
-                    merged.update({k: _decode_metadata_value(v) for k, v in rec.metadata.items()})
+                    merged.update(_decode_metadata(rec.metadata))
                 elif isinstance(rec, Attachment):
                     digest.attachment(rec.name, rec.media_type, rec.data)
                     out.attachments[rec.name] = bytes(rec.data)

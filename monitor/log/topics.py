@@ -4,9 +4,25 @@ Every JSON topic has a JSON schema in ``monitor/log/schemas/<file>.json`` that i
 registered exactly once per log. Foxglove topics use the protobuf schemas of
 ``foxglove.messages`` (registered only when foxglove-sdk is installed).
 
-Timestamps: a message's MCAP ``log_time`` and ``publish_time`` are the simulation
-time in integer nanoseconds (``sim_time_ns``); the wall clock (Unix seconds) is a
-field of the JSON payload.
+Timestamps (format version 2, :data:`FORMAT_VERSION`):
+
+* ``log_time`` is the **wall clock** (Unix ns) of the window, strictly increasing through
+  the file (a window whose clock reading is not later than the previous window's gets
+  the previous value + 1 ns). All messages of one window share it. Foxglove plays the
+  file on this clock, so two episodes never interleave.
+* ``publish_time`` is the **simulation time** (ns) of the window start within its
+  episode (``round(sim_time * 1e9)``); it restarts at each episode.
+* Every JSON payload carries ``index`` (window, 0-based, over the whole file),
+  ``episode`` (0-based; the writer starts a new episode whenever ``sim_time`` goes
+  back, e.g. after ``env.reset()``, or on :meth:`MonitorLog.new_episode`), ``sim_time``
+  (s) and ``wall_time`` (Unix s).
+* Foxglove ``timestamp`` fields (scene, transforms, markers, log) equal ``log_time``.
+
+Unknown values are JSON ``null`` (never a huge finite number): a clearance of ``null``
+means "no lower bound known" (read back as -inf).
+
+Version 1 logs (written before this change) used sim time for ``log_time`` and
+``publish_time``, had no ``episode`` field and stored metadata values as JSON text.
 """
 
 from __future__ import annotations
@@ -31,12 +47,19 @@ MARKERS = "/monitor/markers"
 """foxglove.SceneUpdate: witness markers of violation / uncertain windows."""
 TRANSFORMS = "/monitor/tf"
 """foxglove.FrameTransforms: world -> body poses at each window start."""
+LOG = "/monitor/log"
+"""foxglove.Log (JSON encoding, no foxglove-sdk needed): one line per violation, uncertain
+window or blocked (replaced) action; level error for violations, warning otherwise."""
+
+FORMAT_VERSION = 2
+"""Stored as ``format_version`` in the ``monitor.run`` metadata (absent = version 1)."""
 
 JSON_TOPICS: dict[str, tuple[str, str]] = {
     CERTIFICATE: ("monitor.Certificate", "certificate.json"),
     VIOLATION: ("monitor.Violation", "violation.json"),
     PLAN: ("monitor.Plan", "plan.json"),
     ACTION: ("monitor.Action", "action.json"),
+    LOG: ("foxglove.Log", "foxglove_log.json"),
 }
 """topic -> (schema name, schema file in ``monitor/log/schemas``)."""
 
@@ -46,6 +69,11 @@ METADATA_RUN = "monitor.run"
 """Metadata record: versions, margin, epsilon, pair policy, predictor, ... (JSON values)."""
 METADATA_MODEL = "monitor.model"
 """Metadata record: attachment names and fingerprints of the logged model."""
+METADATA_FINALISE = "monitor.finalise"
+"""Metadata record added when a journal is rewritten into an indexed file (source, bytes dropped)."""
+METADATA_JSON_KEYS = "_json_keys"
+"""Metadata key (version 2) listing, comma-separated, the keys whose values are JSON text;
+every other value is a plain string stored as is (no JSON inside JSON)."""
 
 ATTACHMENT_XML = "model.xml"
 ATTACHMENT_MJB = "model.mjb"
@@ -69,7 +97,8 @@ def schema(topic: str) -> dict[str, Any]:
 
 
 __all__ = [
-    "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "JSON_TOPICS",
+    "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
+    "FORMAT_VERSION", "METADATA_FINALISE", "METADATA_JSON_KEYS",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",
 ]

@@ -1,23 +1,30 @@
-"""MCAP certificate logs: :class:`MonitorLog`.
+"""MCAP certificate logs: :class:`MonitorLog` and :func:`finalise_log`.
 
-File layout (one MCAP file per run, written with the plain ``mcap`` Writer):
+File layout (one MCAP file per run; timestamps and payload fields: :mod:`monitor.log.topics`):
 
 * header, then the ``monitor.run`` metadata (package and MuJoCo versions, margin,
-  epsilon, pair policy, predictor, ... as JSON values) and the model attachments
-  (``model.xml`` + ``assets/*.stl`` + ``model.mjb``) **first**, so that even a
-  killed writer leaves a log that review can re-verify;
+  epsilon, pair policy, predictor, ...; strings stored as is, other values as JSON
+  text listed under ``_json_keys``) and the model attachments (``model.xml`` +
+  ``assets/*.stl`` + ``model.mjb``, ``log_time``/``create_time`` = wall clock at open)
+  **first**, so that even a killed writer leaves a log that review can re-verify;
 * per window: ``/monitor/plan``, ``/monitor/certificate``, ``/monitor/violation``
-  (violation or uncertain only), ``/monitor/action``, and with foxglove-sdk
-  ``/monitor/tf`` (+ ``/monitor/scene`` for the geoms once and witness markers).
-  ``log_time = publish_time = round(sim_time * 1e9)`` ns; wall clock in the payload.
+  (violation or uncertain only), ``/monitor/action``, ``/monitor/log`` (``foxglove.Log``
+  for violations, uncertain windows and replaced actions) and with foxglove-sdk
+  ``/monitor/tf`` (+ ``/monitor/scene`` for the geoms once, ``/monitor/markers`` for witnesses).
 
-Flush policy (crash tolerance): records are written **unchunked** (``use_chunking=False``)
-and the file is flushed at the end of every :meth:`MonitorLog.write_window`.
-A process killed between two windows therefore loses nothing; a process killed
-inside ``write_window`` loses at most the messages of that one window
-(:data:`MAX_MESSAGES_PER_WINDOW`). :func:`monitor.log.reader.read_log` recovers
-every complete record of such a file. ``fsync=True`` additionally survives power loss
-(not measured). The price: no compression (~1.5-2x larger files than zstd chunks).
+Two phases (crash tolerance *and* an indexed file):
+
+1. **Journal.** While the run lasts, records go to ``path`` **unchunked**
+   (``use_chunking=False``) and the file is flushed at the end of every
+   :meth:`MonitorLog.write_window`. A process killed between two windows loses nothing;
+   one killed inside ``write_window`` loses at most the messages of that window
+   (:data:`MAX_MESSAGES_PER_WINDOW`). :func:`monitor.log.reader.read_log` recovers every
+   complete record of such a file; ``fsync=True`` additionally survives power loss (not measured).
+2. **Finalisation.** :meth:`MonitorLog.close` rewrites the journal into a chunked
+   (zstd), indexed MCAP file with a summary (chunk, message, attachment and metadata
+   indexes, statistics) next to it and atomically renames it over ``path``
+   (:func:`finalise_log`; ``index=False`` keeps the journal). A journal left by a
+   killed writer is finalised by ``python -m monitor review --reindex FILE``.
 
 Model export: the exact compiled model is always attached as MJB
 (``mj_saveModel``; loadable by the same MuJoCo version). The MJCF XML comes from an
@@ -44,16 +51,24 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
 from monitor._json import jsonable
-from monitor.errors import InvalidInputError
+from monitor.errors import InvalidInputError, LogFormatError
 from monitor.log import topics
 
-MAX_MESSAGES_PER_WINDOW = 7
+MAX_MESSAGES_PER_WINDOW = 8
 """Upper bound on records one window writes (plan, certificate, violation, action,
-tf, and up to two scene updates on the first window): the most a killed writer can
+log, tf, and up to two scene updates on the first window): the most a killed writer can
 lose under the per-window flush policy."""
+
+FINAL_CHUNK_BYTES = 1 << 20
+"""Chunk size (bytes, before compression) of a finalised log."""
+
+UNKNOWN_ABS = 1e308
+"""Floats at least this large in magnitude are the certificate's JSON stand-in for an
+infinite (unknown) bound; the log writes them as ``null``."""
 
 XML_GEOMETRY_TOL = 1e-4
 """Largest world-frame geometry difference (m) accepted between the attached XML
@@ -99,6 +114,21 @@ def _dumps(obj: Any) -> bytes:
         return json.dumps(_jsonable(obj), allow_nan=False, separators=(",", ":")).encode("utf-8")
 
 
+def _null_unknown(x: Any) -> Any:
+    """Replace the +-1e308 stand-ins of ``Certificate.to_dict`` by None, recursively."""
+    if isinstance(x, dict):
+        return {k: _null_unknown(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_null_unknown(v) for v in x]
+    if isinstance(x, float) and not abs(x) < UNKNOWN_ABS:
+        return None
+    return x
+
+
+def _ns(seconds: float) -> int:
+    return int(round(float(seconds) * 1e9))
+
+
 def package_versions() -> dict[str, str]:
     """Versions of monitor, mujoco, numpy, scipy, mcap, foxglove-sdk (if installed), Python."""
     out = {"python": platform.python_version()}
@@ -135,17 +165,16 @@ class ModelExport:
 
 
 def _stl_bytes(V: np.ndarray, F: np.ndarray) -> bytes:
-    """Binary STL of triangles F (n, 3) over vertices V (m, 3) (float32, exact for mesh_vert)."""
-    V = np.asarray(V, np.float32)
-    F = np.asarray(F, np.int64)
-    tri = V[F]  # (n, 3, 3)
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).astype(np.float64)
-    ln = np.linalg.norm(n, axis=1, keepdims=True)
-    n = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0).astype(np.float32)
-    rec = np.zeros(len(F), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-    rec["n"], rec["v"] = n, tri
-    header = b"monitor: compiled MuJoCo mesh".ljust(80, b" ")
-    return header + np.uint32(len(F)).tobytes() + rec.tobytes()
+    """Binary STL of triangles F (n, 3) over vertices V (m, 3), written by trimesh.
+
+    Binary STL stores float32 coordinates, so MuJoCo's float32 ``mesh_vert`` round-trips
+    exactly; ``process=False`` keeps every vertex and face as compiled (no merging).
+    """
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=np.asarray(V, np.float64), faces=np.asarray(F, np.int64), process=False,
+                           validate=False)
+    return mesh.export(file_type="stl")
 
 
 def _mesh_arrays(model: Any, i: int) -> tuple[np.ndarray, np.ndarray]:
@@ -283,6 +312,8 @@ class MonitorLog:
             silently when foxglove-sdk is not installed).
         model_source: optional ``MjSpec`` or MJCF path of ``model`` (robust XML export).
         fsync: ``os.fsync`` after every window (power-loss durability; slower).
+        index: on :meth:`close`, rewrite the journal into a chunked, indexed file
+            (:func:`finalise_log`); False leaves the unchunked journal.
 
     Example:
         >>> with MonitorLog("run.mcap", model=model, metadata={"margin": 0.01}) as log:
@@ -291,10 +322,12 @@ class MonitorLog:
 
     def __init__(self, path: str | os.PathLike[str] | None = None, *, model: Any = None,
                  metadata: dict[str, Any] | None = None, env_id: str | None = None, foxglove: bool = True,
-                 model_source: Any = None, fsync: bool = False) -> None:
+                 model_source: Any = None, fsync: bool = False, index: bool = True) -> None:
         self.path = Path(path) if path is not None else default_path(env_id)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._fsync = bool(fsync)
+        self._index_on_close = bool(index)
+        self.finalise_error: str | None = None
         self._f = open(self.path, "wb")  # noqa: SIM115 - closed in close()
         self._w = Writer(self._f, use_chunking=False, compression=CompressionType.NONE,
                          enable_crcs=True, enable_data_crcs=False)
@@ -307,6 +340,10 @@ class MonitorLog:
                                                              schema_id=sid)
         self._index = 0
         self._seq = 0
+        self._episode = 0
+        self._last_sim_time: float | None = None
+        self._open_ns = time.time_ns()
+        self._last_log_ns = 0
         self._closed = False
         self._model = None
         self._model_source = model_source
@@ -315,7 +352,9 @@ class MonitorLog:
         self.foxglove_enabled = False
         self.foxglove_error: str | None = None
         run = {"env_id": env_id, "created_utc": _dt.datetime.now(_dt.UTC).isoformat(),
-               "flush_policy": "unchunked; flush per window" + ("; fsync" if fsync else ""),
+               "format_version": topics.FORMAT_VERSION,
+               "flush_policy": "journal: unchunked; flush per window" + ("; fsync" if fsync else "")
+               + ("; finalised into a chunked, indexed file on close" if index else ""),
                "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW}
         versions = package_versions()
         run.update({f"version.{k}": v for k, v in versions.items()})
@@ -339,27 +378,48 @@ class MonitorLog:
         return self._index
 
     @property
+    def episode(self) -> int:
+        """Episode index the next window gets unless its ``sim_time`` goes back."""
+        return self._episode
+
+    @property
     def closed(self) -> bool:
         """True after :meth:`close`."""
         return self._closed
 
-    def add_metadata(self, values: dict[str, Any], name: str = topics.METADATA_RUN) -> None:
-        """Write a metadata record (values JSON-encoded); readers merge records of one name."""
+    def new_episode(self) -> int:
+        """Start a new episode (the next window gets the next episode index); returns it.
+
+        Not needed after an ordinary reset: a window whose ``sim_time`` is earlier than
+        the previous window's starts a new episode by itself.
+        """
         self._check_open()
-        enc = {str(k): json.dumps(_jsonable(v), allow_nan=False) for k, v in values.items()}
-        self._w.add_metadata(name, enc)
+        if self._last_sim_time is not None:
+            self._episode += 1
+            self._last_sim_time = None
+        return self._episode
+
+    def add_metadata(self, values: dict[str, Any], name: str = topics.METADATA_RUN) -> None:
+        """Write a metadata record; readers merge records of one name.
+
+        Strings are stored as they are; every other value (numbers, bools, None, lists,
+        dicts) as JSON text, and its key is listed in :data:`topics.METADATA_JSON_KEYS`.
+        """
+        self._check_open()
+        self._w.add_metadata(name, encode_metadata(values))
         self._flush()
 
     def _attach_model(self, model: Any) -> None:
         exp = export_model(model, self._model_source)
         self._model = model
+        t = self._open_ns
         if exp.xml is not None:
-            self._w.add_attachment(create_time=0, log_time=0, name=topics.ATTACHMENT_XML,
+            self._w.add_attachment(create_time=t, log_time=t, name=topics.ATTACHMENT_XML,
                                    media_type="application/xml", data=exp.xml.encode("utf-8"))
             for fname, data in exp.assets.items():
-                self._w.add_attachment(create_time=0, log_time=0, name=topics.ASSET_PREFIX + fname,
+                self._w.add_attachment(create_time=t, log_time=t, name=topics.ASSET_PREFIX + fname,
                                        media_type="model/stl", data=data)
-        self._w.add_attachment(create_time=0, log_time=0, name=topics.ATTACHMENT_MJB,
+        self._w.add_attachment(create_time=t, log_time=t, name=topics.ATTACHMENT_MJB,
                                media_type="application/x-mujoco-mjb", data=exp.mjb)
         info = dict(exp.info)
         info.update({"nq": int(model.nq), "nbody": int(model.nbody), "ngeom": int(model.ngeom),
@@ -387,8 +447,8 @@ class MonitorLog:
         if self._closed:
             raise InvalidInputError(f"MonitorLog {self.path} is closed")
 
-    def _put(self, topic: str, t_ns: int, data: bytes) -> None:
-        self._w.add_message(self._channels[topic], log_time=t_ns, data=data, publish_time=t_ns,
+    def _put(self, topic: str, log_ns: int, sim_ns: int, data: bytes) -> None:
+        self._w.add_message(self._channels[topic], log_time=log_ns, data=data, publish_time=sim_ns,
                             sequence=self._seq)
         self._seq += 1
 
@@ -399,7 +459,8 @@ class MonitorLog:
 
     def write_window(self, sim_time: float, plan: Any, certificate: Any, proposed_action: Any = None,
                      applied_action: Any = None, replaced: bool = False,
-                     wall_time: float | None = None) -> int:
+                     wall_time: float | None = None, episode: int | None = None,
+                     reason: str | None = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -410,52 +471,88 @@ class MonitorLog:
             proposed_action: (nu,) action proposed by the policy, or None.
             applied_action: (nu,) action actually applied, or None.
             replaced: True if the gate replaced/blocked the proposed action.
-            wall_time: Unix seconds; default ``time.time()``.
+            wall_time: Unix seconds of the window; default ``time.time()``. The MCAP
+                ``log_time`` is this in ns, raised to 1 ns past the previous window's if needed.
+            episode: episode index (>= the current one); default: the current episode,
+                or the next one when ``sim_time`` is earlier than the previous window's.
+            reason: why the action was replaced (e.g. ``"braking tail uncertain"``); default:
+                the window's verdict when it is not certified, else a generic text.
 
         Returns:
             The window index in this log.
 
         Raises:
-            InvalidInputError: non-finite or negative ``sim_time``, closed log, bad plan.
+            InvalidInputError: non-finite or negative ``sim_time``, bad ``episode``,
+                closed log, bad plan.
         """
         self._check_open()
         t = float(sim_time)
         if not math.isfinite(t) or t < 0:
             raise InvalidInputError(f"sim_time must be finite and >= 0, got {sim_time!r}")
-        t_ns = int(round(t * 1e9))
+        if episode is not None:
+            bad_type = isinstance(episode, bool) or not isinstance(episode, int | np.integer)
+            if bad_type or episode < self._episode:
+                raise InvalidInputError(f"episode must be an int >= {self._episode} (the current episode), "
+                                        f"got {episode!r}")
+            if episode > self._episode:
+                self._episode, self._last_sim_time = int(episode), None
+        elif self._last_sim_time is not None and t < self._last_sim_time:
+            self._episode += 1
         wall = time.time() if wall_time is None else float(wall_time)
+        if not math.isfinite(wall) or wall < 0:
+            raise InvalidInputError(f"wall_time must be finite Unix seconds >= 0, got {wall_time!r}")
         cert = certificate.to_dict() if hasattr(certificate, "to_dict") else dict(certificate)
         if cert.get("verdict") not in ("certified", "violation", "uncertain"):
             raise InvalidInputError(f"certificate verdict must be certified/violation/uncertain, "
                                     f"got {cert.get('verdict')!r}")
+        if plan is not None:
+            plan_msg = _plan_payload(plan)  # validates before anything is written
+        cert = _null_unknown(cert)
+        log_ns = max(_ns(wall), self._last_log_ns + 1)
+        sim_ns = _ns(t)
         k = self._index
         if self._model is None and plan is not None and getattr(plan, "model", None) is not None:
             self._attach_model(plan.model)
-        head = {"index": k, "sim_time": t, "wall_time": wall}
+        head = {"index": k, "episode": self._episode, "sim_time": t, "wall_time": wall}
         if plan is not None:
-            self._put(topics.PLAN, t_ns, _dumps({**head, **_plan_payload(plan)}))
-        self._put(topics.CERTIFICATE, t_ns, _dumps({**head, **cert}))
+            self._put(topics.PLAN, log_ns, sim_ns, _dumps({**head, **plan_msg}))
+        self._put(topics.CERTIFICATE, log_ns, sim_ns, _dumps({**head, **cert}))
         if cert["verdict"] != "certified":
             bad = [p for p in cert.get("pairs", []) if p.get("verdict") != "certified"]
-            self._put(topics.VIOLATION, t_ns, _dumps({
+            self._put(topics.VIOLATION, log_ns, sim_ns, _dumps({
                 **head, "verdict": cert["verdict"], "window": cert.get("window"),
                 "margin": cert.get("margin"), "earliest_time": cert.get("earliest_time"),
                 "clearance": cert.get("clearance"),
                 "witness": cert.get("witness"), "pairs": bad, "replaced": bool(replaced)}))
+        if replaced and reason is None:
+            reason = (cert["verdict"] if cert["verdict"] != "certified"
+                      else "replaced although the window is certified (e.g. its braking tail is not)")
         if proposed_action is not None or applied_action is not None or replaced:
-            self._put(topics.ACTION, t_ns, _dumps({
+            self._put(topics.ACTION, log_ns, sim_ns, _dumps({
+                "reason": str(reason) if replaced else None,
                 **head, "proposed": None if proposed_action is None else np.ravel(proposed_action),
                 "applied": None if applied_action is None else np.ravel(applied_action),
                 "replaced": bool(replaced)}))
+        if cert["verdict"] != "certified" or replaced:
+            level, text = log_line(k, self._episode, t, cert, reason if replaced else None)
+            self._put(topics.LOG, log_ns, sim_ns, _dumps({
+                "timestamp": {"sec": log_ns // 1_000_000_000, "nsec": log_ns % 1_000_000_000},
+                "level": level, "message": text, "name": "monitor", "file": "", "line": 0, **head}))
         if self._scene is not None and plan is not None and hasattr(plan, "qpos"):
-            for topic, data in self._scene.window_messages(t_ns, plan, cert):
-                self._put(topic, t_ns, data)
+            for topic, data in self._scene.window_messages(log_ns, plan, cert):
+                self._put(topic, log_ns, sim_ns, data)
         self._index += 1
+        self._last_sim_time = t
+        self._last_log_ns = log_ns
         self._flush()
         return k
 
     def close(self) -> None:
-        """Write the MCAP summary/footer and close the file (idempotent)."""
+        """Finish the journal, then (``index=True``) finalise it into an indexed file (idempotent).
+
+        If finalisation fails, the complete journal stays at ``path`` and the reason is
+        in :attr:`finalise_error` (``review --reindex`` can retry).
+        """
         if self._closed:
             return
         self._closed = True
@@ -463,7 +560,161 @@ class MonitorLog:
             self._w.finish()
         finally:
             self._f.close()
+        if self._index_on_close:
+            try:
+                finalise_log(self.path)
+            except (OSError, LogFormatError) as exc:
+                self.finalise_error = f"{type(exc).__name__}: {exc}"
 
 
-__all__ = ["MonitorLog", "ModelExport", "export_model", "default_path", "package_versions",
-           "MAX_MESSAGES_PER_WINDOW", "XML_GEOMETRY_TOL"]
+# --------------------------------------------------------------------------- helpers
+
+
+def encode_metadata(values: dict[str, Any]) -> dict[str, str]:
+    """MCAP metadata map: strings as is, other values as JSON text listed under ``_json_keys``."""
+    out: dict[str, str] = {}
+    json_keys = []
+    for k, v in values.items():
+        key = str(k)
+        if key == topics.METADATA_JSON_KEYS:
+            raise InvalidInputError(f"metadata key {key!r} is reserved")
+        if isinstance(v, str):
+            out[key] = v
+        else:
+            out[key] = json.dumps(_jsonable(v), allow_nan=False)
+            json_keys.append(key)
+    out[topics.METADATA_JSON_KEYS] = ",".join(json_keys)
+    return out
+
+
+LOG_LEVEL_WARNING = 3
+LOG_LEVEL_ERROR = 4
+
+
+def _fmt(x: Any, unit: str = "") -> str:
+    return "unknown" if x is None else f"{float(x):.4g}{unit}"
+
+
+def log_line(index: int, episode: int, sim_time: float, cert: dict[str, Any],
+             replaced_reason: str | None) -> tuple[int, str]:
+    """(foxglove.Log level, one-line message) for a non-certified window or a replaced action.
+
+    ``replaced_reason`` is None when the action was not replaced.
+    """
+    where = f"window {index} (episode {episode}, t={sim_time:.4f} s)"
+    verdict = cert.get("verdict")
+    wit = cert.get("witness")
+    if verdict == "violation" and wit:
+        ga, gb = wit.get("geoms", ["?", "?"])
+        text = (f"{where}: violation {ga} / {gb} at t={_fmt(wit.get('time'), ' s')}, "
+                f"distance {_fmt(wit.get('distance'), ' m')} < margin {_fmt(cert.get('margin'), ' m')}")
+        level = LOG_LEVEL_ERROR
+    elif verdict in ("violation", "uncertain"):
+        n = sum(1 for p in cert.get("pairs", []) if p.get("verdict") != "certified")
+        text = (f"{where}: {verdict} from t={_fmt(cert.get('earliest_time'), ' s')} "
+                f"({n} pair(s) not certified; clearance {_fmt(cert.get('clearance'), ' m')})")
+        level = LOG_LEVEL_ERROR if verdict == "violation" else LOG_LEVEL_WARNING
+    else:
+        text, level = f"{where}: certified", LOG_LEVEL_WARNING
+    if replaced_reason is not None:
+        text += f"; action replaced ({replaced_reason})"
+    return level, text
+
+
+@dataclass
+class FinaliseResult:
+    """What :func:`finalise_log` did.
+
+    Attributes:
+        path: the rewritten file.
+        messages: messages copied.
+        windows: certificate messages copied.
+        source_complete: the source had its footer (a cleanly closed journal or log).
+        dropped_bytes: trailing bytes of the source that held no complete record (lost).
+        stop_reason: why reading the source stopped early (None when complete).
+    """
+
+    path: Path
+    messages: int
+    windows: int
+    source_complete: bool
+    dropped_bytes: int
+    stop_reason: str | None
+
+
+def finalise_log(path: str | os.PathLike[str], *, chunk_bytes: int = FINAL_CHUNK_BYTES) -> FinaliseResult:
+    """Rewrite a monitor log (journal, killed writer's file, or finished log) as a chunked, indexed MCAP.
+
+    Every complete record is copied in file order (messages keep their ``log_time``,
+    ``publish_time`` and ``sequence``; attachments and metadata keep theirs) into a
+    zstd-chunked file with a full summary, written next to ``path`` and atomically
+    renamed over it. A record cut by a crash is dropped (reported in the result and in
+    a ``monitor.finalise`` metadata record).
+
+    Raises:
+        LogFormatError: ``path`` is missing or not an MCAP file.
+    """
+    from monitor.log.reader import MAGIC, LogContents, _records, _Walker
+
+    src = Path(path)
+    if not src.is_file():
+        raise LogFormatError(f"{src}: no such file")
+    size = src.stat().st_size
+    state = LogContents(path=str(src), size=size)
+    tmp = src.with_name(src.name + ".finalise.tmp")
+    n_msg = n_cert = 0
+    try:
+        with open(src, "rb") as fi, open(tmp, "wb") as fo:
+            walk = _Walker(fi, size, None)
+            if walk.read_exact(len(MAGIC)) != MAGIC:
+                raise LogFormatError(f"{src}: not an MCAP file ({size} bytes)")
+            w = Writer(fo, chunk_size=int(chunk_bytes), compression=CompressionType.ZSTD)
+            started = False
+            smap: dict[int, int] = {}
+            cmap: dict[int, int] = {}
+            cert_channels: set[int] = set()
+            for rec in _records(walk, state):
+                if isinstance(rec, Header):
+                    w.start(profile=rec.profile, library=rec.library)
+                    started = True
+                elif not started:
+                    raise LogFormatError(f"{src}: no MCAP header record")
+                elif isinstance(rec, Schema):
+                    if rec.id not in smap:
+                        smap[rec.id] = w.register_schema(rec.name, rec.encoding, bytes(rec.data))
+                elif isinstance(rec, Channel):
+                    if rec.id not in cmap:
+                        cmap[rec.id] = w.register_channel(rec.topic, rec.message_encoding,
+                                                          smap.get(rec.schema_id, 0), dict(rec.metadata))
+                        if rec.topic == topics.CERTIFICATE:
+                            cert_channels.add(rec.id)
+                elif isinstance(rec, Message):
+                    if rec.channel_id in cmap:
+                        w.add_message(cmap[rec.channel_id], rec.log_time, bytes(rec.data), rec.publish_time,
+                                      rec.sequence)
+                        n_msg += 1
+                        n_cert += rec.channel_id in cert_channels
+                elif isinstance(rec, Metadata):
+                    if rec.name != topics.METADATA_FINALISE:
+                        w.add_metadata(rec.name, dict(rec.metadata))
+                elif isinstance(rec, Attachment):
+                    w.add_attachment(rec.create_time, rec.log_time, rec.name, rec.media_type, bytes(rec.data))
+            if not started:
+                raise LogFormatError(f"{src}: no MCAP header record")
+            dropped = 0 if state.complete else size - state.readable_bytes
+            w.add_metadata(topics.METADATA_FINALISE, encode_metadata({
+                "finalised_utc": _dt.datetime.now(_dt.UTC).isoformat(), "source_bytes": size,
+                "source_complete": state.complete, "dropped_bytes": dropped, "messages": n_msg,
+                "stop_reason": state.stop_reason}))
+            w.finish()
+            fo.flush()
+            os.fsync(fo.fileno())
+        os.replace(tmp, src)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return FinaliseResult(src, n_msg, n_cert, state.complete, dropped, state.stop_reason)
+
+
+__all__ = ["MonitorLog", "ModelExport", "FinaliseResult", "export_model", "finalise_log", "default_path",
+           "package_versions", "encode_metadata", "log_line", "MAX_MESSAGES_PER_WINDOW", "XML_GEOMETRY_TOL"]
