@@ -22,6 +22,9 @@ from mcap.writer import CompressionType, Writer
 
 from monitor.cli import main
 from monitor.log import MonitorLog, topics
+from monitor.log.digest import METADATA_DIGEST
+from monitor.log.reader import _decode_metadata
+from monitor.log.writer import encode_metadata
 
 REPO = Path(__file__).resolve().parents[1]
 ARM = REPO / "models" / "arm" / "scene.xml"
@@ -79,10 +82,12 @@ def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = No
         cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
                 for cid, c in s.channels.items()}
         for m in r.iter_metadata():
-            values = {k: json.loads(v) for k, v in m.metadata.items()}
+            if m.name == METADATA_DIGEST:  # a forger strips the seal (the log then reads "unsealed")
+                continue
+            values = _decode_metadata(dict(m.metadata))
             if metadata is not None:
                 values = metadata(m.name, values)
-            w.add_metadata(m.name, {k: json.dumps(v) for k, v in values.items()})
+            w.add_metadata(m.name, encode_metadata(values))
         for a in r.iter_attachments():
             data = a.data if attachments is None else attachments(a.name, a.data)
             if data is not None:

@@ -30,6 +30,8 @@ import hashlib
 import json
 from typing import Any
 
+from monitor.log.topics import METADATA_FINALISE  # added after sealing by finalise_log: not covered
+
 METADATA_DIGEST = "monitor.digest"
 """Metadata record holding the seal (written last, excluded from the digest itself)."""
 ALGORITHM = "monitor-sha256-chain/1"
@@ -76,7 +78,7 @@ class Digest:
 
     def metadata(self, name: str, values: dict[str, str]) -> None:
         """One metadata record with its raw (stored) string values; the seal record is ignored."""
-        if name == METADATA_DIGEST:
+        if name in (METADATA_DIGEST, METADATA_FINALISE):
             return
         self._metadata.append(json.dumps([name, sorted(values.items())], ensure_ascii=True).encode())
 

@@ -466,6 +466,17 @@ def _closing_magic(w: _Walker, out: LogContents) -> None:
         out.stop_reason, out.stop_kind = "footer not followed by the closing MCAP magic", "corrupt"
 
 
+def _ends_with_magic(f: BinaryIO, size: int) -> bool:
+    """True when the file's last bytes are the closing MCAP magic (restores the position)."""
+    if size < 2 * len(MAGIC) + _FOOTER_RECORD:
+        return False
+    here = f.tell()
+    f.seek(size - len(MAGIC))
+    closed = f.read(len(MAGIC)) == MAGIC
+    f.seek(here)
+    return closed
+
+
 def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> LogContents:
     """Read every complete record of a (possibly truncated or damaged) monitor MCAP log.
 
@@ -505,10 +516,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
             if magic != MAGIC:
                 kind = "empty file" if size == 0 else "does not start with the MCAP magic"
                 raise LogFormatError(f"{p}: not an MCAP file ({kind}; {size} bytes)")
-            if size >= 2 * len(MAGIC) + _FOOTER_RECORD:
-                f.seek(size - len(MAGIC))
-                out.closed_by_writer = f.read(len(MAGIC)) == MAGIC
-                f.seek(len(MAGIC))
+            out.closed_by_writer = _ends_with_magic(f, size)
             out.readable_bytes = w.pos
             for rec in _records(w, out):
                 if isinstance(rec, Header):

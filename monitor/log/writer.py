@@ -57,6 +57,7 @@ from mcap.writer import CompressionType, Writer
 from monitor._json import jsonable
 from monitor.errors import InvalidInputError, LogFormatError
 from monitor.log import topics
+from monitor.log.digest import METADATA_DIGEST, Digest
 
 MAX_MESSAGES_PER_WINDOW = 8
 """Upper bound on records one window writes (plan, certificate, violation, action,
@@ -332,6 +333,7 @@ class MonitorLog:
         self._w = Writer(self._f, use_chunking=False, compression=CompressionType.NONE,
                          enable_crcs=True, enable_data_crcs=False)
         self._w.start(profile=topics.PROFILE, library=f"{topics.LIBRARY}/{package_versions()['monitor']}")
+        self._digest = Digest()  # tamper-evidence seal, written at close (monitor.log.digest)
         self._channels: dict[str, int] = {}
         for topic, (name, _) in topics.JSON_TOPICS.items():
             sid = self._w.register_schema(name=name, encoding="jsonschema",
@@ -406,21 +408,19 @@ class MonitorLog:
         dicts) as JSON text, and its key is listed in :data:`topics.METADATA_JSON_KEYS`.
         """
         self._check_open()
-        self._w.add_metadata(name, encode_metadata(values))
+        enc = encode_metadata(values)
+        self._w.add_metadata(name, enc)
+        self._digest.metadata(name, enc)
         self._flush()
 
     def _attach_model(self, model: Any) -> None:
         exp = export_model(model, self._model_source)
         self._model = model
-        t = self._open_ns
         if exp.xml is not None:
-            self._w.add_attachment(create_time=t, log_time=t, name=topics.ATTACHMENT_XML,
-                                   media_type="application/xml", data=exp.xml.encode("utf-8"))
+            self._attach(topics.ATTACHMENT_XML, "application/xml", exp.xml.encode("utf-8"))
             for fname, data in exp.assets.items():
-                self._w.add_attachment(create_time=t, log_time=t, name=topics.ASSET_PREFIX + fname,
-                                       media_type="model/stl", data=data)
-        self._w.add_attachment(create_time=t, log_time=t, name=topics.ATTACHMENT_MJB,
-                               media_type="application/x-mujoco-mjb", data=exp.mjb)
+                self._attach(topics.ASSET_PREFIX + fname, "model/stl", data)
+        self._attach(topics.ATTACHMENT_MJB, "application/x-mujoco-mjb", exp.mjb)
         info = dict(exp.info)
         info.update({"nq": int(model.nq), "nbody": int(model.nbody), "ngeom": int(model.ngeom),
                      "nmocap": int(model.nmocap), "assets": sorted(exp.assets)})
@@ -442,6 +442,11 @@ class MonitorLog:
                                                                  schema_id=sid)
             self.foxglove_enabled = True
 
+    def _attach(self, name: str, media_type: str, data: bytes) -> None:
+        t = self._open_ns
+        self._w.add_attachment(create_time=t, log_time=t, name=name, media_type=media_type, data=data)
+        self._digest.attachment(name, media_type, data)
+
     # ----------------------------------------------------------------- writing
     def _check_open(self) -> None:
         if self._closed:
@@ -450,6 +455,7 @@ class MonitorLog:
     def _put(self, topic: str, log_ns: int, sim_ns: int, data: bytes) -> None:
         self._w.add_message(self._channels[topic], log_time=log_ns, data=data, publish_time=sim_ns,
                             sequence=self._seq)
+        self._digest.message(topic, log_ns, sim_ns, self._seq, data)
         self._seq += 1
 
     def _flush(self) -> None:
@@ -557,6 +563,7 @@ class MonitorLog:
             return
         self._closed = True
         try:
+            self._w.add_metadata(METADATA_DIGEST, self._digest.seal())
             self._w.finish()
         finally:
             self._f.close()
@@ -654,7 +661,7 @@ def finalise_log(path: str | os.PathLike[str], *, chunk_bytes: int = FINAL_CHUNK
     Raises:
         LogFormatError: ``path`` is missing or not an MCAP file.
     """
-    from monitor.log.reader import MAGIC, LogContents, _records, _Walker
+    from monitor.log.reader import MAGIC, LogContents, _ends_with_magic, _records, _Walker
 
     src = Path(path)
     if not src.is_file():
@@ -668,6 +675,7 @@ def finalise_log(path: str | os.PathLike[str], *, chunk_bytes: int = FINAL_CHUNK
             walk = _Walker(fi, size, None)
             if walk.read_exact(len(MAGIC)) != MAGIC:
                 raise LogFormatError(f"{src}: not an MCAP file ({size} bytes)")
+            state.closed_by_writer = _ends_with_magic(fi, size)
             w = Writer(fo, chunk_size=int(chunk_bytes), compression=CompressionType.ZSTD)
             started = False
             smap: dict[int, int] = {}
