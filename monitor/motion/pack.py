@@ -96,63 +96,100 @@ class MotionPack(NamedTuple):
 
 
 def _f64(a: object, shape: tuple[int, ...] | None = None) -> np.ndarray:
-    out = np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+    """Writable C-contiguous float64 (read-only arrays would compile a second specialisation)."""
+    out = np.asarray(a, dtype=np.float64)
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        out = np.array(out, dtype=np.float64, order="C")
     return out.reshape(shape) if shape is not None else out
 
 
 def _i64(a: object) -> np.ndarray:
-    return np.ascontiguousarray(np.asarray(a, dtype=np.int64)).reshape(-1)
+    out = np.asarray(a, dtype=np.int64).reshape(-1)
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        out = np.array(out, dtype=np.int64, order="C")
+    return out
 
 
-def _tracks(qpos: np.ndarray, adr: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Quaternion tracks of qpos columns adr[k]..adr[k]+3, with ``QuatTrack``'s formulas (vectorised)."""
-    K = qpos.shape[0]
-    n = adr.shape[0]
-    if n == 0:
-        return (np.zeros((0, K - 1, 4)), np.zeros((0, K - 1)), np.zeros((0, K - 1)), np.zeros((0, K)),
-                np.zeros((0, K - 1), dtype=np.int64))
-    cols = adr[:, None] + np.arange(4)[None, :]  # (n, 4)
-    q = np.transpose(qpos[:, cols], (1, 0, 2))  # (n, K, 4)
-    a = q[:, :-1]
-    b = q[:, 1:].copy()
-    flip = np.einsum("nkj,nkj->nk", a, b) < 0
-    b[flip] *= -1.0
-    half = 2.0 * np.arctan2(np.linalg.norm(b - a, axis=-1), np.linalg.norm(b + a, axis=-1))
-    phi = 2.0 * half
-    cum = np.concatenate([np.zeros((n, 1)), np.cumsum(phi, axis=1)], axis=1)
-    same = np.all(a == b, axis=-1).astype(np.int64)
-    return (np.ascontiguousarray(b), np.ascontiguousarray(half), np.ascontiguousarray(phi),
-            np.ascontiguousarray(cum), np.ascontiguousarray(same))
+class _Static(NamedTuple):
+    """The model-only part of a pack (shared by every pack of one model structure; never written)."""
+
+    qpos0: np.ndarray
+    jnt_type: np.ndarray
+    jnt_qposadr: np.ndarray
+    jnt_pos: np.ndarray
+    jnt_axis: np.ndarray
+    jnt_axis_norm: np.ndarray
+    jnt_track: np.ndarray
+    body_parent: np.ndarray
+    body_jntadr: np.ndarray
+    body_jntnum: np.ndarray
+    body_pos: np.ndarray
+    body_quat: np.ndarray
+    body_mocap: np.ndarray
+    mocapid: np.ndarray
+    ref_points: np.ndarray
+    qt_adr: np.ndarray
+    qpos0_mag: float
 
 
-def _finish(times: np.ndarray, qpos: np.ndarray, qpos0: np.ndarray, jnt_type: np.ndarray,
-            jnt_qposadr: np.ndarray, jnt_pos: np.ndarray, jnt_axis: np.ndarray,
-            body_parent: np.ndarray, body_jntadr: np.ndarray, body_jntnum: np.ndarray,
-            body_pos: np.ndarray, body_quat: np.ndarray, body_mocap: np.ndarray,
-            ref_points: np.ndarray, tol: Tolerances) -> MotionPack:
-    """Derived arrays (tracks, flags, magnitudes, rounding scale) and the pack."""
-    nbody = body_parent.shape[0]
-    quat_j = np.flatnonzero((jnt_type == _FREE) | (jnt_type == _BALL))
-    qt_adr = _i64(jnt_qposadr[quat_j] + np.where(jnt_type[quat_j] == _FREE, 3, 0))
-    jnt_track = np.full(jnt_type.shape[0], -1, dtype=np.int64)
+def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: object, jnt_axis: object,
+            body_parent: object, body_jntadr: object, body_jntnum: object, body_pos: object,
+            body_quat: object, mocapid: object, ref_points: object, check_free: bool = True) -> _Static:
+    jt = _i64(jnt_type)
+    jadr = _i64(jnt_qposadr)
+    jpos = _f64(np.array(jnt_pos, dtype=np.float64), (-1, 3))
+    jaxis = _f64(np.array(jnt_axis, dtype=np.float64), (-1, 3))
+    parent = _i64(body_parent)
+    jntadr = _i64(body_jntadr)
+    jntnum = _i64(body_jntnum)
+    if check_free and (jt == _FREE).any():
+        for b in range(parent.shape[0]):
+            js = range(int(jntadr[b]), int(jntadr[b] + jntnum[b]))
+            if any(jt[j] == _FREE for j in js) and (jntnum[b] != 1 or parent[b] != 0):
+                raise UnsupportedGeometryError(
+                    f"model body {b}: a free joint must be the only joint of a child of the world")
+    quat_j = np.flatnonzero((jt == _FREE) | (jt == _BALL))
+    jnt_track = np.full(jt.shape[0], -1, dtype=np.int64)
     jnt_track[quat_j] = np.arange(quat_j.shape[0])
-    target, half, phi, cum, same = _tracks(qpos, qt_adr)
-    axis_norm = np.linalg.norm(jnt_axis, axis=-1) if jnt_axis.shape[0] else np.zeros(0)
-    axis_norm = np.where((jnt_type == _HINGE) | (jnt_type == _SLIDE), axis_norm, 1.0).astype(np.float64)
-    moving = np.zeros(nbody, dtype=np.int64)
-    rotating = np.zeros(nbody, dtype=np.int64)
-    KN.motion_flags(qpos, body_parent, body_mocap, body_jntadr, body_jntnum, jnt_type, jnt_qposadr,
-                    moving, rotating)
-    qmag = float(np.max(np.abs(qpos), initial=0.0)) + float(np.max(np.abs(qpos0), initial=0.0))
-    pathmag = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
-    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, qmag, pathmag], dtype=np.float64)
+    axis_norm = np.linalg.norm(jaxis, axis=-1) if jaxis.shape[0] else np.zeros(0)
+    axis_norm = np.where((jt == _HINGE) | (jt == _SLIDE), axis_norm, 1.0).astype(np.float64)
+    mid = _i64(mocapid)
+    body_mocap = (mid >= 0).astype(np.int64)
+    body_mocap[0] = 1
+    q0 = _f64(np.array(qpos0, dtype=np.float64))
+    return _Static(
+        qpos0=q0, jnt_type=jt, jnt_qposadr=jadr, jnt_pos=jpos, jnt_axis=jaxis,
+        jnt_axis_norm=_f64(axis_norm), jnt_track=jnt_track, body_parent=parent, body_jntadr=jntadr,
+        body_jntnum=jntnum, body_pos=_f64(np.array(body_pos, dtype=np.float64), (-1, 3)),
+        body_quat=_f64(np.array(body_quat, dtype=np.float64), (-1, 4)), body_mocap=body_mocap, mocapid=mid,
+        ref_points=_f64(np.array(ref_points, dtype=np.float64), (-1, 3)),
+        qt_adr=_i64(jadr[quat_j] + np.where(jt[quat_j] == _FREE, 3, 0)),
+        qpos0_mag=float(np.max(np.abs(q0), initial=0.0)))
+
+
+def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
+            tol: Tolerances) -> MotionPack:
+    """Derived arrays (tracks, flags, magnitudes: one compiled call; rounding scale: one more)."""
+    K = qpos.shape[0]
+    nqt = st.qt_adr.shape[0]
+    nbody = st.body_parent.shape[0]
+    target = np.empty((nqt, K - 1, 4))
+    half = np.empty((nqt, K - 1))
+    phi = np.empty((nqt, K - 1))
+    cum = np.empty((nqt, K))
+    same = np.empty((nqt, K - 1), dtype=np.int64)
+    moving = np.empty(nbody, dtype=np.int64)
+    rotating = np.empty(nbody, dtype=np.int64)
+    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, 0.0])
+    KN.derive(qpos, st.qt_adr, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
+              st.jnt_qposadr, target, half, phi, cum, same, moving, rotating, tol_arr)
+    tol_arr[KN.TOL_QMAG] += st.qpos0_mag
     mp = MotionPack(
-        times=_f64(times), qpos=_f64(qpos), qpos0=_f64(qpos0), jnt_type=_i64(jnt_type),
-        jnt_qposadr=_i64(jnt_qposadr), jnt_pos=_f64(jnt_pos, (-1, 3)), jnt_axis=_f64(jnt_axis, (-1, 3)),
-        jnt_axis_norm=_f64(axis_norm), jnt_track=jnt_track, body_parent=_i64(body_parent),
-        body_jntadr=_i64(body_jntadr), body_jntnum=_i64(body_jntnum), body_pos=_f64(body_pos, (-1, 3)),
-        body_quat=_f64(body_quat, (-1, 4)), body_mocap=_i64(body_mocap), body_moving=moving,
-        body_rotating=rotating, ref_points=_f64(ref_points, (-1, 3)), qt_adr=qt_adr, qt_target=target,
+        times=times, qpos=qpos, qpos0=st.qpos0, jnt_type=st.jnt_type, jnt_qposadr=st.jnt_qposadr,
+        jnt_pos=st.jnt_pos, jnt_axis=st.jnt_axis, jnt_axis_norm=st.jnt_axis_norm, jnt_track=st.jnt_track,
+        body_parent=st.body_parent, body_jntadr=st.body_jntadr, body_jntnum=st.body_jntnum,
+        body_pos=body_pos, body_quat=body_quat, body_mocap=st.body_mocap, body_moving=moving,
+        body_rotating=rotating, ref_points=st.ref_points, qt_adr=st.qt_adr, qt_target=target,
         qt_half=half, qt_phi=phi, qt_cum=cum, qt_same=same, tol=tol_arr)
     if moving.any():
         tol_arr[KN.TOL_SCALE] = KN.rounding_scale(mp)  # the pack shares tol_arr
@@ -160,7 +197,6 @@ def _finish(times: np.ndarray, qpos: np.ndarray, qpos0: np.ndarray, jnt_type: np
 
 
 def _pack_body_motion(bm: BodyMotion) -> MotionPack:
-    times = bm.times
     pos = bm.pos
     quat = bm.quat
     K, nbody = pos.shape[0], pos.shape[1]
@@ -171,45 +207,64 @@ def _pack_body_motion(bm: BodyMotion) -> MotionPack:
     body_quat[:, 0] = 1.0
     body_pos[0] = pos[0, 0]
     body_quat[0] = quat[0, 0]
-    body_mocap = np.zeros(nbody, dtype=np.int64)
-    body_mocap[0] = 1
     jnt_axis = np.zeros((nj, 3))
     jnt_axis[:, 2] = 1.0
-    return _finish(times, qpos, np.zeros(7 * nj), np.zeros(nj, dtype=np.int64), 7 * np.arange(nj),
-                   np.zeros((nj, 3)), jnt_axis, np.zeros(nbody, dtype=np.int64),
-                   np.concatenate([[0], np.arange(nj)]), np.concatenate([[0], np.ones(nj, dtype=np.int64)]),
-                   body_pos, body_quat, body_mocap, bm.ref_points, bm._tol)
+    st = _static(np.zeros(7 * nj), np.zeros(nj, dtype=np.int64), 7 * np.arange(nj), np.zeros((nj, 3)),
+                 jnt_axis,
+                 np.zeros(nbody, dtype=np.int64), np.concatenate([[0], np.arange(nj)]),
+                 np.concatenate([[0], np.ones(nj, dtype=np.int64)]), body_pos, body_quat,
+                 np.full(nbody, -1), bm.ref_points, check_free=False)
+    return _finish(st, _f64(bm.times), _f64(qpos), st.body_pos, st.body_quat, bm._tol)
+
+
+def _plan_static(plan: object) -> _Static:
+    """The model part of a Plan's pack, cached on the plan's model structure when it has one.
+
+    ``Plan._st`` (plan.py's ``_ModelStructure``) is keyed by the bytes of every model
+    array it reads, so a model edited in place gets a new one; its copies are the
+    snapshot the plan was built on. Without it the model is read as it is now.
+    """
+    st = getattr(plan, "_st", None)
+    if st is not None:
+        hit = getattr(st, "_motion_pack_static", None)
+        if hit is not None:
+            return hit
+        try:
+            jnt = st.jnt
+            jntadr = [js[0] if js else 0 for js in st.jnt_of_body]
+            out = _static(jnt["qpos0"], jnt["type"], jnt["adr"], jnt["pos"], jnt["axis"], st.parent, jntadr,
+                          [len(js) for js in st.jnt_of_body], st.body_pos, st.body_quat,
+                          plan.model.body_mocapid, st.ref)
+        except (AttributeError, KeyError, TypeError):
+            out = None
+        if out is not None:
+            _world_identity(out)
+            st._motion_pack_static = out
+            return out
+    m = plan.model
+    out = _static(m.qpos0, m.jnt_type, m.jnt_qposadr, m.jnt_pos, m.jnt_axis, m.body_parentid, m.body_jntadr,
+                  m.body_jntnum, m.body_pos, m.body_quat, m.body_mocapid, plan.ref_points)
+    _world_identity(out)
+    return out
+
+
+def _world_identity(st: _Static) -> None:
+    """MuJoCo's world body sits at the origin with identity orientation."""
+    st.body_pos[0] = 0.0
+    st.body_quat[0] = (1.0, 0.0, 0.0, 0.0)
 
 
 def _pack_plan(plan: object) -> MotionPack:
-    m = plan.model
-    jnt_type = _i64(m.jnt_type)
-    jnt_bodyid = _i64(m.jnt_bodyid)
-    body_jntnum = _i64(m.body_jntnum)
-    body_jntadr = _i64(m.body_jntadr)
-    body_parent = _i64(m.body_parentid)
-    free = np.flatnonzero(jnt_type == _FREE)
-    for j in free:
-        b = int(jnt_bodyid[j])
-        if body_jntnum[b] != 1 or body_parent[b] != 0:
-            raise UnsupportedGeometryError(
-                f"model joint {j}: a free joint must be the only joint of a child of the world (body {b})")
-    mocapid = _i64(m.body_mocapid)
-    body_mocap = (mocapid >= 0).astype(np.int64)
-    body_pos = np.array(m.body_pos, dtype=np.float64).reshape(-1, 3)
-    body_quat = np.array(m.body_quat, dtype=np.float64).reshape(-1, 4)
-    if m.nmocap:
-        mb = np.flatnonzero(mocapid >= 0)
-        body_pos[mb] = plan.mocap_pos[mocapid[mb]]
-        body_quat[mb] = plan.mocap_quat[mocapid[mb]]
-    body_mocap[0] = 1
-    body_pos[0] = 0.0
-    body_quat[0] = (1.0, 0.0, 0.0, 0.0)
-    return _finish(plan.times, plan.qpos, np.asarray(m.qpos0, dtype=np.float64), jnt_type,
-                   _i64(m.jnt_qposadr), np.asarray(m.jnt_pos, dtype=np.float64).reshape(-1, 3),
-                   np.asarray(m.jnt_axis, dtype=np.float64).reshape(-1, 3), body_parent, body_jntadr,
-                   body_jntnum, body_pos, body_quat, body_mocap, plan.ref_points,
-                   getattr(plan, "_tol", DEFAULT))
+    st = _plan_static(plan)
+    body_pos = st.body_pos
+    body_quat = st.body_quat
+    mocap = np.flatnonzero(st.mocapid >= 0)
+    if mocap.size:
+        body_pos = body_pos.copy()
+        body_quat = body_quat.copy()
+        body_pos[mocap] = plan.mocap_pos[st.mocapid[mocap]]
+        body_quat[mocap] = plan.mocap_quat[st.mocapid[mocap]]
+    return _finish(st, _f64(plan.times), _f64(plan.qpos), body_pos, body_quat, getattr(plan, "_tol", DEFAULT))
 
 
 def pack_trajectory(traj: object) -> MotionPack:
