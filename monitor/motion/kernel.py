@@ -200,9 +200,9 @@ def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 # ------------------------------------------------------------------ interpolation
 @njit(cache=True)
-def _lerp_col(mp, c: int, i: int, s: float, at_end: bool) -> float:
+def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float:
     """Interpolated qpos column c at (segment i, parameter s)."""
-    q = mp.qpos
+    q = qpos
     if at_end:
         return q[q.shape[0] - 1, c]
     a = q[i, c]
@@ -210,49 +210,54 @@ def _lerp_col(mp, c: int, i: int, s: float, at_end: bool) -> float:
 
 
 @njit(cache=True)
-def _slerp(mp, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
+def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
+           qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
-    adr = mp.qt_adr[k]
-    q = mp.qpos
+    adr = qt_adr[k]
+    q = qpos
     if at_end:
         last = q.shape[0] - 1
         for c in range(4):
             out[c] = q[last, adr + c]
         return
-    if mp.qt_same[k, i] != 0 or s == 0.0:
+    if qt_same[k, i] != 0 or s == 0.0:
         for c in range(4):
             out[c] = q[i, adr + c]
         return
-    h = mp.qt_half[k, i]
+    h = qt_half[k, i]
     den = _sinc(h)
     c0 = (1.0 - s) * _sinc((1.0 - s) * h) / den
     c1 = s * _sinc(s * h) / den
     for c in range(4):
-        out[c] = c0 * q[i, adr + c] + c1 * mp.qt_target[k, i, c]
+        out[c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
 
 
 @njit(cache=True)
-def _qpos_at(mp, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
+def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
+             qt_target: np.ndarray, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Interpolated qpos (nq,) at (segment i, parameter s)."""
-    nq = mp.qpos.shape[1]
+    nq = qpos.shape[1]
     for c in range(nq):
-        out[c] = _lerp_col(mp, c, i, s, at_end)
+        out[c] = _lerp_col(qpos, c, i, s, at_end)
     tmp = np.empty(4)
-    for k in range(mp.qt_adr.shape[0]):
-        _slerp(mp, k, i, s, at_end, tmp)
-        adr = mp.qt_adr[k]
+    for k in range(qt_adr.shape[0]):
+        _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, tmp)
+        adr = qt_adr[k]
         for c in range(4):
             out[adr + c] = tmp[c]
 
 
 @njit(cache=True)
-def _track_path(mp, k: int, i: int, s: float) -> float:
-    return mp.qt_cum[k, i] + s * mp.qt_phi[k, i]
+def _track_path(qt_cum: np.ndarray, qt_phi: np.ndarray, k: int, i: int, s: float) -> float:
+    return qt_cum[k, i] + s * qt_phi[k, i]
 
 
 # ------------------------------------------------------------------ forward kinematics
 @njit(cache=True)
-def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray,
+def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
+        body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
+        jnt_pos: np.ndarray, jnt_axis: np.ndarray, jnt_axis_norm: np.ndarray, qpos0: np.ndarray,
+        q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray,
         janchor: np.ndarray, jaxis: np.ndarray, jframe: np.ndarray) -> None:
     """MuJoCo's mj_kinematics for the bodies with need[b] != 0 (their ancestors must be needed too).
 
@@ -269,22 +274,22 @@ def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray
     for b in range(nbody):
         if need[b] == 0:
             continue
-        if b == 0 or mp.body_mocap[b] != 0:
+        if b == 0 or body_mocap[b] != 0:
             for c in range(3):
-                xpos[b, c] = mp.body_pos[b, c]
+                xpos[b, c] = body_pos[b, c]
             for c in range(4):
-                xquat[b, c] = mp.body_quat[b, c]
+                xquat[b, c] = body_quat[b, c]
             _quat_normalize(xquat[b])
             _quat_to_mat(xquat[b], xmat[b])
             continue
-        ja = mp.body_jntadr[b]
-        jn = mp.body_jntnum[b]
-        if jn >= 1 and mp.jnt_type[ja] == _FREE:
-            adr = mp.jnt_qposadr[ja]
+        ja = body_jntadr[b]
+        jn = body_jntnum[b]
+        if jn >= 1 and jnt_type[ja] == _FREE:
+            adr = jnt_qposadr[ja]
             for c in range(3):
                 xpos[b, c] = q[adr + c]
                 janchor[ja, c] = q[adr + c]
-                jaxis[ja, c] = mp.jnt_axis[ja, c]
+                jaxis[ja, c] = jnt_axis[ja, c]
             for c in range(4):
                 xquat[b, c] = q[adr + 3 + c]
             _quat_normalize(xquat[b])
@@ -294,24 +299,24 @@ def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray
             jframe[ja, 3] = 0.0
             _quat_to_mat(xquat[b], xmat[b])
             continue
-        p = mp.body_parent[b]
+        p = body_parent[b]
         for r in range(3):
-            xpos[b, r] = xpos[p, r] + (xmat[p, r, 0] * mp.body_pos[b, 0] + xmat[p, r, 1] * mp.body_pos[b, 1]
-                                       + xmat[p, r, 2] * mp.body_pos[b, 2])
-        _quat_mul(xquat[p], mp.body_quat[b], xquat[b])
+            xpos[b, r] = xpos[p, r] + (xmat[p, r, 0] * body_pos[b, 0] + xmat[p, r, 1] * body_pos[b, 1]
+                                       + xmat[p, r, 2] * body_pos[b, 2])
+        _quat_mul(xquat[p], body_quat[b], xquat[b])
         for j in range(ja, ja + jn):
-            typ = mp.jnt_type[j]
-            adr = mp.jnt_qposadr[j]
+            typ = jnt_type[j]
+            adr = jnt_qposadr[j]
             for c in range(4):
                 jframe[j, c] = xquat[b, c]
-            _rot_vec(xquat[b], mp.jnt_pos[j], tmp3)
+            _rot_vec(xquat[b], jnt_pos[j], tmp3)
             for c in range(3):
                 janchor[j, c] = tmp3[c] + xpos[b, c]
-            _rot_vec(xquat[b], mp.jnt_axis[j], tmp3)
+            _rot_vec(xquat[b], jnt_axis[j], tmp3)
             for c in range(3):
                 jaxis[j, c] = tmp3[c]
             if typ == _SLIDE:
-                d = q[adr] - mp.qpos0[adr]
+                d = q[adr] - qpos0[adr]
                 for c in range(3):
                     xpos[b, c] += jaxis[j, c] * d
                 continue
@@ -320,8 +325,8 @@ def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray
                     qloc[c] = q[adr + c]
                 _quat_normalize(qloc)
             else:  # hinge
-                ang = q[adr] - mp.qpos0[adr]
-                n = mp.jnt_axis_norm[j]
+                ang = q[adr] - qpos0[adr]
+                n = jnt_axis_norm[j]
                 if ang == 0.0:
                     qloc[0] = 1.0
                     qloc[1] = 0.0
@@ -331,9 +336,9 @@ def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray
                     sh = math.sin(0.5 * ang)
                     qloc[0] = math.cos(0.5 * ang)
                     for c in range(3):
-                        qloc[1 + c] = sh * mp.jnt_axis[j, c] / n
+                        qloc[1 + c] = sh * jnt_axis[j, c] / n
             _quat_mul(xquat[b], qloc, xquat[b])
-            _rot_vec(xquat[b], mp.jnt_pos[j], tmp3)
+            _rot_vec(xquat[b], jnt_pos[j], tmp3)
             for c in range(3):
                 xpos[b, c] = janchor[j, c] - tmp3[c]
         _quat_normalize(xquat[b])
@@ -341,7 +346,7 @@ def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray
 
 
 @njit(cache=True)
-def _ancestors(mp, body: int, need: np.ndarray) -> None:
+def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
     """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
     need[:] = 0
     c = body
@@ -349,7 +354,7 @@ def _ancestors(mp, body: int, need: np.ndarray) -> None:
         need[c] = 1
         if c == 0:
             break
-        c = mp.body_parent[c]
+        c = body_parent[c]
 
 
 @njit(cache=True)
@@ -358,17 +363,19 @@ def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray
     nbody = mp.body_parent.shape[0]
     njnt = mp.jnt_type.shape[0]
     need = np.empty(nbody, dtype=np.int64)
-    _ancestors(mp, body, need)
+    _ancestors(mp.body_parent, body, need)
     q = np.empty(mp.qpos.shape[1])
     i, s, at_end = _locate(mp.times, t)
-    _qpos_at(mp, i, s, at_end, q)
+    _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
     xpos = np.empty((nbody, 3))
     xquat = np.empty((nbody, 4))
     xmat = np.empty((nbody, 3, 3))
     ja = np.empty((njnt, 3))
     jx = np.empty((njnt, 3))
     jf = np.empty((njnt, 4))
-    _fk(mp, q, need, xpos, xquat, xmat, ja, jx, jf)
+    _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
+        mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
+        q, need, xpos, xquat, xmat, ja, jx, jf)
     for r in range(3):
         p_W_out[r] = xpos[body, r]
         for c in range(3):
@@ -383,41 +390,43 @@ def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
     need = np.ones(nbody, dtype=np.int64)
     q = np.empty(mp.qpos.shape[1])
     i, s, at_end = _locate(mp.times, t)
-    _qpos_at(mp, i, s, at_end, q)
+    _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
     xquat = np.empty((nbody, 4))
     ja = np.empty((njnt, 3))
     jx = np.empty((njnt, 3))
     jf = np.empty((njnt, 4))
-    _fk(mp, q, need, p_W_out, xquat, R_WB_out, ja, jx, jf)
+    _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
+        mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
+        q, need, p_W_out, xquat, R_WB_out, ja, jx, jf)
 
 
 # ------------------------------------------------------------------ joint deviations
 @njit(cache=True)
-def _col_dev(mp, c: int, qm_c: float, la, lb, lo: int, hi: int) -> float:
+def _col_dev(qpos: np.ndarray, c: int, qm_c: float, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of |q_c(t) - q_c(m)| (scalar_deviation)."""
-    va = _lerp_col(mp, c, la[0], la[1], la[2])
-    vb = _lerp_col(mp, c, lb[0], lb[1], lb[2])
+    va = _lerp_col(qpos, c, la[0], la[1], la[2])
+    vb = _lerp_col(qpos, c, lb[0], lb[1], lb[2])
     dev = max(abs(va - qm_c), abs(vb - qm_c))
     for w in range(lo, hi):
-        d = abs(mp.qpos[w, c] - qm_c)
+        d = abs(qpos[w, c] - qm_c)
         if d > dev:
             dev = d
     return dev
 
 
 @njit(cache=True)
-def _vec_dev(mp, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
+def _vec_dev(qpos: np.ndarray, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of ||x(t) - x(m)|| for qpos columns adr..adr+2 (vector_deviation)."""
     da = 0.0
     db = 0.0
     for c in range(3):
-        da += (_lerp_col(mp, adr + c, la[0], la[1], la[2]) - qm[adr + c]) ** 2
-        db += (_lerp_col(mp, adr + c, lb[0], lb[1], lb[2]) - qm[adr + c]) ** 2
+        da += (_lerp_col(qpos, adr + c, la[0], la[1], la[2]) - qm[adr + c]) ** 2
+        db += (_lerp_col(qpos, adr + c, lb[0], lb[1], lb[2]) - qm[adr + c]) ** 2
     dev = max(math.sqrt(da), math.sqrt(db))
     for w in range(lo, hi):
         d = 0.0
         for c in range(3):
-            d += (mp.qpos[w, adr + c] - qm[adr + c]) ** 2
+            d += (qpos[w, adr + c] - qm[adr + c]) ** 2
         d = math.sqrt(d)
         if d > dev:
             dev = d
@@ -425,11 +434,11 @@ def _vec_dev(mp, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
 
 
 @njit(cache=True)
-def _rot_dev(mp, k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, lm, lo: int, hi: int) -> float:
+def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np.ndarray, qt_phi: np.ndarray,
+             k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, lm, lo: int, hi: int) -> float:
     """Bound on the rotation angle of track k from the midpoint over [ta, tb] (rotation_deviation)."""
-    times = mp.times
     K = times.shape[0]
-    s_m = _track_path(mp, k, lm[0], lm[1])
+    s_m = _track_path(qt_cum, qt_phi, k, lm[0], lm[1])
     j = _search_right(times, tm) - 1
     if j < 0:
         j = 0
@@ -439,41 +448,119 @@ def _rot_dev(mp, k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, l
     near_right = max(min(times[min(j + 1, K - 1)], tb), tm)
     i_l, s_l, _ = _locate(times, near_left)
     i_r, s_r, _ = _locate(times, near_right)
-    dev = max(abs(s_m - _track_path(mp, k, i_l, s_l)), abs(_track_path(mp, k, i_r, s_r) - s_m))
-    adr = mp.qt_adr[k]
+    dev = max(abs(s_m - _track_path(qt_cum, qt_phi, k, i_l, s_l)),
+              abs(_track_path(qt_cum, qt_phi, k, i_r, s_r) - s_m))
+    adr = qt_adr[k]
     for w in range(lo, hi):
-        d_w = _quat_angle(mp.qpos[w, adr:adr + 4], qm_unit)
+        d_w = _quat_angle(qpos[w, adr:adr + 4], qm_unit)
         if times[w] <= tm:
             outer = max(times[max(w - 1, 0)], ta)
         else:
             outer = min(times[min(w + 1, K - 1)], tb)
         i_o, s_o, _ = _locate(times, outer)
-        v = d_w + abs(_track_path(mp, k, i_o, s_o) - mp.qt_cum[k, w])
+        v = d_w + abs(_track_path(qt_cum, qt_phi, k, i_o, s_o) - qt_cum[k, w])
         if v > dev:
             dev = v
     return min(dev, math.pi)
 
 
 @njit(cache=True)
-def _track_omega(mp, k: int, seg: int, out: np.ndarray) -> None:
+def _track_omega(qpos: np.ndarray, qt_adr: np.ndarray, qt_target: np.ndarray, qt_phi: np.ndarray, k: int,
+                 seg: int, out: np.ndarray) -> None:
     """Angular velocity (3,) per unit segment parameter of track k on segment seg.
 
     ``QuatTrack.angular_velocity`` with dt = 1, in the frame the quaternions map into.
     """
-    adr = mp.qt_adr[k]
-    a = mp.qpos[seg, adr:adr + 4]
-    b = mp.qt_target[k, seg]
+    adr = qt_adr[k]
+    a = qpos[seg, adr:adr + 4]
+    b = qt_target[k, seg]
     # vector part of b * conj(a)
     vx = -b[0] * a[1] + b[1] * a[0] - b[2] * a[3] + b[3] * a[2]
     vy = -b[0] * a[2] + b[1] * a[3] + b[2] * a[0] - b[3] * a[1]
     vz = -b[0] * a[3] - b[1] * a[2] + b[2] * a[1] + b[3] * a[0]
-    sc = 2.0 / _sinc(0.5 * mp.qt_phi[k, seg])
+    sc = 2.0 / _sinc(0.5 * qt_phi[k, seg])
     out[0] = vx * sc
     out[1] = vy * sc
     out[2] = vz * sc
 
 
 # ------------------------------------------------------------------ bounds
+@njit(cache=True)
+def _velocity_bound(chain: np.ndarray, L: int, vkind: np.ndarray, vrate: np.ndarray, D: np.ndarray,
+                    r0: np.ndarray, suffix: np.ndarray, rmax: np.ndarray, h: float, rel: float, qmag: float,
+                    pathmag: float, scale: float) -> tuple[float, float]:
+    """Second-order (Taylor) bound (T2 m, Th2 rad) for one chain: ``Plan._velocity_bound``, same pads.
+
+    chain[:L] virtual joints root first; D (L, 3) reference point minus anchors, r0 (L,) their norms;
+    suffix, rmax: (>= L,) scratch.
+    """
+    Vx = 0.0
+    Vy = 0.0
+    Vz = 0.0
+    Wx = 0.0
+    Wy = 0.0
+    Wz = 0.0
+    acc = 0.0
+    for li in range(L - 1, -1, -1):  # suffix sums of e (joints nearer the body)
+        v = chain[li]
+        kd = vkind[v]
+        rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+        wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
+        suffix[li] = acc
+        if rot:
+            e = _chord(wabs * h) * r0[li]
+        else:
+            e = wabs * h
+        acc += e
+    S_acc = 0.0
+    S0 = 0.0
+    sum_rmax = 0.0
+    for li in range(L - 1, -1, -1):
+        v = chain[li]
+        kd = vkind[v]
+        rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+        wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
+        rm = (r0[li] if rot else 0.0) + suffix[li]
+        rmax[li] = rm
+        sum_rmax += rm
+        S_acc += wabs * rm if rot else wabs
+        suffix[li] = S_acc  # now S_k
+    if L > 0:
+        S0 = suffix[0]
+    Omega = 0.0
+    A = 0.0
+    AW = 0.0
+    wrot_sum = 0.0
+    for li in range(L):
+        v = chain[li]
+        kd = vkind[v]
+        rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+        w0, w1, w2 = vrate[v, 0], vrate[v, 1], vrate[v, 2]
+        wabs = _norm3(w0, w1, w2)
+        if rot:
+            Vx += w1 * D[li, 2] - w2 * D[li, 1]
+            Vy += w2 * D[li, 0] - w0 * D[li, 2]
+            Vz += w0 * D[li, 1] - w1 * D[li, 0]
+            Wx += w0
+            Wy += w1
+            Wz += w2
+            A += wabs * (2.0 * Omega * rmax[li] + suffix[li])
+            AW += wabs * Omega
+            Omega += wabs
+            wrot_sum += wabs
+        else:
+            Vx += w0
+            Vy += w1
+            Vz += w2
+            A += wabs * Omega
+    mag = qmag + pathmag + 1.0
+    T2 = h * _norm3(Vx, Vy, Vz) + 0.5 * h * h * A
+    Th2 = h * _norm3(Wx, Wy, Wz) + 0.5 * h * h * AW
+    if L > 0:
+        T2 += rel * (4.0 * h * S0 + mag * (sum_rmax + L) + 4.0 * h * wrot_sum * scale)
+        Th2 += rel * (4.0 * h * wrot_sum + mag * L)
+    return T2, Th2
+
 @njit(cache=True)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray) -> None:
@@ -500,12 +587,14 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     lo = _search_right(times, ta)
     hi = _search_left(times, tb)
     qm = np.empty(nq)
-    _qpos_at(mp, lm[0], lm[1], lm[2], qm)
+    _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, lm[0], lm[1], lm[2], qm)
     xquat = np.empty((nbody, 4))
     janchor = np.empty((njnt, 3))
     jaxis = np.empty((njnt, 3))
     jframe = np.empty((njnt, 4))
-    _fk(mp, qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
+    _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
+        mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
+        qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
 
     # Single-segment sub-interval: the velocity bound applies.
     seg = lm[0]
@@ -539,12 +628,12 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
                 for c in range(4):
                     qu[c] = qm[qa + c]
                 _quat_normalize(qu)
-                th = _rot_dev(mp, k, qu, ta, tb, tm, lm, lo, hi)
+                th = _rot_dev(times, mp.qpos, mp.qt_adr, mp.qt_cum, mp.qt_phi, k, qu, ta, tb, tm, lm, lo, hi)
                 th += rel * (mp.qt_cum[k, times.shape[0] - 1] + 1.0)
                 if single:
-                    _track_omega(mp, k, seg, om)
+                    _track_omega(mp.qpos, mp.qt_adr, mp.qt_target, mp.qt_phi, k, seg, om)
                 if typ == _FREE:
-                    dx = _vec_dev(mp, adr, qm, la, lb, lo, hi) + rel * qmag
+                    dx = _vec_dev(mp.qpos, adr, qm, la, lb, lo, hi) + rel * qmag
                     vkind[v] = _V_FREE_T
                     vcoef[v] = dx
                     vkind[v + 1] = _V_FREE_R
@@ -565,7 +654,7 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
                     if single:
                         _rot_vec(jframe[j], om[:3], vrate[v])
             else:
-                dq = _col_dev(mp, adr, qm[adr], la, lb, lo, hi) + rel * qmag
+                dq = _col_dev(mp.qpos, adr, qm[adr], la, lb, lo, hi) + rel * qmag
                 rate = (mp.qpos[seg + 1, adr] - mp.qpos[seg, adr]) if single else 0.0
                 if typ == _HINGE:
                     n = mp.jnt_axis_norm[j]
@@ -659,72 +748,8 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
             T = min(T_rec, T_dir)
             Th = Th + angle[P]
         if single:
-            # Velocity (Taylor) bound, Plan._velocity_bound.
-            Vx = 0.0
-            Vy = 0.0
-            Vz = 0.0
-            Wx = 0.0
-            Wy = 0.0
-            Wz = 0.0
-            acc = 0.0
-            for li in range(L - 1, -1, -1):  # suffix sums of e (joints nearer the body)
-                v = chain[li]
-                kd = vkind[v]
-                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
-                wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
-                suffix[li] = acc
-                if rot:
-                    e = _chord(wabs * h) * r0[li]
-                else:
-                    e = wabs * h
-                acc += e
-            S_acc = 0.0
-            S0 = 0.0
-            sum_rmax = 0.0
-            for li in range(L - 1, -1, -1):
-                v = chain[li]
-                kd = vkind[v]
-                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
-                wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
-                rm = (r0[li] if rot else 0.0) + suffix[li]
-                rmax[li] = rm
-                sum_rmax += rm
-                S_acc += wabs * rm if rot else wabs
-                suffix[li] = S_acc  # now S_k
-            if L > 0:
-                S0 = suffix[0]
-            Omega = 0.0
-            A = 0.0
-            AW = 0.0
-            wrot_sum = 0.0
-            for li in range(L):
-                v = chain[li]
-                kd = vkind[v]
-                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
-                w0, w1, w2 = vrate[v, 0], vrate[v, 1], vrate[v, 2]
-                wabs = _norm3(w0, w1, w2)
-                if rot:
-                    Vx += w1 * D[li, 2] - w2 * D[li, 1]
-                    Vy += w2 * D[li, 0] - w0 * D[li, 2]
-                    Vz += w0 * D[li, 1] - w1 * D[li, 0]
-                    Wx += w0
-                    Wy += w1
-                    Wz += w2
-                    A += wabs * (2.0 * Omega * rmax[li] + suffix[li])
-                    AW += wabs * Omega
-                    Omega += wabs
-                    wrot_sum += wabs
-                else:
-                    Vx += w0
-                    Vy += w1
-                    Vz += w2
-                    A += wabs * Omega
-            mag = qmag + pathmag + 1.0
-            T2 = h * _norm3(Vx, Vy, Vz) + 0.5 * h * h * A
-            Th2 = h * _norm3(Wx, Wy, Wz) + 0.5 * h * h * AW
-            if L > 0:
-                T2 += rel * (4.0 * h * S0 + mag * (sum_rmax + L) + 4.0 * h * wrot_sum * scale)
-                Th2 += rel * (4.0 * h * wrot_sum + mag * L)
+            T2, Th2 = _velocity_bound(chain, L, vkind, vrate, D, r0, suffix, rmax, h, rel, qmag, pathmag,
+                                      scale)
             T = min(T, T2)
             Th = min(Th, Th2)
         if mp.body_rotating[b] != 0:
@@ -751,7 +776,7 @@ def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
     """
     nbody = mp.body_parent.shape[0]
     need = np.empty(nbody, dtype=np.int64)
-    _ancestors(mp, body, need)
+    _ancestors(mp.body_parent, body, need)
     xpos = np.empty((nbody, 3))
     xmat = np.empty((nbody, 3, 3))
     trans = np.zeros(nbody)
@@ -776,19 +801,54 @@ def tree_bounds(mp, ta: float, tb: float, p_W_out: np.ndarray, R_WB_out: np.ndar
     _bounds_core(mp, ta, tb, need, p_W_out, R_WB_out, trans_out, angle_out)
 
 
-@njit(cache=True)
-def batch_bounds(mp, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: np.ndarray,
-                 trans: np.ndarray, angle: np.ndarray) -> None:
-    """tree_bounds for N sub-intervals: pos (N, nbody, 3), rot (N, nbody, 3, 3), trans/angle (N, nbody)."""
-    for n in range(t0.shape[0]):
-        tree_bounds(mp, t0[n], t1[n], pos[n], rot[n], trans[n], angle[n])
+BATCH_BOUNDS = 0
+BATCH_POSES = 1
+BATCH_SCALE = 2
 
 
 @njit(cache=True)
-def batch_poses(mp, times: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
-    """tree_poses at T times: pos (T, nbody, 3), rot (T, nbody, 3, 3)."""
-    for n in range(times.shape[0]):
-        tree_poses(mp, times[n], pos[n], rot[n])
+def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: np.ndarray,
+          trans: np.ndarray, angle: np.ndarray) -> float:
+    """Batched entry point of the Python helpers (one compiled function for all three modes).
+
+    Each compiled function that takes the 25-array pack costs about a second of cold
+    compile, so the helpers share this one.
+
+    * ``BATCH_BOUNDS``: tree_bounds for N sub-intervals [t0[n], t1[n]]: pos (N, nbody, 3),
+      rot (N, nbody, 3, 3), trans/angle (N, nbody). Returns 0.
+    * ``BATCH_POSES``: tree_poses at the N times t0: pos, rot. Returns 0.
+    * ``BATCH_SCALE``: the rounding scale of the trajectory (m), as ``Plan._scale``: waypoint
+      origins + reference points + the whole-window bound computed with scale 0
+      (``mp.tol[3]`` must be 0 when this is called). pos/rot/trans/angle: (1, nbody, ...) scratch.
+    """
+    if mode == BATCH_BOUNDS:
+        for n in range(t0.shape[0]):
+            tree_bounds(mp, t0[n], t1[n], pos[n], rot[n], trans[n], angle[n])
+        return 0.0
+    if mode == BATCH_POSES:
+        for n in range(t0.shape[0]):
+            tree_poses(mp, t0[n], pos[n], rot[n])
+        return 0.0
+    nbody = mp.body_parent.shape[0]
+    K = mp.times.shape[0]
+    ref_norm = 0.0
+    for b in range(nbody):
+        r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
+        if r > ref_norm:
+            ref_norm = r
+    big = 0.0
+    for k in range(K):
+        tree_poses(mp, mp.times[k], pos[0], rot[0])
+        for b in range(nbody):
+            r = _norm3(pos[0, b, 0], pos[0, b, 1], pos[0, b, 2])
+            if r > big:
+                big = r
+    tree_bounds(mp, mp.times[0], mp.times[K - 1], pos[0], rot[0], trans[0], angle[0])
+    whole = 0.0
+    for b in range(nbody):
+        if trans[0, b] > whole:
+            whole = trans[0, b]
+    return big + ref_norm + whole + 2.0 * ref_norm
 
 
 @njit(cache=True)
@@ -868,36 +928,3 @@ def derive(qpos: np.ndarray, qt_adr: np.ndarray, body_parent: np.ndarray, body_m
                         rt = 1
         moving[b] = mv
         rotating[b] = rt
-
-
-@njit(cache=True)
-def rounding_scale(mp) -> float:
-    """Coordinate magnitude of the trajectory (m), as ``Plan._scale``.
-
-    Waypoint origins + reference points + the whole-window bound computed with
-    scale 0 (``mp.tol[3]`` must be 0 when this is called).
-    """
-    nbody = mp.body_parent.shape[0]
-    K = mp.times.shape[0]
-    ref_norm = 0.0
-    for b in range(nbody):
-        r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
-        if r > ref_norm:
-            ref_norm = r
-    pos = np.empty((nbody, 3))
-    rot = np.empty((nbody, 3, 3))
-    big = 0.0
-    for k in range(K):
-        tree_poses(mp, mp.times[k], pos, rot)
-        for b in range(nbody):
-            r = _norm3(pos[b, 0], pos[b, 1], pos[b, 2])
-            if r > big:
-                big = r
-    trans = np.zeros(nbody)
-    angle = np.zeros(nbody)
-    tree_bounds(mp, mp.times[0], mp.times[K - 1], pos, rot, trans, angle)
-    whole = 0.0
-    for b in range(nbody):
-        if trans[b] > whole:
-            whole = trans[b]
-    return big + ref_norm + whole + 2.0 * ref_norm

@@ -192,7 +192,10 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
         body_rotating=rotating, ref_points=st.ref_points, qt_adr=st.qt_adr, qt_target=target,
         qt_half=half, qt_phi=phi, qt_cum=cum, qt_same=same, tol=tol_arr)
     if moving.any():
-        tol_arr[KN.TOL_SCALE] = KN.rounding_scale(mp)  # the pack shares tol_arr
+        z = np.zeros(1)
+        tol_arr[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
+                                         np.empty((1, nbody, 3, 3)), np.empty((1, nbody)),
+                                         np.empty((1, nbody)))  # the pack shares tol_arr
     return mp
 
 
@@ -310,7 +313,7 @@ def poses_and_bounds(mp: MotionPack, t0: object, t1: object) -> tuple[np.ndarray
     rot = np.empty((N, nbody, 3, 3))
     trans = np.empty((N, nbody))
     angle = np.empty((N, nbody))
-    KN.batch_bounds(mp, np.ascontiguousarray(a), np.ascontiguousarray(b), pos, rot, trans, angle)
+    KN.batch(mp, KN.BATCH_BOUNDS, np.ascontiguousarray(a), np.ascontiguousarray(b), pos, rot, trans, angle)
     return pos, rot, MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
 
 
@@ -321,7 +324,8 @@ def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
     t = K.check_times_in_window(times, (float(mp.times[0]), float(mp.times[-1])))
     pos = np.empty((t.shape[0], mp.nbody, 3))
     rot = np.empty((t.shape[0], mp.nbody, 3, 3))
-    KN.batch_poses(mp, np.ascontiguousarray(t), pos, rot)
+    z = np.empty((1, 1))
+    KN.batch(mp, KN.BATCH_POSES, np.ascontiguousarray(t), np.ascontiguousarray(t), pos, rot, z, z)
     return pos, rot
 
 
