@@ -325,3 +325,47 @@ def test_errors_are_typed():
     pos, rot, mb = poses_and_bounds(mp, [0.0, 0.25], [1.0, 0.5])
     assert (mb.trans == 0).all() and (mb.angle == 0).all()
     assert (pos == 0).all()
+
+
+def test_half_turn_picks_the_trajectorys_own_arc():
+    """Regression (false negative found by h12b through test_redteam's half-turn slerp): at an exact
+    half turn the slerp branch is the sign of a dot product that is +-0 by rounding; the pack used to
+    recompute it with a different summation order and could interpolate the OTHER arc. The pack now
+    copies the trajectory's own QuatTrack arrays: poses must equal the trajectory's at every time."""
+    from test_redteam import _Q0, _Q1, _V
+
+    free_xml = ('<mujoco><worldbody><body name="b"><freejoint/><geom name="s" type="sphere" size=".1" '
+                'pos="1 0 0"/></body></worldbody></mujoco>')
+    ball_xml = ('<mujoco><worldbody><body name="h"><inertial pos="0 0 0" mass="1" diaginertia=".1 .1 .1"/>'
+                '<joint type="hinge" axis="0 0 1"/><body name="c" pos=".5 0 0">'
+                '<inertial pos="0 0 0" mass="1" diaginertia=".1 .1 .1"/><joint type="ball"/>'
+                '<geom type="sphere" size=".1" pos="1 0 0"/></body></body></worldbody></mujoco>')
+    m_free = mujoco.MjModel.from_xml_string(free_xml)
+    m_ball = mujoco.MjModel.from_xml_string(ball_xml)
+    rng = np.random.default_rng(11)
+    pairs = [(np.array(_Q0), np.array(_Q1))]
+    for _ in range(60):  # random (near-)orthogonal pairs, +-1e-17 along q0
+        q0 = _rand_quat(rng)
+        r = rng.normal(size=4)
+        r -= (r @ q0) * q0
+        r /= np.linalg.norm(r)
+        pairs.append((q0, r + rng.choice([0.0, 1e-17, -1e-17]) * q0))
+    ts = np.array([0.0, 0.1, 0.37, 0.5, 0.53, 0.9, 1.0])
+    for q0, q1 in pairs:
+        v = 0.5 * np.array(_V)
+        trajs = [Plan([0.0, 1.0], np.array([[*(-v), *q0], [*v, *q1]]), m_free),
+                 Plan([0.0, 1.0], np.array([[0.0, *q0], [0.7, *q1]]), m_ball),
+                 BodyMotion([0.0, 1.0], np.array([[[0, 0, 0], [1, 2, 3]], [[0, 0, 0], [2, 2, 3]]], float),
+                            np.array([[[1, 0, 0, 0], q0], [[1, 0, 0, 0], q1]]))]
+        for traj in trajs:
+            mp = pack_trajectory(traj)
+            pos, mat = body_poses(mp, ts)
+            ref_pos, ref_mat = traj.body_poses(ts)
+            np.testing.assert_allclose(pos, ref_pos, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(mat, ref_mat, rtol=0, atol=1e-12)
+            for tm, h in ((0.5, 1e-3), (0.53, 1e-2), (0.5, 0.5)):
+                _, _, mb = poses_and_bounds(mp, [tm - h], [tm + h])
+                tt = np.concatenate([[tm], np.linspace(tm - h, tm + h, 101)])
+                P, R = traj.body_poses(tt)
+                _check_samples(P, R, traj.ref_points, mb.trans[0], mb.angle[0], rng, far=False,
+                               tag=f"half turn {type(traj).__name__}")

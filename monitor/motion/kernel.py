@@ -858,17 +858,16 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
 
 
 @njit(cache=True, error_model="numpy")
-def derive(qpos: np.ndarray, qt_adr: np.ndarray, body_parent: np.ndarray, body_mocap: np.ndarray,
-           body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
-           qt_target: np.ndarray, qt_half: np.ndarray, qt_phi: np.ndarray, qt_cum: np.ndarray,
-           qt_same: np.ndarray, moving: np.ndarray, rotating: np.ndarray, tol: np.ndarray) -> None:
-    """Per-trajectory derived arrays of a pack (outputs after ``jnt_qposadr``).
+def derive(qpos: np.ndarray, body_parent: np.ndarray, body_mocap: np.ndarray, body_jntadr: np.ndarray,
+           body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray, moving: np.ndarray,
+           rotating: np.ndarray, tol: np.ndarray) -> None:
+    """Per-trajectory flags and joint magnitude of a pack (outputs: moving, rotating, tol[4]).
 
-    Quaternion tracks exactly as ``QuatTrack`` (sign-aligned segment ends, half angle
-    2 atan2(|b - a|, |b + a|), phi = 2 half, cumulative path, bit-identical ends);
     (nbody,) int flags: some (rotational) coordinate on the body's chain changes in the
-    window (mocap bodies and the world never move); tol[4] = max |qpos|, tol[5] = the
-    largest total rotation path of a track.
+    window (mocap bodies and the world never move); tol[4] = max |qpos|. The quaternion
+    tracks are NOT derived here: they are copied from the trajectory's own ``QuatTrack``
+    objects (the slerp branch is decided by the sign of a dot product that can be +-0 by
+    rounding at a half turn; only the very same arithmetic picks the same arc).
     """
     K = qpos.shape[0]
     nq = qpos.shape[1]
@@ -879,34 +878,6 @@ def derive(qpos: np.ndarray, qt_adr: np.ndarray, body_parent: np.ndarray, body_m
             if v > qmag:
                 qmag = v
     tol[TOL_QMAG] = qmag
-    pathmag = 0.0
-    for t in range(qt_adr.shape[0]):
-        adr = qt_adr[t]
-        qt_cum[t, 0] = 0.0
-        for i in range(K - 1):
-            dot = 0.0
-            for c in range(4):
-                dot += qpos[i, adr + c] * qpos[i + 1, adr + c]
-            sgn = -1.0 if dot < 0 else 1.0
-            dm = 0.0
-            dp = 0.0
-            same = 1
-            for c in range(4):
-                a = qpos[i, adr + c]
-                b = sgn * qpos[i + 1, adr + c]
-                qt_target[t, i, c] = b
-                dm += (b - a) ** 2
-                dp += (b + a) ** 2
-                if a != b:
-                    same = 0
-            h = 2.0 * math.atan2(math.sqrt(dm), math.sqrt(dp))
-            qt_half[t, i] = h
-            qt_phi[t, i] = 2.0 * h
-            qt_cum[t, i + 1] = qt_cum[t, i] + 2.0 * h
-            qt_same[t, i] = same
-        if qt_cum[t, K - 1] > pathmag:
-            pathmag = qt_cum[t, K - 1]
-    tol[TOL_PATHMAG] = pathmag
     nbody = body_parent.shape[0]
     moving[0] = 0
     rotating[0] = 0

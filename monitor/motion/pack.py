@@ -23,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
+from monitor.motion import _kinematics as K_
 from monitor.motion import kernel as KN
 from monitor.motion.base import MotionBounds
 from monitor.motion.bodymotion import BodyMotion
@@ -167,23 +168,37 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
         qpos0_mag=float(np.max(np.abs(q0), initial=0.0)))
 
 
+def _track_arrays(tracks: list, K: int) -> tuple[np.ndarray, ...]:
+    """(target, half, phi, cum, same) stacked from ``QuatTrack`` objects (bit-exact copies)."""
+    n = len(tracks)
+    if n == 0:
+        return (np.zeros((0, K - 1, 4)), np.zeros((0, K - 1)), np.zeros((0, K - 1)), np.zeros((0, K)),
+                np.zeros((0, K - 1), dtype=np.int64))
+    return (np.ascontiguousarray(np.stack([tr.target for tr in tracks]), dtype=np.float64),
+            np.ascontiguousarray(np.stack([tr.half for tr in tracks]), dtype=np.float64),
+            np.ascontiguousarray(np.stack([tr.phi for tr in tracks]), dtype=np.float64),
+            np.ascontiguousarray(np.stack([tr.cum for tr in tracks]), dtype=np.float64),
+            np.ascontiguousarray(np.stack([tr.same for tr in tracks]), dtype=np.int64))
+
+
 def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
-            tol: Tolerances) -> MotionPack:
-    """Derived arrays (tracks, flags, magnitudes: one compiled call; rounding scale: one more)."""
+            tracks: list, tol: Tolerances) -> MotionPack:
+    """Derived arrays (flags, magnitudes: one compiled call; rounding scale: one more) and the pack.
+
+    ``tracks``: the trajectory's own ``QuatTrack`` per quaternion track (order of ``st.qt_adr``).
+    """
     K = qpos.shape[0]
-    nqt = st.qt_adr.shape[0]
     nbody = st.body_parent.shape[0]
-    target = np.empty((nqt, K - 1, 4))
-    half = np.empty((nqt, K - 1))
-    phi = np.empty((nqt, K - 1))
-    cum = np.empty((nqt, K))
-    same = np.empty((nqt, K - 1), dtype=np.int64)
+    if len(tracks) != st.qt_adr.shape[0]:
+        raise InvalidInputError(f"{len(tracks)} quaternion tracks for {st.qt_adr.shape[0]} ball/free joints")
+    target, half, phi, cum, same = _track_arrays(tracks, K)
     moving = np.empty(nbody, dtype=np.int64)
     rotating = np.empty(nbody, dtype=np.int64)
     tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, 0.0])
-    KN.derive(qpos, st.qt_adr, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
-              st.jnt_qposadr, target, half, phi, cum, same, moving, rotating, tol_arr)
+    KN.derive(qpos, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
+              st.jnt_qposadr, moving, rotating, tol_arr)
     tol_arr[KN.TOL_QMAG] += st.qpos0_mag
+    tol_arr[KN.TOL_PATHMAG] = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
     mp = MotionPack(
         times=times, qpos=qpos, qpos0=st.qpos0, jnt_type=st.jnt_type, jnt_qposadr=st.jnt_qposadr,
         jnt_pos=st.jnt_pos, jnt_axis=st.jnt_axis, jnt_axis_norm=st.jnt_axis_norm, jnt_track=st.jnt_track,
@@ -217,7 +232,9 @@ def _pack_body_motion(bm: BodyMotion) -> MotionPack:
                  np.zeros(nbody, dtype=np.int64), np.concatenate([[0], np.arange(nj)]),
                  np.concatenate([[0], np.ones(nj, dtype=np.int64)]), body_pos, body_quat,
                  np.full(nbody, -1), bm.ref_points, check_free=False)
-    return _finish(st, _f64(bm.times), _f64(qpos), st.body_pos, st.body_quat, bm._tol)
+    tracks = getattr(bm, "_tracks", None)
+    tracks = tracks[1:] if tracks is not None else [K_.QuatTrack(quat[:, b]) for b in range(1, nbody)]
+    return _finish(st, _f64(bm.times), _f64(qpos), st.body_pos, st.body_quat, tracks, bm._tol)
 
 
 def _plan_static(plan: object) -> _Static:
@@ -267,7 +284,14 @@ def _pack_plan(plan: object) -> MotionPack:
         body_quat = body_quat.copy()
         body_pos[mocap] = plan.mocap_pos[st.mocapid[mocap]]
         body_quat[mocap] = plan.mocap_quat[st.mocapid[mocap]]
-    return _finish(st, _f64(plan.times), _f64(plan.qpos), body_pos, body_quat, getattr(plan, "_tol", DEFAULT))
+    own = getattr(plan, "_quat_tracks", {})
+    qpos = plan.qpos
+    quat_j = np.flatnonzero(st.jnt_track >= 0)
+    # Plan builds each track from the view qpos[:, a:a + 4] of this very array: same arithmetic.
+    tracks = [own[j] if j in own else K_.QuatTrack(qpos[:, a:a + 4])
+              for j, a in zip(quat_j, st.qt_adr, strict=True)]
+    return _finish(st, _f64(plan.times), _f64(qpos), body_pos, body_quat, tracks,
+                   getattr(plan, "_tol", DEFAULT))
 
 
 def pack_trajectory(traj: object) -> MotionPack:
