@@ -369,3 +369,17 @@ def test_half_turn_picks_the_trajectorys_own_arc():
                 P, R = traj.body_poses(tt)
                 _check_samples(P, R, traj.ref_points, mb.trans[0], mb.angle[0], rng, far=False,
                                tag=f"half turn {type(traj).__name__}")
+
+
+def test_kernel_and_pack_do_not_import_mujoco():
+    """kernel.py is numpy + numba only; pack.py recognises a Plan without importing mujoco."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = ("import sys, monitor.motion.kernel, monitor.motion.pack; "
+            "print(sorted(m for m in ('mujoco', 'gymnasium', 'mcap') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], cwd=Path(__file__).resolve().parents[1],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"

@@ -18,6 +18,7 @@ The rounding scale (``tol[3]``) is computed once here, by the kernels, as
 
 from __future__ import annotations
 
+import sys
 from typing import NamedTuple
 
 import numpy as np
@@ -303,9 +304,10 @@ def pack_trajectory(traj: object) -> MotionPack:
     """
     if isinstance(traj, BodyMotion):
         return _pack_body_motion(traj)
-    from monitor.motion.plan import Plan  # imports mujoco; BodyMotion users need not
-
-    if isinstance(traj, Plan):
+    # A Plan can only exist once monitor.motion.plan is imported; looking it up here keeps this
+    # module free of mujoco (the algorithmic core may import it) and costs nothing per call.
+    plan_mod = sys.modules.get("monitor.motion.plan")
+    if plan_mod is not None and isinstance(traj, plan_mod.Plan):
         return _pack_plan(traj)
     raise InvalidInputError(f"traj must be a Plan or a BodyMotion, got {type(traj).__name__}")
 
@@ -327,10 +329,8 @@ def poses_and_bounds(mp: MotionPack, t0: object, t1: object) -> tuple[np.ndarray
     Raises:
         InvalidInputError: shapes, NaN, or a sub-interval outside the window.
     """
-    from monitor.motion import _kinematics as K
-
     window = (float(mp.times[0]), float(mp.times[-1]))
-    a, b = K.check_interval_arrays(t0, t1, window)
+    a, b = K_.check_interval_arrays(t0, t1, window)
     N = a.shape[0]
     nbody = mp.nbody
     pos = np.empty((N, nbody, 3))
@@ -343,9 +343,7 @@ def poses_and_bounds(mp: MotionPack, t0: object, t1: object) -> tuple[np.ndarray
 
 def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
     """World poses at ``times`` (T,): positions (T, nbody, 3) m, rotations (T, nbody, 3, 3)."""
-    from monitor.motion import _kinematics as K
-
-    t = K.check_times_in_window(times, (float(mp.times[0]), float(mp.times[-1])))
+    t = K_.check_times_in_window(times, (float(mp.times[0]), float(mp.times[-1])))
     pos = np.empty((t.shape[0], mp.nbody, 3))
     rot = np.empty((t.shape[0], mp.nbody, 3, 3))
     z = np.empty((1, 1))
