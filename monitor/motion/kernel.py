@@ -72,7 +72,7 @@ TOL_PATHMAG = 5
 
 
 # ------------------------------------------------------------------ small helpers
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _chord(a: float) -> float:
     """2 sin(min(a, pi) / 2)."""
     if a > math.pi:
@@ -80,7 +80,7 @@ def _chord(a: float) -> float:
     return 2.0 * math.sin(0.5 * a)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _sinc(x: float) -> float:
     """sin(x) / x (np.sinc(x / pi))."""
     if x == 0.0:
@@ -88,12 +88,12 @@ def _sinc(x: float) -> float:
     return math.sin(x) / x
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _norm3(x: float, y: float, z: float) -> float:
     return math.sqrt(x * x + y * y + z * z)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _search_right(times: np.ndarray, t: float) -> int:
     """Number of entries <= t (np.searchsorted side='right')."""
     lo = 0
@@ -107,7 +107,7 @@ def _search_right(times: np.ndarray, t: float) -> int:
     return lo
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _search_left(times: np.ndarray, t: float) -> int:
     """Number of entries < t (np.searchsorted side='left')."""
     lo = 0
@@ -121,7 +121,7 @@ def _search_left(times: np.ndarray, t: float) -> int:
     return lo
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _locate(times: np.ndarray, t: float) -> tuple[int, float, bool]:
     """(segment i, parameter s in [0, 1], at_end) as ``Segments.locate``."""
     K = times.shape[0]
@@ -138,7 +138,7 @@ def _locate(times: np.ndarray, t: float) -> tuple[int, float, bool]:
     return i, s, t >= times[K - 1]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _quat_mul(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
     """Set out = a * b (Hamilton, MuJoCo's mju_mulQuat); out may alias a or b."""
     w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3]
@@ -151,7 +151,7 @@ def _quat_mul(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
     out[3] = z
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _quat_normalize(q: np.ndarray) -> None:
     n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     if n > 0.0:
@@ -166,7 +166,7 @@ def _quat_normalize(q: np.ndarray) -> None:
         q[3] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
     """R (3, 3) of a unit quaternion q (w, x, y, z)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -181,7 +181,7 @@ def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
     R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Set out = R(q) v for a unit quaternion q (v and out (3,), may not alias)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -191,7 +191,7 @@ def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     out[2] = 2.0 * (x * z - w * y) * v0 + 2.0 * (y * z + w * x) * v1 + (1.0 - 2.0 * (x * x + y * y)) * v2
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Rotation angle (rad, [0, pi]) of R(a) R(b)^T, as ``_kinematics.quat_angle``."""
     d = 0.0
@@ -205,7 +205,7 @@ def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 # ------------------------------------------------------------------ interpolation
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float:
     """Interpolated qpos column c at (segment i, parameter s)."""
     q = qpos
@@ -215,7 +215,7 @@ def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float
     return a + s * (q[i + 1, c] - a)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
            qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
@@ -238,7 +238,7 @@ def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: n
         out[c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
              qt_target: np.ndarray, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Interpolated qpos (nq,) at (segment i, parameter s)."""
@@ -253,13 +253,13 @@ def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half:
             out[adr + c] = tmp[c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _track_path(qt_cum: np.ndarray, qt_phi: np.ndarray, k: int, i: int, s: float) -> float:
     return qt_cum[k, i] + s * qt_phi[k, i]
 
 
 # ------------------------------------------------------------------ forward kinematics
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
         body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
         jnt_pos: np.ndarray, jnt_axis: np.ndarray, jnt_axis_norm: np.ndarray, qpos0: np.ndarray,
@@ -351,7 +351,7 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         _quat_to_mat(xquat[b], xmat[b])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
     """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
     need[:] = 0
@@ -407,7 +407,7 @@ def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
 
 
 # ------------------------------------------------------------------ joint deviations
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _col_dev(qpos: np.ndarray, c: int, qm_c: float, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of |q_c(t) - q_c(m)| (scalar_deviation)."""
     va = _lerp_col(qpos, c, la[0], la[1], la[2])
@@ -420,7 +420,7 @@ def _col_dev(qpos: np.ndarray, c: int, qm_c: float, la, lb, lo: int, hi: int) ->
     return dev
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _vec_dev(qpos: np.ndarray, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of ||x(t) - x(m)|| for qpos columns adr..adr+2 (vector_deviation)."""
     da = 0.0
@@ -439,7 +439,7 @@ def _vec_dev(qpos: np.ndarray, adr: int, qm: np.ndarray, la, lb, lo: int, hi: in
     return dev
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np.ndarray, qt_phi: np.ndarray,
              k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, lm, lo: int, hi: int) -> float:
     """Bound on the rotation angle of track k from the midpoint over [ta, tb] (rotation_deviation)."""
@@ -470,7 +470,7 @@ def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np
     return min(dev, math.pi)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _track_omega(qpos: np.ndarray, qt_adr: np.ndarray, qt_target: np.ndarray, qt_phi: np.ndarray, k: int,
                  seg: int, out: np.ndarray) -> None:
     """Angular velocity (3,) per unit segment parameter of track k on segment seg.
@@ -491,15 +491,16 @@ def _track_omega(qpos: np.ndarray, qt_adr: np.ndarray, qt_target: np.ndarray, qt
 
 
 # ------------------------------------------------------------------ bounds
-@njit(cache=True, error_model="numpy")
-def _velocity_bound(chain: np.ndarray, L: int, vkind: np.ndarray, vrate: np.ndarray, D: np.ndarray,
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: np.ndarray,
                     r0: np.ndarray, suffix: np.ndarray, rmax: np.ndarray, h: float, rel: float, qmag: float,
                     pathmag: float, scale: float) -> tuple[float, float]:
     """Second-order (Taylor) bound (T2 m, Th2 rad) for one chain: ``Plan._velocity_bound``, same pads.
 
-    chain[:L] virtual joints root first; D (L, 3) reference point minus anchors, r0 (L,) their norms;
+    chain (L,) virtual joints root first; D (L, 3) reference point minus anchors, r0 (L,) their norms;
     suffix, rmax: (>= L,) scratch.
     """
+    L = chain.shape[0]
     Vx = 0.0
     Vy = 0.0
     Vz = 0.0
@@ -567,7 +568,7 @@ def _velocity_bound(chain: np.ndarray, L: int, vkind: np.ndarray, vrate: np.ndar
         Th2 += rel * (4.0 * h * wrot_sum + mag * L)
     return T2, Th2
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
@@ -754,7 +755,7 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
             T = min(T_rec, T_dir)
             Th = Th + angle[P]
         if single:
-            T2, Th2 = _velocity_bound(chain, L, vkind, vrate, D, r0, suffix, rmax, h, rel, qmag, pathmag,
+            T2, Th2 = _velocity_bound(chain[:L], vkind, vrate, D, r0, suffix, rmax, h, rel, qmag, pathmag,
                                       scale)
             T = min(T, T2)
             Th = min(Th, Th2)
