@@ -356,8 +356,10 @@ def _budget_tests(tests: Any) -> int | None:
 def _check_log(log: Any) -> None:
     """``log`` must be None, a path or an object with ``write_window`` (a MonitorLog)."""
     if isinstance(log, (str, os.PathLike)):
-        if not Path(log).parent.is_dir():
-            raise InvalidInputError(f"log: the directory of {str(log)!r} does not exist")
+        try:  # like MonitorLog: a missing directory is created (the README's log="logs/arm.mcap")
+            Path(log).parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InvalidInputError(f"log: cannot create the directory of {str(log)!r}: {exc}") from exc
         return
     if log is None or callable(getattr(log, "write_window", None)):
         return

@@ -269,7 +269,8 @@ class Scene:
         self._by_name = {g.name: g for g in geoms}
         self.version = 0
         self._pairs_spec: Any = "mujoco"  # set by from_model: the pairs argument, for rebuilds
-        self._snapshot = _Snapshot(model)
+        # a scene built by hand without an MjModel (tests, pure-geometry use) has nothing to watch
+        self._snapshot = _Snapshot(model) if model is not None else None
 
     # ------------------------------------------------------------------ model edits
 
@@ -291,6 +292,8 @@ class Scene:
                 snapshot is kept, so every later call raises again instead of certifying a
                 stale scene.
         """
+        if self._snapshot is None:
+            return False
         changed = self._snapshot.changed()
         if not changed:
             return False

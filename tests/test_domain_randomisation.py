@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs.tunnel_v0 import TunnelEnv
+from monitor.envs.tunnel_v0 import TunnelEnv
 from monitor.gym_gate import SafetyGate
 
 N_SAMPLES = 257

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from gymnasium.wrappers import ClipAction, RecordEpisodeStatistics, RescaleAction
 
-import envs  # noqa: F401  (registers monitor/Tunnel-v0)
+import monitor.envs  # noqa: F401  (registers monitor/Tunnel-v0)
 from envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS
 from monitor.errors import InvalidInputError
 from monitor.gym_gate import SafetyGate

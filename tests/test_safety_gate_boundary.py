@@ -9,7 +9,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import envs  # noqa: F401  (registers monitor/Tunnel-v0)
+import monitor.envs  # noqa: F401  (registers monitor/Tunnel-v0)
 from monitor.errors import InvalidInputError
 from monitor.gym_gate import SafetyGate
 
@@ -104,3 +104,16 @@ def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
     env.reset(seed=0)
     with pytest.raises(InvalidInputError, match="fallback"):
         env.step(np.array([1.0]))
+
+
+def test_log_directory_is_created_or_a_typed_error(tmp_path):
+    path = tmp_path / "new" / "dir" / "tunnel.mcap"
+    env = SafetyGate(gym.make("monitor/Tunnel-v0"), log=str(path))
+    env.reset(seed=0)
+    env.step(np.zeros(env.action_space.shape))
+    env.close()
+    assert path.is_file()
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    with pytest.raises(InvalidInputError, match="log"):
+        SafetyGate(gym.make("monitor/Tunnel-v0"), log=str(blocker / "x.mcap"))
