@@ -17,7 +17,7 @@ import pytest
 from gymnasium.wrappers import ClipAction, RecordEpisodeStatistics, RescaleAction
 
 import monitor.envs  # noqa: F401  (registers monitor/Tunnel-v0)
-from envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS
+from monitor.envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS
 from monitor.errors import InvalidInputError
 from monitor.gym_gate import SafetyGate
 
@@ -142,7 +142,7 @@ def test_action_transform_is_evaluated_once_per_step():
 
 def test_env_step_that_changes_the_control_is_detected():
     """A MuJoCo env whose step doubles the action: the post-step check raises, never silent."""
-    from envs.tunnel_v0 import TunnelEnv
+    from monitor.envs.tunnel_v0 import TunnelEnv
 
     class Doubling(TunnelEnv):
         def step(self, action):
