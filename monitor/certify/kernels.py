@@ -1,0 +1,456 @@
+r"""Compiled pair-window narrow phase: whole-shape exclusion, bisection, exact witnesses (issue 12).
+
+One call decides one geom pair over one window ``[t0, t1]`` of a packed motion, with no
+Python per sub-interval. It is the whole-shape stage of the toleranced checker of
+Schröcker & Weber (seed 003; §2 metric, §3 orbits, §4 tests, §5 balls, §6 algorithm):
+
+**Ball of a sub-interval (§5).** On ``I = [a, b]`` with midpoint ``m`` the motion-bound
+contract (:mod:`monitor.motion.base`) gives, per body, ``(trans, angle)`` with
+``|X(t) p - X(m) p| <= trans + chord(angle) |p - ref|`` for all t in I and every point p.
+For the relative motion of A in B's frame (design.md, "Both bodies moving"), every point
+p of A stays within
+
+    delta_rel(p) = T_A + ch_A |p - c_A| + T_B + ch_B |X_WA(m) p - X_WB(m) c_B|
+
+of its pose at m. The R^12 ball ``B_R(g)`` of §5 (g = relative pose at m, metric of §2
+on A's feature points m_i with weights w_i) has ``R^2 = sum_i w_i delta_rel(m_i)^2``.
+
+**Whole-shape test (§3 orbits, §4).** By eq. 4 the orbit of a point x of A under
+``B_R(g)`` is the ball of radius ``R rho(x)`` about ``g(x)``, and rho is convex, so the
+orbit of the core A lies in ``g(A) ⊕ ball(R rho_max)`` (rho_max over A's vertices).
+Hence ``dist(g(A), B) - R rho_max > r`` (r = radii + margin + pad) excludes the whole
+sub-interval with ONE exact static distance call. The plain displacement bounds give
+the same kind of statement with other radii, all sound, and we take the smallest:
+
+* ``R_A rho_max_A`` (the paper's ball for A moving relative to B) and ``R_B rho_max_B``;
+* ``max_{p in A} delta_rel(p)`` (A in B's frame) and the same for B in A's frame
+  (a convex function of p: the max is at a vertex of the core);
+* ``max_A (T_A + ch_A |p - c_A|) + max_B (T_B + ch_B |q - c_B|)`` (each body about
+  its own pose at m; not for half-spaces).
+
+Only sub-intervals left open go on (bisection here; the fat vertex/edge/face tests of
+§4 remain in :mod:`monitor.certify.toleranced`, which the engine runs on what this
+stage does not certify).
+
+**Distance.** :func:`monitor.geometry._gjk.core_distance` (GJK/EPA, rigorous bounds)
+or the closed-form half-space distance, minus the radii: ``lower <= dist <= upper``.
+
+**Algorithm (§6, depth-first, earliest first).** A stack of sub-intervals, left child
+popped first. For each: the exact static distance at ``m``; ``upper + approx < margin``
+confirms a violation at m (``approx`` = over-approximation of circumscribed geoms), after
+which only ``[a, m]`` is searched further for an earlier confirmed time (everything
+still on the stack is later); ``lower - bound - pad > margin`` excludes I and
+contributes ``lower - bound - pad`` to the clearance lower bound; otherwise, when the
+bound is below ``epsilon`` (the role of eq. 11's ``R rho_max < epsilon``) or the depth
+reaches ``max_depth``, I is *unresolved*, else it is split. Before the first
+sub-interval the start pose t0 gets the exact static test (a body starting inside or
+within margin of another is a violation at t0). The exclusion test is a whole-solid
+signed-distance test, so containment is excluded or not like any other contact: no
+boundary argument is needed and no start pose must be proven.
+
+Verdicts: ``CERTIFIED`` (every sub-interval excluded), ``VIOLATION`` (a confirmed time;
+the earliest one found), ``UNRESOLVED`` (some sub-interval neither excluded nor
+confirmed; the caller falls back or reports uncertain), ``PAUSED`` (the test budget of
+this call ran out; call again with the same state to continue), ``UNSUPPORTED`` (two
+half-spaces, or a geom without a shape).
+
+Rounding: every bound used is padded upward (motion bounds by the motion kernels,
+distances by ``core_distance``); the exclusion threshold adds
+``rel_pad (|lower| + bound + margin) + abs_pad`` for the subtraction, the bound is
+multiplied by ``1 + 8 rel_pad`` and gets ``8 rel_pad (ch_A + ch_B) S`` for the world
+coordinates of magnitude S that enter the lever arms. NaN anywhere never excludes
+(every exclusion is written as a comparison that NaN fails).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from monitor.certify._motion_standin import body_bound, body_pose
+from monitor.geometry._gjk import OUT_SIZE, core_distance, halfspace_distance
+
+# ---------------------------------------------------------------------------- codes
+
+CERTIFIED = 0
+VIOLATION = 1
+UNRESOLVED = 2
+PAUSED = 3
+UNSUPPORTED = 4
+
+MODE_FULL = 0
+"""Search the whole window: earliest confirmed violation, every unresolved interval counted."""
+MODE_CERTIFY_ONLY = 1
+"""Stop at the first confirmed violation or the first unresolved sub-interval (pre-filter use)."""
+
+# layout of the result row (float64)
+R_VERDICT = 0
+R_WTIME = 1
+R_WPOINT = 2            # 3 entries
+R_WUPPER = 5
+R_CLEAR = 6
+R_TESTS = 7
+R_DEPTH = 8
+R_UNRES = 9
+R_FIRST_UNRES = 10
+R_PAPER = 11            # sub-intervals where a paper ball (R rho_max) was the smallest bound
+R_SP = 12               # stack pointer (resumable state)
+R_STARTED = 13
+R_SIZE = 14
+
+_EPS_REL = 1e-14
+_MAX_ITER = 200
+_MAX_EDGE_PAIRS = 2_000_000
+
+
+@njit(cache=True)
+def _norm3(x, y, z):
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@njit(cache=True)
+def _chord(angle):
+    a = min(angle, math.pi)
+    return 2.0 * math.sin(0.5 * a) * (1.0 + 4.0 * 2.0**-52)
+
+
+@njit(cache=True)
+def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
+    """Rigorous signed distance bounds of geoms ga, gb of ``gp`` posed by (R, p) (world).
+
+    Returns ``(lower, upper)`` of the solid distance (cores minus radii, m) and writes a
+    world point between the closest / common points into ``w_out`` (3,). Both geoms
+    must have shapes and not both be half-spaces (checked by the caller).
+    """
+    ka, kb = gp.kind[ga], gp.kind[gb]
+    ra, rb = gp.radius[ga], gp.radius[gb]
+    if kb == -1 or ka == -1:
+        if kb == -1:
+            h, c, Rh, ph, Rc, pc = gb, ga, Rb, pb, Ra, pa
+        else:
+            h, c, Rh, ph, Rc, pc = ga, gb, Ra, pa, Rb, pb
+        n0 = gp.nstart[h]
+        PC = gp.verts[gp.vstart[c]:gp.vstart[c + 1]]
+        halfspace_distance(gp.normals[n0], gp.offset[h], Rh, ph, PC, Rc, pc, rel_pad, abs_pad, out)
+        for r in range(3):
+            w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pc[r]
+        rc = gp.radius[c]
+        return out[2] - rc, out[3] - rc
+    PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+    PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+    EA = gp.edges[gp.estart[ga]:gp.estart[ga + 1]]
+    EB = gp.edges[gp.estart[gb]:gp.estart[gb + 1]]
+    NA = gp.normals[gp.nstart[ga]:gp.nstart[ga + 1]]
+    NB = gp.normals[gp.nstart[gb]:gp.nstart[gb + 1]]
+    core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, ka, kb, gp.dpad[ga], gp.dpad[gb], rel_pad, abs_pad,
+                  _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+    for r in range(3):
+        w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pa[r]
+    return out[2] - ra - rb, out[3] - ra - rb
+
+
+@njit(cache=True)
+def _lever(gp, g, ref):
+    """Max over g's core vertices of |v - ref| (body frame), padded."""
+    lv = 0.0
+    for i in range(gp.vstart[g], gp.vstart[g + 1]):
+        lv = max(lv, _norm3(gp.verts[i, 0] - ref[0], gp.verts[i, 1] - ref[1], gp.verts[i, 2] - ref[2]))
+    return lv * (1.0 + 4.0 * 2.0**-52)
+
+
+@njit(cache=True)
+def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
+    """Relative displacement bound delta_rel over the rows of P (points of A, body frame).
+
+    Returns max_i delta_rel(P_i) if not ``weighted``, else sqrt(sum_i w_i delta_rel(P_i)^2) (= R).
+    B's reference point c_B is taken to world by (RB, pB), A's points by (RA, pA); only the
+    difference pA - pB of the translations enters.
+    """
+    # X_WB(m) c_B - pA (world, relative to A's origin)
+    qb = np.empty(3)
+    for r in range(3):
+        qb[r] = RB[r, 0] * cB[0] + RB[r, 1] * cB[1] + RB[r, 2] * cB[2] + (pB[r] - pA[r])
+    acc = 0.0
+    for i in range(P.shape[0]):
+        x0, x1, x2 = P[i, 0], P[i, 1], P[i, 2]
+        dA = _norm3(x0 - cA[0], x1 - cA[1], x2 - cA[2])
+        y0 = RA[0, 0] * x0 + RA[0, 1] * x1 + RA[0, 2] * x2 - qb[0]
+        y1 = RA[1, 0] * x0 + RA[1, 1] * x1 + RA[1, 2] * x2 - qb[1]
+        y2 = RA[2, 0] * x0 + RA[2, 1] * x1 + RA[2, 2] * x2 - qb[2]
+        d = TA + chA * dA + TB + chB * _norm3(y0, y1, y2)
+        if weighted:
+            acc += w[i] * d * d
+        else:
+            acc = max(acc, d)
+    if weighted:
+        return math.sqrt(acc)
+    return acc
+
+
+@njit(cache=True)
+def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats):
+    """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
+
+    Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
+    precomputed max |v - ref| of A and B. ``stats[0]`` is incremented when a paper
+    ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
+    """
+    ba, bb = gp.body[ga], gp.body[gb]
+    TA, angA = body_bound(mp, ba, ta, tb, pA, RA)
+    TB, angB = body_bound(mp, bb, ta, tb, pB, RB)
+    chA, chB = _chord(angA), _chord(angB)
+    cA, cB = mp.ref_points[ba], mp.ref_points[bb]
+    hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
+    best = np.inf
+    paper = False
+    if not hsA and not hsB:
+        best = TA + chA * levers[0] + TB + chB * levers[1]
+    if not hsA:
+        PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+        d = _rel_terms(PA, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, gp.mw, False)
+        if d < best:
+            best = d
+        M = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
+        W = gp.mw[gp.mstart[ga]:gp.mstart[ga + 1]]
+        d = _rel_terms(M, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, W, True) * gp.rho_max[ga]
+        if d < best:
+            best = d
+            paper = True
+    if not hsB:
+        PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+        d = _rel_terms(PB, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, gp.mw, False)
+        if d < best:
+            best = d
+            paper = False
+        M = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
+        W = gp.mw[gp.mstart[gb]:gp.mstart[gb + 1]]
+        d = _rel_terms(M, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, W, True) * gp.rho_max[gb]
+        if d < best:
+            best = d
+            paper = True
+    if paper:
+        stats[0] += 1.0
+    # coordinates of magnitude S enter the lever arms: pad their rounding
+    S = levers[0] + levers[1] + _norm3(pA[0] - pB[0], pA[1] - pB[1], pA[2] - pB[2])
+    S += _norm3(cA[0], cA[1], cA[2]) + _norm3(cB[0], cB[1], cB[2])
+    pad = 8.0 * mp.rel_pad * (best + (chA + chB) * S)
+    return best * (1.0 + 8.0 * mp.rel_pad) + pad
+
+
+@njit(cache=True)
+def _push(stack, sp, a, b, depth):
+    stack[sp, 0] = a
+    stack[sp, 1] = b
+    stack[sp, 2] = depth
+    return sp + 1
+
+
+@njit(cache=True)
+def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
+                stack, res):
+    """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
+
+    Args:
+        gp: :class:`monitor.certify.packed.GeomPack`.
+        mp: the motion pack (``body_pose`` / ``body_bound``).
+        ga, gb: geom indices.
+        t0, t1: window (s).
+        margin: clearance (m) below which the pair is in violation.
+        epsilon: stop splitting a sub-interval once its motion bound is below this (m).
+        max_depth: maximum bisection depth.
+        max_tests: distance tests this call may spend (PAUSED when reached).
+        mode: MODE_FULL or MODE_CERTIFY_ONLY.
+        rel_pad, abs_pad: rounding pads.
+        stack: (max_depth + 2, 3) float64 work array (ta, tb, depth); keep it between
+            calls to resume a PAUSED search.
+        res: (R_SIZE,) float64 result row; set ``res[R_STARTED] = 0`` for a fresh search
+            (:func:`new_result`). Holds verdict, witness time / point / upper bound,
+            clearance lower bound, tests, max depth, unresolved count, first unresolved
+            time, paper-ball wins, and the resumable state.
+
+    Returns:
+        The verdict code (also in ``res[R_VERDICT]``).
+    """
+    out = np.empty(OUT_SIZE)
+    w = np.empty(3)
+    pA = np.empty(3)
+    pB = np.empty(3)
+    RA = np.empty((3, 3))
+    RB = np.empty((3, 3))
+    stats = np.zeros(1)
+    if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
+        res[R_VERDICT] = UNSUPPORTED
+        return UNSUPPORTED
+    approx = gp.approx[ga] + gp.approx[gb]
+    levers = np.zeros(2)
+    if gp.kind[ga] != -1:
+        levers[0] = _lever(gp, ga, mp.ref_points[gp.body[ga]])
+    if gp.kind[gb] != -1:
+        levers[1] = _lever(gp, gb, mp.ref_points[gp.body[gb]])
+    spent = 0
+    sp = int(res[R_SP])
+    if res[R_STARTED] == 0.0:
+        res[R_STARTED] = 1.0
+        res[R_WTIME] = np.nan
+        res[R_CLEAR] = np.inf
+        res[R_FIRST_UNRES] = np.nan
+        res[R_TESTS] = 0.0
+        res[R_DEPTH] = 0.0
+        res[R_UNRES] = 0.0
+        res[R_PAPER] = 0.0
+        # start pose: exact static test at t0
+        body_pose(mp, gp.body[ga], t0, pA, RA)
+        body_pose(mp, gp.body[gb], t0, pB, RB)
+        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+        spent += 1
+        res[R_TESTS] += 1.0
+        if up + approx < margin:
+            res[R_WTIME] = t0
+            for r in range(3):
+                res[R_WPOINT + r] = w[r]
+            res[R_WUPPER] = up + approx
+            res[R_VERDICT] = VIOLATION
+            res[R_SP] = 0.0
+            return VIOLATION
+        sp = _push(stack, 0, t0, t1, 0.0)
+    while sp > 0:
+        if spent >= max_tests:
+            res[R_SP] = sp
+            res[R_PAPER] += stats[0]
+            res[R_VERDICT] = PAUSED
+            return PAUSED
+        sp -= 1
+        a, b, depth = stack[sp, 0], stack[sp, 1], stack[sp, 2]
+        wt = res[R_WTIME]
+        if wt == wt and a >= wt:      # a confirmed violation earlier than this interval
+            continue
+        m = 0.5 * (a + b)
+        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats)
+        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+        spent += 1
+        res[R_TESTS] += 1.0
+        if depth > res[R_DEPTH]:
+            res[R_DEPTH] = depth
+        if up + approx < margin:
+            res[R_WTIME] = m
+            for r in range(3):
+                res[R_WPOINT + r] = w[r]
+            res[R_WUPPER] = up + approx
+            if mode == MODE_CERTIFY_ONLY:
+                sp = 0
+                break
+            # everything on the stack is later than m: search [a, m] only
+            sp = 0
+            if depth < max_depth and a < m and bound >= epsilon:
+                sp = _push(stack, 0, a, m, depth + 1.0)
+            continue
+        slack = lo - bound - (rel_pad * (abs(lo) + bound + margin) + abs_pad)
+        if slack > margin:
+            if slack < res[R_CLEAR]:
+                res[R_CLEAR] = slack
+            continue
+        if not (bound >= epsilon) or depth >= max_depth or not (a < m < b):
+            if wt == wt:               # refining an earlier witness: nothing more to find here
+                continue
+            res[R_UNRES] += 1.0
+            if not (res[R_FIRST_UNRES] == res[R_FIRST_UNRES]):
+                res[R_FIRST_UNRES] = a
+            if mode == MODE_CERTIFY_ONLY:
+                sp = 0
+                break
+            continue
+        sp = _push(stack, sp, m, b, depth + 1.0)
+        sp = _push(stack, sp, a, m, depth + 1.0)
+    res[R_SP] = 0.0
+    res[R_PAPER] += stats[0]
+    if res[R_WTIME] == res[R_WTIME]:
+        res[R_VERDICT] = VIOLATION
+        return VIOLATION
+    if res[R_UNRES] > 0.0:
+        res[R_VERDICT] = UNRESOLVED
+        return UNRESOLVED
+    res[R_VERDICT] = CERTIFIED
+    return CERTIFIED
+
+
+@njit(cache=True)
+def pairs_window(gp, mp, pairs, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad, res):
+    """:func:`pair_window` for every row of ``pairs`` (P, 2) int64; results into ``res`` (P, R_SIZE).
+
+    Each pair gets a fresh search with at most ``max_tests`` tests (PAUSED beyond).
+    """
+    stack = np.empty((max_depth + 2, 3))
+    for k in range(pairs.shape[0]):
+        for j in range(R_SIZE):
+            res[k, j] = 0.0
+        pair_window(gp, mp, pairs[k, 0], pairs[k, 1], t0, t1, margin, epsilon, max_depth, max_tests, mode,
+                    rel_pad, abs_pad, stack, res[k])
+
+
+def new_result() -> np.ndarray:
+    """A fresh (R_SIZE,) result row for :func:`pair_window`."""
+    return np.zeros(R_SIZE)
+
+
+
+
+
+_NAMES = {CERTIFIED: "certified", VIOLATION: "violation", UNRESOLVED: "unresolved", PAUSED: "unresolved",
+          UNSUPPORTED: "unsupported"}
+
+
+def check_pair_window(gp, mp, ga: int, gb: int, window: tuple[float, float], margin: float, epsilon: float, *,
+                      max_depth: int = 40, max_tests: int | None = None, deadline: float | None = None,
+                      certify_only: bool = False, rel_pad: float = 64 * 2.0**-52, abs_pad: float = 1e-12,
+                      batch: int = 64) -> dict:
+    """Python driver of :func:`pair_window` with a test budget and an optional wall-clock deadline.
+
+    numba has no clock, so with a ``deadline`` (a ``time.perf_counter()`` value) the kernel
+    runs in batches of ``batch`` tests and the clock is checked between batches; a run
+    stopped by the budget or the deadline is ``"unresolved"`` (or ``"violation"`` if a
+    violation was already confirmed), never ``"certified"``.
+
+    Returns:
+        dict with ``verdict`` ("certified" | "violation" | "unresolved" | "unsupported"),
+        ``witness_time``, ``witness_point`` (3,) world, ``witness_upper``, ``clearance``
+        (lower bound, m; meaningful when certified), ``tests``, ``max_depth``,
+        ``unresolved`` (count), ``first_unresolved`` (s), ``paper_ball_wins``, ``stopped``
+        ("" | "budget" | "deadline").
+    """
+    import time
+
+    stack = np.empty((int(max_depth) + 2, 3))
+    res = new_result()
+    left = np.iinfo(np.int64).max if max_tests is None else int(max_tests)
+    mode = MODE_CERTIFY_ONLY if certify_only else MODE_FULL
+    stopped = ""
+    while True:
+        n = left if deadline is None else min(left, int(batch))
+        before = res[R_TESTS]
+        v = pair_window(gp, mp, int(ga), int(gb), float(window[0]), float(window[1]), float(margin),
+                        float(epsilon), int(max_depth), n, mode, float(rel_pad), float(abs_pad), stack, res)
+        left -= int(res[R_TESTS] - before)
+        if v != PAUSED:
+            break
+        if left <= 0:
+            stopped = "budget"
+            break
+        if deadline is not None and time.perf_counter() >= deadline:
+            stopped = "deadline"
+            break
+    if v == PAUSED:
+        v = VIOLATION if res[R_WTIME] == res[R_WTIME] else UNRESOLVED
+    wt = float(res[R_WTIME])
+    return {"verdict": _NAMES[int(v)], "witness_time": None if wt != wt else wt,
+            "witness_point": res[R_WPOINT:R_WPOINT + 3].copy(), "witness_upper": float(res[R_WUPPER]),
+            "clearance": float(res[R_CLEAR]) if v == CERTIFIED else float("-inf"),
+            "tests": int(res[R_TESTS]), "max_depth": int(res[R_DEPTH]), "unresolved": int(res[R_UNRES]),
+            "first_unresolved": float(res[R_FIRST_UNRES]), "paper_ball_wins": int(res[R_PAPER]),
+            "stopped": stopped}
+
+
+__all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MODE_FULL", "MODE_CERTIFY_ONLY",
+           "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
+           "check_pair_window"]
