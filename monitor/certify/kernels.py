@@ -70,7 +70,7 @@ import numpy as np
 from numba import njit
 
 from monitor.certify._motion_standin import body_bound, body_pose
-from monitor.geometry._gjk import OUT_SIZE, core_distance, halfspace_distance
+from monitor.geometry._gjk import OUT_SIZE, _depth_at, _rotate, _transform, core_distance, halfspace_distance
 
 # ---------------------------------------------------------------------------- codes
 
@@ -148,7 +148,53 @@ def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
                   _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
     for r in range(3):
         w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pa[r]
+    if ka == 2 and kb == 2 and out[0] != 0.0 and not out[3] < 0.0:
+        _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, gp.dpad[ga], gp.dpad[gb], out)
     return out[2] - ra - rb, out[3] - ra - rb
+
+
+@njit(cache=True)
+def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
+    """Overlapping polytopes whose GJK/EPA gave no negative upper bound (e.g. containment).
+
+    Candidate common points x (GJK's point ``out[4:7]`` in the frame shifted by pa, and
+    the vertex centroids of A and of B): with certified depths
+    d_A >= 0, d_B >= 0 of x in both cores (face normals, minus the normals' depth pad
+    and 2 pads of rounding), B(x, d_A) lies in A and B(x, d_B) in B, so separating them
+    needs a translation of at least d_A + d_B: ``upper = -(d_A + d_B)`` (the same
+    certificate as ``distance._depth_lp``, at GJK's point instead of the LP optimum).
+    """
+    VA = np.empty((PA.shape[0], 3))
+    VB = np.empty((PB.shape[0], 3))
+    z = np.zeros(3)
+    d = np.empty(3)
+    for r in range(3):
+        d[r] = pb[r] - pa[r]
+    _transform(PA, Ra, z, VA)
+    _transform(PB, Rb, d, VB)
+    WNA = np.empty((NA.shape[0], 3))
+    WNB = np.empty((NB.shape[0], 3))
+    _rotate(NA, Ra, WNA)
+    _rotate(NB, Rb, WNB)
+    pad = out[10]
+    x = np.empty(3)
+    for k in range(3):      # candidates: GJK's point, the vertex centroids of A and of B
+        for r in range(3):
+            if k == 0:
+                x[r] = out[4 + r]
+            else:
+                acc = 0.0
+                V = VA if k == 1 else VB
+                for i in range(V.shape[0]):
+                    acc += V[i, r]
+                x[r] = acc / V.shape[0]
+        da = _depth_at(VA, WNA, x) - 2.0 * pad - dpad_a
+        db = _depth_at(VB, WNB, x) - 2.0 * pad - dpad_b
+        if da >= 0.0 and db >= 0.0 and -(da + db) < out[3]:
+            out[3] = -(da + db)
+            for r in range(3):
+                out[4 + r] = x[r]
+                out[7 + r] = x[r]
 
 
 @njit(cache=True)
