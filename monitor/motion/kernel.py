@@ -1,0 +1,903 @@
+r"""Compiled forward kinematics and certified motion bounds over a :class:`MotionPack`.
+
+numba, nopython, ``cache=True``; numpy and numba only (no MuJoCo). The arrays come
+from :func:`monitor.motion.pack.pack_trajectory`, which packs a :class:`monitor.Plan`
+(joint waypoints of a MuJoCo tree) or a :class:`monitor.BodyMotion` (every body a
+free-joint child of the world) into one flat :class:`~monitor.motion.pack.MotionPack`.
+
+What is computed is exactly what :mod:`monitor.motion.plan` derives (its module
+docstring is THE contract and the derivation; the section names below refer to it):
+
+* **Interpolation.** Piecewise in time, breakpoints at the waypoints. Scalar joint
+  coordinates and free-joint positions: ``a + s (b - a)``; ball and free quaternions:
+  shortest-arc slerp (``QuatTrack.interp`` of :mod:`monitor.motion._kinematics`, same
+  formulas); at the last waypoint time the stored waypoint is returned exactly.
+* **Forward kinematics.** MuJoCo's ``mj_kinematics`` rules: X_Wb = X_WP T0 G_1 ... G_n
+  in quaternions; a free joint sets the world pose; mocap bodies (and the world) hold
+  their packed pose. Equal to ``mj_kinematics`` up to a few ulp.
+* **Motion bound** for body b on [ta, tb], midpoint m, w.r.t. ``ref_points[b]``:
+  the minimum of (i) the *chain bound* (sum of single-joint deviations of every joint
+  root -> b at the world reference point, "Own (local) motion"), (ii) the same through
+  the parent's bound ("Parent"), and (iii) on sub-intervals inside one segment the
+  second-order *velocity (Taylor) bound* (``Plan._velocity_bound``). Joint deviations
+  are the maxima over the vertices {ta, tb, waypoints inside} ("Joint deviations");
+  quaternion deviations the slerp path length, plus the exact waypoint angle across
+  waypoints (``rotation_deviation``). An interval spanning several segments is thus
+  bounded soundly without splitting (the vertex maxima cover every piece).
+* **Rounding.** The same pads as ``Plan._bounds``: rel_pad/abs_pad/scale_pad with the
+  plan's coordinate scale (computed ONCE at pack time, ``tol[3]``), joint-coordinate
+  magnitude ``tol[4]`` and rotation path magnitude ``tol[5]``.
+* **Never NaN.** A bound that comes out NaN (overflowing inputs) is returned as
+  ``inf`` (translation) / ``pi`` (angle, always valid); callers treat inf as
+  "cannot certify".
+
+Preconditions (not checked in the kernels, checked by the Python helpers):
+``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
+
+Joint type codes are MuJoCo's: 0 free, 1 ball, 2 slide, 3 hinge.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_FREE = 0
+_BALL = 1
+_SLIDE = 2
+_HINGE = 3
+
+# Virtual joint kinds (as in plan.py): 0 hinge, 1 slide, 2 ball, 3 free translation, 4 free rotation.
+_V_HINGE = 0
+_V_SLIDE = 1
+_V_BALL = 2
+_V_FREE_T = 3
+_V_FREE_R = 4
+
+# Indices into MotionPack.tol.
+TOL_REL = 0
+TOL_ABS = 1
+TOL_SCALE_PAD = 2
+TOL_SCALE = 3
+TOL_QMAG = 4
+TOL_PATHMAG = 5
+
+
+# ------------------------------------------------------------------ small helpers
+@njit(cache=True)
+def _chord(a: float) -> float:
+    """2 sin(min(a, pi) / 2)."""
+    if a > math.pi:
+        a = math.pi
+    return 2.0 * math.sin(0.5 * a)
+
+
+@njit(cache=True)
+def _sinc(x: float) -> float:
+    """sin(x) / x (np.sinc(x / pi))."""
+    if x == 0.0:
+        return 1.0
+    return math.sin(x) / x
+
+
+@njit(cache=True)
+def _norm3(x: float, y: float, z: float) -> float:
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@njit(cache=True)
+def _search_right(times: np.ndarray, t: float) -> int:
+    """Number of entries <= t (np.searchsorted side='right')."""
+    lo = 0
+    hi = times.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if times[mid] <= t:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True)
+def _search_left(times: np.ndarray, t: float) -> int:
+    """Number of entries < t (np.searchsorted side='left')."""
+    lo = 0
+    hi = times.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if times[mid] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True)
+def _locate(times: np.ndarray, t: float) -> tuple[int, float, bool]:
+    """(segment i, parameter s in [0, 1], at_end) as ``Segments.locate``."""
+    K = times.shape[0]
+    i = _search_right(times, t) - 1
+    if i < 0:
+        i = 0
+    if i > K - 2:
+        i = K - 2
+    s = (t - times[i]) / (times[i + 1] - times[i])
+    if s < 0.0:
+        s = 0.0
+    if s > 1.0:
+        s = 1.0
+    return i, s, t >= times[K - 1]
+
+
+@njit(cache=True)
+def _quat_mul(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    """Set out = a * b (Hamilton, MuJoCo's mju_mulQuat); out may alias a or b."""
+    w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3]
+    x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2]
+    y = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1]
+    z = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]
+    out[0] = w
+    out[1] = x
+    out[2] = y
+    out[3] = z
+
+
+@njit(cache=True)
+def _quat_normalize(q: np.ndarray) -> None:
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if n > 0.0:
+        q[0] /= n
+        q[1] /= n
+        q[2] /= n
+        q[3] /= n
+    else:
+        q[0] = 1.0
+        q[1] = 0.0
+        q[2] = 0.0
+        q[3] = 0.0
+
+
+@njit(cache=True)
+def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
+    """R (3, 3) of a unit quaternion q (w, x, y, z)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    R[0, 1] = 2.0 * (x * y - w * z)
+    R[0, 2] = 2.0 * (x * z + w * y)
+    R[1, 0] = 2.0 * (x * y + w * z)
+    R[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    R[1, 2] = 2.0 * (y * z - w * x)
+    R[2, 0] = 2.0 * (x * z - w * y)
+    R[2, 1] = 2.0 * (y * z + w * x)
+    R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True)
+def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    """Set out = R(q) v for a unit quaternion q (v and out (3,), may not alias)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    v0, v1, v2 = v[0], v[1], v[2]
+    out[0] = (1.0 - 2.0 * (y * y + z * z)) * v0 + 2.0 * (x * y - w * z) * v1 + 2.0 * (x * z + w * y) * v2
+    out[1] = 2.0 * (x * y + w * z) * v0 + (1.0 - 2.0 * (x * x + z * z)) * v1 + 2.0 * (y * z - w * x) * v2
+    out[2] = 2.0 * (x * z - w * y) * v0 + 2.0 * (y * z + w * x) * v1 + (1.0 - 2.0 * (x * x + y * y)) * v2
+
+
+@njit(cache=True)
+def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Rotation angle (rad, [0, pi]) of R(a) R(b)^T, as ``_kinematics.quat_angle``."""
+    d = 0.0
+    s = 0.0
+    for k in range(4):
+        d += (a[k] - b[k]) ** 2
+        s += (a[k] + b[k]) ** 2
+    d = math.sqrt(d)
+    s = math.sqrt(s)
+    return 4.0 * math.atan2(min(d, s), max(d, s))
+
+
+# ------------------------------------------------------------------ interpolation
+@njit(cache=True)
+def _lerp_col(mp, c: int, i: int, s: float, at_end: bool) -> float:
+    """Interpolated qpos column c at (segment i, parameter s)."""
+    q = mp.qpos
+    if at_end:
+        return q[q.shape[0] - 1, c]
+    a = q[i, c]
+    return a + s * (q[i + 1, c] - a)
+
+
+@njit(cache=True)
+def _slerp(mp, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
+    """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
+    adr = mp.qt_adr[k]
+    q = mp.qpos
+    if at_end:
+        last = q.shape[0] - 1
+        for c in range(4):
+            out[c] = q[last, adr + c]
+        return
+    if mp.qt_same[k, i] != 0 or s == 0.0:
+        for c in range(4):
+            out[c] = q[i, adr + c]
+        return
+    h = mp.qt_half[k, i]
+    den = _sinc(h)
+    c0 = (1.0 - s) * _sinc((1.0 - s) * h) / den
+    c1 = s * _sinc(s * h) / den
+    for c in range(4):
+        out[c] = c0 * q[i, adr + c] + c1 * mp.qt_target[k, i, c]
+
+
+@njit(cache=True)
+def _qpos_at(mp, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
+    """Interpolated qpos (nq,) at (segment i, parameter s)."""
+    nq = mp.qpos.shape[1]
+    for c in range(nq):
+        out[c] = _lerp_col(mp, c, i, s, at_end)
+    tmp = np.empty(4)
+    for k in range(mp.qt_adr.shape[0]):
+        _slerp(mp, k, i, s, at_end, tmp)
+        adr = mp.qt_adr[k]
+        for c in range(4):
+            out[adr + c] = tmp[c]
+
+
+@njit(cache=True)
+def _track_path(mp, k: int, i: int, s: float) -> float:
+    return mp.qt_cum[k, i] + s * mp.qt_phi[k, i]
+
+
+# ------------------------------------------------------------------ forward kinematics
+@njit(cache=True)
+def _fk(mp, q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray,
+        janchor: np.ndarray, jaxis: np.ndarray, jframe: np.ndarray) -> None:
+    """MuJoCo's mj_kinematics for the bodies with need[b] != 0 (their ancestors must be needed too).
+
+    Args:
+        q: (nq,) joint positions.
+        need: (nbody,) int mask.
+        xpos, xquat, xmat: (nbody, 3), (nbody, 4), (nbody, 3, 3) outputs (world).
+        janchor, jaxis: (njnt, 3) world joint anchors and (unnormalised) axes, before each joint acts.
+        jframe: (njnt, 4) world orientation of the frame each joint acts in (before the joint).
+    """
+    nbody = xpos.shape[0]
+    tmp3 = np.empty(3)
+    qloc = np.empty(4)
+    for b in range(nbody):
+        if need[b] == 0:
+            continue
+        if b == 0 or mp.body_mocap[b] != 0:
+            for c in range(3):
+                xpos[b, c] = mp.body_pos[b, c]
+            for c in range(4):
+                xquat[b, c] = mp.body_quat[b, c]
+            _quat_normalize(xquat[b])
+            _quat_to_mat(xquat[b], xmat[b])
+            continue
+        ja = mp.body_jntadr[b]
+        jn = mp.body_jntnum[b]
+        if jn >= 1 and mp.jnt_type[ja] == _FREE:
+            adr = mp.jnt_qposadr[ja]
+            for c in range(3):
+                xpos[b, c] = q[adr + c]
+                janchor[ja, c] = q[adr + c]
+                jaxis[ja, c] = mp.jnt_axis[ja, c]
+            for c in range(4):
+                xquat[b, c] = q[adr + 3 + c]
+            _quat_normalize(xquat[b])
+            jframe[ja, 0] = 1.0
+            jframe[ja, 1] = 0.0
+            jframe[ja, 2] = 0.0
+            jframe[ja, 3] = 0.0
+            _quat_to_mat(xquat[b], xmat[b])
+            continue
+        p = mp.body_parent[b]
+        for r in range(3):
+            xpos[b, r] = xpos[p, r] + (xmat[p, r, 0] * mp.body_pos[b, 0] + xmat[p, r, 1] * mp.body_pos[b, 1]
+                                       + xmat[p, r, 2] * mp.body_pos[b, 2])
+        _quat_mul(xquat[p], mp.body_quat[b], xquat[b])
+        for j in range(ja, ja + jn):
+            typ = mp.jnt_type[j]
+            adr = mp.jnt_qposadr[j]
+            for c in range(4):
+                jframe[j, c] = xquat[b, c]
+            _rot_vec(xquat[b], mp.jnt_pos[j], tmp3)
+            for c in range(3):
+                janchor[j, c] = tmp3[c] + xpos[b, c]
+            _rot_vec(xquat[b], mp.jnt_axis[j], tmp3)
+            for c in range(3):
+                jaxis[j, c] = tmp3[c]
+            if typ == _SLIDE:
+                d = q[adr] - mp.qpos0[adr]
+                for c in range(3):
+                    xpos[b, c] += jaxis[j, c] * d
+                continue
+            if typ == _BALL:
+                for c in range(4):
+                    qloc[c] = q[adr + c]
+                _quat_normalize(qloc)
+            else:  # hinge
+                ang = q[adr] - mp.qpos0[adr]
+                n = mp.jnt_axis_norm[j]
+                if ang == 0.0:
+                    qloc[0] = 1.0
+                    qloc[1] = 0.0
+                    qloc[2] = 0.0
+                    qloc[3] = 0.0
+                else:
+                    sh = math.sin(0.5 * ang)
+                    qloc[0] = math.cos(0.5 * ang)
+                    for c in range(3):
+                        qloc[1 + c] = sh * mp.jnt_axis[j, c] / n
+            _quat_mul(xquat[b], qloc, xquat[b])
+            _rot_vec(xquat[b], mp.jnt_pos[j], tmp3)
+            for c in range(3):
+                xpos[b, c] = janchor[j, c] - tmp3[c]
+        _quat_normalize(xquat[b])
+        _quat_to_mat(xquat[b], xmat[b])
+
+
+@njit(cache=True)
+def _ancestors(mp, body: int, need: np.ndarray) -> None:
+    """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
+    need[:] = 0
+    c = body
+    while True:
+        need[c] = 1
+        if c == 0:
+            break
+        c = mp.body_parent[c]
+
+
+@njit(cache=True)
+def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
+    """World pose of ``body`` at time ``t``: origin p_W_out (3,) m and rotation R_WB_out (3, 3)."""
+    nbody = mp.body_parent.shape[0]
+    njnt = mp.jnt_type.shape[0]
+    need = np.empty(nbody, dtype=np.int64)
+    _ancestors(mp, body, need)
+    q = np.empty(mp.qpos.shape[1])
+    i, s, at_end = _locate(mp.times, t)
+    _qpos_at(mp, i, s, at_end, q)
+    xpos = np.empty((nbody, 3))
+    xquat = np.empty((nbody, 4))
+    xmat = np.empty((nbody, 3, 3))
+    ja = np.empty((njnt, 3))
+    jx = np.empty((njnt, 3))
+    jf = np.empty((njnt, 4))
+    _fk(mp, q, need, xpos, xquat, xmat, ja, jx, jf)
+    for r in range(3):
+        p_W_out[r] = xpos[body, r]
+        for c in range(3):
+            R_WB_out[r, c] = xmat[body, r, c]
+
+
+@njit(cache=True)
+def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
+    """World poses of every body at time ``t``: p_W_out (nbody, 3), R_WB_out (nbody, 3, 3)."""
+    nbody = mp.body_parent.shape[0]
+    njnt = mp.jnt_type.shape[0]
+    need = np.ones(nbody, dtype=np.int64)
+    q = np.empty(mp.qpos.shape[1])
+    i, s, at_end = _locate(mp.times, t)
+    _qpos_at(mp, i, s, at_end, q)
+    xquat = np.empty((nbody, 4))
+    ja = np.empty((njnt, 3))
+    jx = np.empty((njnt, 3))
+    jf = np.empty((njnt, 4))
+    _fk(mp, q, need, p_W_out, xquat, R_WB_out, ja, jx, jf)
+
+
+# ------------------------------------------------------------------ joint deviations
+@njit(cache=True)
+def _col_dev(mp, c: int, qm_c: float, la, lb, lo: int, hi: int) -> float:
+    """Maximum over the vertices of |q_c(t) - q_c(m)| (scalar_deviation)."""
+    va = _lerp_col(mp, c, la[0], la[1], la[2])
+    vb = _lerp_col(mp, c, lb[0], lb[1], lb[2])
+    dev = max(abs(va - qm_c), abs(vb - qm_c))
+    for w in range(lo, hi):
+        d = abs(mp.qpos[w, c] - qm_c)
+        if d > dev:
+            dev = d
+    return dev
+
+
+@njit(cache=True)
+def _vec_dev(mp, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
+    """Maximum over the vertices of ||x(t) - x(m)|| for qpos columns adr..adr+2 (vector_deviation)."""
+    da = 0.0
+    db = 0.0
+    for c in range(3):
+        da += (_lerp_col(mp, adr + c, la[0], la[1], la[2]) - qm[adr + c]) ** 2
+        db += (_lerp_col(mp, adr + c, lb[0], lb[1], lb[2]) - qm[adr + c]) ** 2
+    dev = max(math.sqrt(da), math.sqrt(db))
+    for w in range(lo, hi):
+        d = 0.0
+        for c in range(3):
+            d += (mp.qpos[w, adr + c] - qm[adr + c]) ** 2
+        d = math.sqrt(d)
+        if d > dev:
+            dev = d
+    return dev
+
+
+@njit(cache=True)
+def _rot_dev(mp, k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, lm, lo: int, hi: int) -> float:
+    """Bound on the rotation angle of track k from the midpoint over [ta, tb] (rotation_deviation)."""
+    times = mp.times
+    K = times.shape[0]
+    s_m = _track_path(mp, k, lm[0], lm[1])
+    j = _search_right(times, tm) - 1
+    if j < 0:
+        j = 0
+    if j > K - 1:
+        j = K - 1
+    near_left = max(times[j], ta)
+    near_right = max(min(times[min(j + 1, K - 1)], tb), tm)
+    i_l, s_l, _ = _locate(times, near_left)
+    i_r, s_r, _ = _locate(times, near_right)
+    dev = max(abs(s_m - _track_path(mp, k, i_l, s_l)), abs(_track_path(mp, k, i_r, s_r) - s_m))
+    adr = mp.qt_adr[k]
+    for w in range(lo, hi):
+        d_w = _quat_angle(mp.qpos[w, adr:adr + 4], qm_unit)
+        if times[w] <= tm:
+            outer = max(times[max(w - 1, 0)], ta)
+        else:
+            outer = min(times[min(w + 1, K - 1)], tb)
+        i_o, s_o, _ = _locate(times, outer)
+        v = d_w + abs(_track_path(mp, k, i_o, s_o) - mp.qt_cum[k, w])
+        if v > dev:
+            dev = v
+    return min(dev, math.pi)
+
+
+@njit(cache=True)
+def _track_omega(mp, k: int, seg: int, out: np.ndarray) -> None:
+    """Angular velocity (3,) per unit segment parameter of track k on segment seg.
+
+    ``QuatTrack.angular_velocity`` with dt = 1, in the frame the quaternions map into.
+    """
+    adr = mp.qt_adr[k]
+    a = mp.qpos[seg, adr:adr + 4]
+    b = mp.qt_target[k, seg]
+    # vector part of b * conj(a)
+    vx = -b[0] * a[1] + b[1] * a[0] - b[2] * a[3] + b[3] * a[2]
+    vy = -b[0] * a[2] + b[1] * a[3] + b[2] * a[0] - b[3] * a[1]
+    vz = -b[0] * a[3] - b[1] * a[2] + b[2] * a[1] + b[3] * a[0]
+    sc = 2.0 / _sinc(0.5 * mp.qt_phi[k, seg])
+    out[0] = vx * sc
+    out[1] = vy * sc
+    out[2] = vz * sc
+
+
+# ------------------------------------------------------------------ bounds
+@njit(cache=True)
+def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
+                 trans: np.ndarray, angle: np.ndarray) -> None:
+    """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
+
+    ``need`` must be closed under ancestors. Fills xpos (nbody, 3), xmat (nbody, 3, 3),
+    trans (nbody,) m and angle (nbody,) rad for those bodies (0 for static ones).
+    """
+    rel = mp.tol[TOL_REL]
+    abs_pad = mp.tol[TOL_ABS]
+    scale_pad = mp.tol[TOL_SCALE_PAD]
+    scale = mp.tol[TOL_SCALE]
+    qmag = mp.tol[TOL_QMAG]
+    pathmag = mp.tol[TOL_PATHMAG]
+    times = mp.times
+    nbody = xpos.shape[0]
+    njnt = mp.jnt_type.shape[0]
+    nq = mp.qpos.shape[1]
+
+    tm = 0.5 * (ta + tb)
+    la = _locate(times, ta)
+    lb = _locate(times, tb)
+    lm = _locate(times, tm)
+    lo = _search_right(times, ta)
+    hi = _search_left(times, tb)
+    qm = np.empty(nq)
+    _qpos_at(mp, lm[0], lm[1], lm[2], qm)
+    xquat = np.empty((nbody, 4))
+    janchor = np.empty((njnt, 3))
+    jaxis = np.empty((njnt, 3))
+    jframe = np.empty((njnt, 4))
+    _fk(mp, qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
+
+    # Single-segment sub-interval: the velocity bound applies.
+    seg = lm[0]
+    b_next = lb[0] == seg + 1 and lb[1] == 0.0
+    single = la[0] == seg and (lb[0] == seg or b_next) and hi <= lo
+    h = 0.0
+    if single:
+        s_b = 1.0 if b_next else lb[1]
+        h = max(max(s_b - lm[1], lm[1] - la[1]), 0.0)
+
+    # Virtual joints (2 slots per joint: [2j] translation / single, [2j+1] free rotation).
+    nv = 2 * njnt
+    vkind = np.empty(nv, dtype=np.int64)
+    vanchor = np.zeros((nv, 3))
+    vaxis = np.zeros((nv, 3))
+    vcoef = np.zeros(nv)
+    vang = np.zeros(nv)
+    vrate = np.zeros((nv, 3))
+    qu = np.empty(4)
+    om = np.empty(4)
+    for b in range(1, nbody):
+        if need[b] == 0 or mp.body_moving[b] == 0:
+            continue
+        for j in range(mp.body_jntadr[b], mp.body_jntadr[b] + mp.body_jntnum[b]):
+            typ = mp.jnt_type[j]
+            adr = mp.jnt_qposadr[j]
+            v = 2 * j
+            if typ == _FREE or typ == _BALL:
+                k = mp.jnt_track[j]
+                qa = adr + 3 if typ == _FREE else adr
+                for c in range(4):
+                    qu[c] = qm[qa + c]
+                _quat_normalize(qu)
+                th = _rot_dev(mp, k, qu, ta, tb, tm, lm, lo, hi)
+                th += rel * (mp.qt_cum[k, times.shape[0] - 1] + 1.0)
+                if single:
+                    _track_omega(mp, k, seg, om)
+                if typ == _FREE:
+                    dx = _vec_dev(mp, adr, qm, la, lb, lo, hi) + rel * qmag
+                    vkind[v] = _V_FREE_T
+                    vcoef[v] = dx
+                    vkind[v + 1] = _V_FREE_R
+                    for c in range(3):
+                        vanchor[v + 1, c] = xpos[b, c]
+                    vcoef[v + 1] = _chord(th)
+                    vang[v + 1] = th
+                    if single:
+                        for c in range(3):
+                            vrate[v, c] = mp.qpos[seg + 1, adr + c] - mp.qpos[seg, adr + c]
+                            vrate[v + 1, c] = om[c]
+                else:
+                    vkind[v] = _V_BALL
+                    for c in range(3):
+                        vanchor[v, c] = janchor[j, c]
+                    vcoef[v] = _chord(th)
+                    vang[v] = th
+                    if single:
+                        _rot_vec(jframe[j], om[:3], vrate[v])
+            else:
+                dq = _col_dev(mp, adr, qm[adr], la, lb, lo, hi) + rel * qmag
+                rate = (mp.qpos[seg + 1, adr] - mp.qpos[seg, adr]) if single else 0.0
+                if typ == _HINGE:
+                    n = mp.jnt_axis_norm[j]
+                    vkind[v] = _V_HINGE
+                    for c in range(3):
+                        vanchor[v, c] = janchor[j, c]
+                        vaxis[v, c] = jaxis[j, c] / n
+                        vrate[v, c] = rate * vaxis[v, c]
+                    vcoef[v] = _chord(dq)
+                    vang[v] = dq
+                else:  # slide
+                    vkind[v] = _V_SLIDE
+                    vcoef[v] = dq * mp.jnt_axis_norm[j]
+                    for c in range(3):
+                        vrate[v, c] = rate * jaxis[j, c]
+
+    # Per body: chain root -> body over the moving bodies.
+    chain = np.empty(nv, dtype=np.int64)
+    stack = np.empty(nbody, dtype=np.int64)
+    p_ref = np.empty((nbody, 3))
+    D = np.empty((nv, 3))
+    r0 = np.empty(nv)
+    suffix = np.empty(nv)
+    rmax = np.empty(nv)
+    for b in range(nbody):
+        if need[b] == 0:
+            continue
+        for r in range(3):
+            rp = mp.ref_points[b]
+            p_ref[b, r] = xpos[b, r] + (xmat[b, r, 0] * rp[0] + xmat[b, r, 1] * rp[1] + xmat[b, r, 2] * rp[2])
+        if b == 0 or mp.body_moving[b] == 0:
+            trans[b] = 0.0
+            angle[b] = 0.0
+            continue
+        # Ancestors (moving) root-first.
+        ns = 0
+        c = b
+        while c != 0 and mp.body_moving[c] != 0:
+            stack[ns] = c
+            ns += 1
+            c = mp.body_parent[c]
+        L = 0
+        own_start = 0
+        for si in range(ns - 1, -1, -1):
+            cb = stack[si]
+            if cb == b:
+                own_start = L
+            for j in range(mp.body_jntadr[cb], mp.body_jntadr[cb] + mp.body_jntnum[cb]):
+                chain[L] = 2 * j
+                L += 1
+                if mp.jnt_type[j] == _FREE:
+                    chain[L] = 2 * j + 1
+                    L += 1
+        # Chain terms at the world reference point.
+        T_dir = 0.0
+        T_own = 0.0
+        Th = 0.0
+        for li in range(L):
+            v = chain[li]
+            kd = vkind[v]
+            dx = p_ref[b, 0] - vanchor[v, 0]
+            dy = p_ref[b, 1] - vanchor[v, 1]
+            dz = p_ref[b, 2] - vanchor[v, 2]
+            D[li, 0] = dx
+            D[li, 1] = dy
+            D[li, 2] = dz
+            dist = _norm3(dx, dy, dz)
+            r0[li] = dist
+            if kd == _V_HINGE:
+                ax = vaxis[v]
+                lever = _norm3(ax[1] * dz - ax[2] * dy, ax[2] * dx - ax[0] * dz, ax[0] * dy - ax[1] * dx)
+            elif kd == _V_BALL or kd == _V_FREE_R:
+                lever = dist
+            else:
+                lever = 1.0
+            term = vcoef[v] * lever
+            if kd != _V_SLIDE and kd != _V_FREE_T:
+                term += rel * scale * vcoef[v]
+            T_dir += term
+            if li >= own_start:
+                T_own += term
+                Th += vang[v]
+        P = mp.body_parent[b]
+        T = T_dir
+        if P != 0 and mp.body_moving[P] != 0 and own_start > 0:
+            dpx = p_ref[b, 0] - p_ref[P, 0]
+            dpy = p_ref[b, 1] - p_ref[P, 1]
+            dpz = p_ref[b, 2] - p_ref[P, 2]
+            T_rec = T_own + trans[P] + _chord(angle[P]) * _norm3(dpx, dpy, dpz)
+            T_dir = T_dir * (1.0 + rel) + abs_pad + scale_pad * scale
+            T = min(T_rec, T_dir)
+            Th = Th + angle[P]
+        if single:
+            # Velocity (Taylor) bound, Plan._velocity_bound.
+            Vx = 0.0
+            Vy = 0.0
+            Vz = 0.0
+            Wx = 0.0
+            Wy = 0.0
+            Wz = 0.0
+            acc = 0.0
+            for li in range(L - 1, -1, -1):  # suffix sums of e (joints nearer the body)
+                v = chain[li]
+                kd = vkind[v]
+                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+                wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
+                suffix[li] = acc
+                if rot:
+                    e = _chord(wabs * h) * r0[li]
+                else:
+                    e = wabs * h
+                acc += e
+            S_acc = 0.0
+            S0 = 0.0
+            sum_rmax = 0.0
+            for li in range(L - 1, -1, -1):
+                v = chain[li]
+                kd = vkind[v]
+                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+                wabs = _norm3(vrate[v, 0], vrate[v, 1], vrate[v, 2])
+                rm = (r0[li] if rot else 0.0) + suffix[li]
+                rmax[li] = rm
+                sum_rmax += rm
+                S_acc += wabs * rm if rot else wabs
+                suffix[li] = S_acc  # now S_k
+            if L > 0:
+                S0 = suffix[0]
+            Omega = 0.0
+            A = 0.0
+            AW = 0.0
+            wrot_sum = 0.0
+            for li in range(L):
+                v = chain[li]
+                kd = vkind[v]
+                rot = kd == _V_HINGE or kd == _V_BALL or kd == _V_FREE_R
+                w0, w1, w2 = vrate[v, 0], vrate[v, 1], vrate[v, 2]
+                wabs = _norm3(w0, w1, w2)
+                if rot:
+                    Vx += w1 * D[li, 2] - w2 * D[li, 1]
+                    Vy += w2 * D[li, 0] - w0 * D[li, 2]
+                    Vz += w0 * D[li, 1] - w1 * D[li, 0]
+                    Wx += w0
+                    Wy += w1
+                    Wz += w2
+                    A += wabs * (2.0 * Omega * rmax[li] + suffix[li])
+                    AW += wabs * Omega
+                    Omega += wabs
+                    wrot_sum += wabs
+                else:
+                    Vx += w0
+                    Vy += w1
+                    Vz += w2
+                    A += wabs * Omega
+            mag = qmag + pathmag + 1.0
+            T2 = h * _norm3(Vx, Vy, Vz) + 0.5 * h * h * A
+            Th2 = h * _norm3(Wx, Wy, Wz) + 0.5 * h * h * AW
+            if L > 0:
+                T2 += rel * (4.0 * h * S0 + mag * (sum_rmax + L) + 4.0 * h * wrot_sum * scale)
+                Th2 += rel * (4.0 * h * wrot_sum + mag * L)
+            T = min(T, T2)
+            Th = min(Th, Th2)
+        if mp.body_rotating[b] != 0:
+            Th = min(Th, math.pi)
+            a_out = min(Th * (1.0 + rel) + abs_pad, math.pi)
+            if not (a_out >= 0.0):  # NaN
+                a_out = math.pi
+            angle[b] = a_out
+        else:
+            angle[b] = 0.0
+        t_out = T * (1.0 + rel) + abs_pad + scale_pad * scale
+        if not (t_out >= 0.0):  # NaN
+            t_out = math.inf
+        trans[b] = t_out
+
+
+@njit(cache=True)
+def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
+               R_WB_out: np.ndarray) -> tuple[float, float]:
+    """Pose of ``body`` at m = (ta + tb) / 2 and its certified (trans m, angle rad) over [ta, tb].
+
+    The motion-bound contract of :mod:`monitor.motion.base` w.r.t. ``mp.ref_points[body]``.
+    Outputs: p_W_out (3,), R_WB_out (3, 3).
+    """
+    nbody = mp.body_parent.shape[0]
+    need = np.empty(nbody, dtype=np.int64)
+    _ancestors(mp, body, need)
+    xpos = np.empty((nbody, 3))
+    xmat = np.empty((nbody, 3, 3))
+    trans = np.zeros(nbody)
+    angle = np.zeros(nbody)
+    _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle)
+    for r in range(3):
+        p_W_out[r] = xpos[body, r]
+        for c in range(3):
+            R_WB_out[r, c] = xmat[body, r, c]
+    return trans[body], angle[body]
+
+
+@njit(cache=True)
+def tree_bounds(mp, ta: float, tb: float, p_W_out: np.ndarray, R_WB_out: np.ndarray,
+                trans_out: np.ndarray, angle_out: np.ndarray) -> None:
+    """Poses at m = (ta + tb) / 2 and certified bounds over [ta, tb] of every body, in one pass.
+
+    Outputs: p_W_out (nbody, 3), R_WB_out (nbody, 3, 3), trans_out (nbody,) m, angle_out (nbody,) rad.
+    """
+    nbody = mp.body_parent.shape[0]
+    need = np.ones(nbody, dtype=np.int64)
+    _bounds_core(mp, ta, tb, need, p_W_out, R_WB_out, trans_out, angle_out)
+
+
+@njit(cache=True)
+def batch_bounds(mp, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: np.ndarray,
+                 trans: np.ndarray, angle: np.ndarray) -> None:
+    """tree_bounds for N sub-intervals: pos (N, nbody, 3), rot (N, nbody, 3, 3), trans/angle (N, nbody)."""
+    for n in range(t0.shape[0]):
+        tree_bounds(mp, t0[n], t1[n], pos[n], rot[n], trans[n], angle[n])
+
+
+@njit(cache=True)
+def batch_poses(mp, times: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
+    """tree_poses at T times: pos (T, nbody, 3), rot (T, nbody, 3, 3)."""
+    for n in range(times.shape[0]):
+        tree_poses(mp, times[n], pos[n], rot[n])
+
+
+@njit(cache=True)
+def derive(qpos: np.ndarray, qt_adr: np.ndarray, body_parent: np.ndarray, body_mocap: np.ndarray,
+           body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
+           qt_target: np.ndarray, qt_half: np.ndarray, qt_phi: np.ndarray, qt_cum: np.ndarray,
+           qt_same: np.ndarray, moving: np.ndarray, rotating: np.ndarray, tol: np.ndarray) -> None:
+    """Per-trajectory derived arrays of a pack (outputs after ``jnt_qposadr``).
+
+    Quaternion tracks exactly as ``QuatTrack`` (sign-aligned segment ends, half angle
+    2 atan2(|b - a|, |b + a|), phi = 2 half, cumulative path, bit-identical ends);
+    (nbody,) int flags: some (rotational) coordinate on the body's chain changes in the
+    window (mocap bodies and the world never move); tol[4] = max |qpos|, tol[5] = the
+    largest total rotation path of a track.
+    """
+    K = qpos.shape[0]
+    nq = qpos.shape[1]
+    qmag = 0.0
+    for k in range(K):
+        for c in range(nq):
+            v = abs(qpos[k, c])
+            if v > qmag:
+                qmag = v
+    tol[TOL_QMAG] = qmag
+    pathmag = 0.0
+    for t in range(qt_adr.shape[0]):
+        adr = qt_adr[t]
+        qt_cum[t, 0] = 0.0
+        for i in range(K - 1):
+            dot = 0.0
+            for c in range(4):
+                dot += qpos[i, adr + c] * qpos[i + 1, adr + c]
+            sgn = -1.0 if dot < 0 else 1.0
+            dm = 0.0
+            dp = 0.0
+            same = 1
+            for c in range(4):
+                a = qpos[i, adr + c]
+                b = sgn * qpos[i + 1, adr + c]
+                qt_target[t, i, c] = b
+                dm += (b - a) ** 2
+                dp += (b + a) ** 2
+                if a != b:
+                    same = 0
+            h = 2.0 * math.atan2(math.sqrt(dm), math.sqrt(dp))
+            qt_half[t, i] = h
+            qt_phi[t, i] = 2.0 * h
+            qt_cum[t, i + 1] = qt_cum[t, i] + 2.0 * h
+            qt_same[t, i] = same
+        if qt_cum[t, K - 1] > pathmag:
+            pathmag = qt_cum[t, K - 1]
+    tol[TOL_PATHMAG] = pathmag
+    nbody = body_parent.shape[0]
+    moving[0] = 0
+    rotating[0] = 0
+    for b in range(1, nbody):
+        moving[b] = 0
+        rotating[b] = 0
+        if body_mocap[b] != 0:
+            continue
+        mv = moving[body_parent[b]]
+        rt = rotating[body_parent[b]]
+        for j in range(body_jntadr[b], body_jntadr[b] + body_jntnum[b]):
+            typ = jnt_type[j]
+            adr = jnt_qposadr[j]
+            width = 7 if typ == _FREE else (4 if typ == _BALL else 1)
+            rot_from = 3 if typ == _FREE else (width if typ == _SLIDE else 0)
+            for c in range(width):
+                ch = False
+                for k in range(1, K):
+                    if qpos[k, adr + c] != qpos[0, adr + c]:
+                        ch = True
+                        break
+                if ch:
+                    mv = 1
+                    if c >= rot_from:
+                        rt = 1
+        moving[b] = mv
+        rotating[b] = rt
+
+
+@njit(cache=True)
+def rounding_scale(mp) -> float:
+    """Coordinate magnitude of the trajectory (m), as ``Plan._scale``.
+
+    Waypoint origins + reference points + the whole-window bound computed with
+    scale 0 (``mp.tol[3]`` must be 0 when this is called).
+    """
+    nbody = mp.body_parent.shape[0]
+    K = mp.times.shape[0]
+    ref_norm = 0.0
+    for b in range(nbody):
+        r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
+        if r > ref_norm:
+            ref_norm = r
+    pos = np.empty((nbody, 3))
+    rot = np.empty((nbody, 3, 3))
+    big = 0.0
+    for k in range(K):
+        tree_poses(mp, mp.times[k], pos, rot)
+        for b in range(nbody):
+            r = _norm3(pos[b, 0], pos[b, 1], pos[b, 2])
+            if r > big:
+                big = r
+    trans = np.zeros(nbody)
+    angle = np.zeros(nbody)
+    tree_bounds(mp, mp.times[0], mp.times[K - 1], pos, rot, trans, angle)
+    whole = 0.0
+    for b in range(nbody):
+        if trans[b] > whole:
+            whole = trans[b]
+    return big + ref_norm + whole + 2.0 * ref_norm

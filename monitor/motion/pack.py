@@ -1,0 +1,328 @@
+"""Pack a trajectory (:class:`monitor.Plan` or :class:`monitor.BodyMotion`) into flat arrays.
+
+The :class:`MotionPack` is what the compiled kernels of :mod:`monitor.motion.kernel`
+read: contiguous float64 / int64 arrays only, so the tuple is numba-typable and one
+compiled specialisation serves every trajectory.
+
+* A :class:`~monitor.Plan` is packed from its waypoints and its model's kinematic
+  tree (read from the model as it is now, like ``Plan.body_poses`` does), with the
+  plan's held mocap poses.
+* A :class:`~monitor.BodyMotion` becomes a tree in which every body b >= 1 is a
+  free-joint child of the world whose qpos is (position, quaternion) at each
+  waypoint: lerp of the position and slerp of the quaternion, exactly BodyMotion's
+  interpolation. The world (body 0) holds its constant pose.
+
+The rounding scale (``tol[3]``) is computed once here, by the kernels, as
+``Plan._scale`` defines it (waypoint origins + reference points + whole-window bound).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from monitor.errors import InvalidInputError, UnsupportedGeometryError
+from monitor.motion import kernel as KN
+from monitor.motion.base import MotionBounds
+from monitor.motion.bodymotion import BodyMotion
+from monitor.tolerances import DEFAULT, Tolerances
+
+_FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3
+
+
+class MotionPack(NamedTuple):
+    """Flat arrays of one trajectory.
+
+    K waypoints, nq coordinates, njnt joints, nbody bodies, nqt quaternion tracks.
+
+    Attributes:
+        times: (K,) waypoint times (s).
+        qpos: (K, nq) waypoint joint positions (quaternions normalised).
+        qpos0: (nq,) reference configuration (hinge/slide zero).
+        jnt_type: (njnt,) MuJoCo joint type (0 free, 1 ball, 2 slide, 3 hinge).
+        jnt_qposadr: (njnt,) first qpos column of each joint.
+        jnt_pos: (njnt, 3) joint anchor in its body frame (m).
+        jnt_axis: (njnt, 3) joint axis in its body frame (as in the model).
+        jnt_axis_norm: (njnt,) norm of ``jnt_axis`` (1 for free/ball).
+        jnt_track: (njnt,) quaternion track index of ball/free joints, else -1.
+        body_parent: (nbody,) parent body (world: 0).
+        body_jntadr, body_jntnum: (nbody,) first joint and joint count of each body.
+        body_pos: (nbody, 3) body offset in the parent frame; absolute pose for body 0 and mocap bodies.
+        body_quat: (nbody, 4) body orientation offset (unit; absolute for body 0 and mocap bodies).
+        body_mocap: (nbody,) 1 where the packed pose is absolute and held (mocap).
+        body_moving: (nbody,) 1 where some coordinate on the body's chain changes in the window.
+        body_rotating: (nbody,) 1 where some rotational coordinate on the chain changes.
+        ref_points: (nbody, 3) body-frame reference points of the bounds (m).
+        qt_adr: (nqt,) first qpos column of each quaternion track.
+        qt_target: (nqt, K-1, 4) segment end quaternions, sign-aligned with the start.
+        qt_half: (nqt, K-1) half rotation angle of each segment (rad).
+        qt_phi: (nqt, K-1) rotation angle of each segment (rad).
+        qt_cum: (nqt, K) cumulative rotation path length at the waypoints (rad).
+        qt_same: (nqt, K-1) 1 where a segment's end quaternions are bit-identical.
+        tol: (6,) rel_pad, abs_pad, scale_pad, scale (m), joint magnitude, rotation path magnitude.
+    """
+
+    times: np.ndarray
+    qpos: np.ndarray
+    qpos0: np.ndarray
+    jnt_type: np.ndarray
+    jnt_qposadr: np.ndarray
+    jnt_pos: np.ndarray
+    jnt_axis: np.ndarray
+    jnt_axis_norm: np.ndarray
+    jnt_track: np.ndarray
+    body_parent: np.ndarray
+    body_jntadr: np.ndarray
+    body_jntnum: np.ndarray
+    body_pos: np.ndarray
+    body_quat: np.ndarray
+    body_mocap: np.ndarray
+    body_moving: np.ndarray
+    body_rotating: np.ndarray
+    ref_points: np.ndarray
+    qt_adr: np.ndarray
+    qt_target: np.ndarray
+    qt_half: np.ndarray
+    qt_phi: np.ndarray
+    qt_cum: np.ndarray
+    qt_same: np.ndarray
+    tol: np.ndarray
+
+    @property
+    def nbody(self) -> int:
+        """Number of bodies (world included)."""
+        return int(self.body_parent.shape[0])
+
+
+def _f64(a: object, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    """Writable C-contiguous float64 (read-only arrays would compile a second specialisation)."""
+    out = np.asarray(a, dtype=np.float64)
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        out = np.array(out, dtype=np.float64, order="C")
+    return out.reshape(shape) if shape is not None else out
+
+
+def _i64(a: object) -> np.ndarray:
+    out = np.asarray(a, dtype=np.int64).reshape(-1)
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        out = np.array(out, dtype=np.int64, order="C")
+    return out
+
+
+class _Static(NamedTuple):
+    """The model-only part of a pack (shared by every pack of one model structure; never written)."""
+
+    qpos0: np.ndarray
+    jnt_type: np.ndarray
+    jnt_qposadr: np.ndarray
+    jnt_pos: np.ndarray
+    jnt_axis: np.ndarray
+    jnt_axis_norm: np.ndarray
+    jnt_track: np.ndarray
+    body_parent: np.ndarray
+    body_jntadr: np.ndarray
+    body_jntnum: np.ndarray
+    body_pos: np.ndarray
+    body_quat: np.ndarray
+    body_mocap: np.ndarray
+    mocapid: np.ndarray
+    ref_points: np.ndarray
+    qt_adr: np.ndarray
+    qpos0_mag: float
+
+
+def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: object, jnt_axis: object,
+            body_parent: object, body_jntadr: object, body_jntnum: object, body_pos: object,
+            body_quat: object, mocapid: object, ref_points: object, check_free: bool = True) -> _Static:
+    jt = _i64(jnt_type)
+    jadr = _i64(jnt_qposadr)
+    jpos = _f64(np.array(jnt_pos, dtype=np.float64), (-1, 3))
+    jaxis = _f64(np.array(jnt_axis, dtype=np.float64), (-1, 3))
+    parent = _i64(body_parent)
+    jntadr = _i64(body_jntadr)
+    jntnum = _i64(body_jntnum)
+    if check_free and (jt == _FREE).any():
+        for b in range(parent.shape[0]):
+            js = range(int(jntadr[b]), int(jntadr[b] + jntnum[b]))
+            if any(jt[j] == _FREE for j in js) and (jntnum[b] != 1 or parent[b] != 0):
+                raise UnsupportedGeometryError(
+                    f"model body {b}: a free joint must be the only joint of a child of the world")
+    quat_j = np.flatnonzero((jt == _FREE) | (jt == _BALL))
+    jnt_track = np.full(jt.shape[0], -1, dtype=np.int64)
+    jnt_track[quat_j] = np.arange(quat_j.shape[0])
+    axis_norm = np.linalg.norm(jaxis, axis=-1) if jaxis.shape[0] else np.zeros(0)
+    axis_norm = np.where((jt == _HINGE) | (jt == _SLIDE), axis_norm, 1.0).astype(np.float64)
+    mid = _i64(mocapid)
+    body_mocap = (mid >= 0).astype(np.int64)
+    body_mocap[0] = 1
+    q0 = _f64(np.array(qpos0, dtype=np.float64))
+    return _Static(
+        qpos0=q0, jnt_type=jt, jnt_qposadr=jadr, jnt_pos=jpos, jnt_axis=jaxis,
+        jnt_axis_norm=_f64(axis_norm), jnt_track=jnt_track, body_parent=parent, body_jntadr=jntadr,
+        body_jntnum=jntnum, body_pos=_f64(np.array(body_pos, dtype=np.float64), (-1, 3)),
+        body_quat=_f64(np.array(body_quat, dtype=np.float64), (-1, 4)), body_mocap=body_mocap, mocapid=mid,
+        ref_points=_f64(np.array(ref_points, dtype=np.float64), (-1, 3)),
+        qt_adr=_i64(jadr[quat_j] + np.where(jt[quat_j] == _FREE, 3, 0)),
+        qpos0_mag=float(np.max(np.abs(q0), initial=0.0)))
+
+
+def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
+            tol: Tolerances) -> MotionPack:
+    """Derived arrays (tracks, flags, magnitudes: one compiled call; rounding scale: one more)."""
+    K = qpos.shape[0]
+    nqt = st.qt_adr.shape[0]
+    nbody = st.body_parent.shape[0]
+    target = np.empty((nqt, K - 1, 4))
+    half = np.empty((nqt, K - 1))
+    phi = np.empty((nqt, K - 1))
+    cum = np.empty((nqt, K))
+    same = np.empty((nqt, K - 1), dtype=np.int64)
+    moving = np.empty(nbody, dtype=np.int64)
+    rotating = np.empty(nbody, dtype=np.int64)
+    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, 0.0])
+    KN.derive(qpos, st.qt_adr, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
+              st.jnt_qposadr, target, half, phi, cum, same, moving, rotating, tol_arr)
+    tol_arr[KN.TOL_QMAG] += st.qpos0_mag
+    mp = MotionPack(
+        times=times, qpos=qpos, qpos0=st.qpos0, jnt_type=st.jnt_type, jnt_qposadr=st.jnt_qposadr,
+        jnt_pos=st.jnt_pos, jnt_axis=st.jnt_axis, jnt_axis_norm=st.jnt_axis_norm, jnt_track=st.jnt_track,
+        body_parent=st.body_parent, body_jntadr=st.body_jntadr, body_jntnum=st.body_jntnum,
+        body_pos=body_pos, body_quat=body_quat, body_mocap=st.body_mocap, body_moving=moving,
+        body_rotating=rotating, ref_points=st.ref_points, qt_adr=st.qt_adr, qt_target=target,
+        qt_half=half, qt_phi=phi, qt_cum=cum, qt_same=same, tol=tol_arr)
+    if moving.any():
+        tol_arr[KN.TOL_SCALE] = KN.rounding_scale(mp)  # the pack shares tol_arr
+    return mp
+
+
+def _pack_body_motion(bm: BodyMotion) -> MotionPack:
+    pos = bm.pos
+    quat = bm.quat
+    K, nbody = pos.shape[0], pos.shape[1]
+    nj = nbody - 1
+    qpos = np.concatenate([pos[:, 1:], quat[:, 1:]], axis=2).reshape(K, 7 * nj)
+    body_pos = np.zeros((nbody, 3))
+    body_quat = np.zeros((nbody, 4))
+    body_quat[:, 0] = 1.0
+    body_pos[0] = pos[0, 0]
+    body_quat[0] = quat[0, 0]
+    jnt_axis = np.zeros((nj, 3))
+    jnt_axis[:, 2] = 1.0
+    st = _static(np.zeros(7 * nj), np.zeros(nj, dtype=np.int64), 7 * np.arange(nj), np.zeros((nj, 3)),
+                 jnt_axis,
+                 np.zeros(nbody, dtype=np.int64), np.concatenate([[0], np.arange(nj)]),
+                 np.concatenate([[0], np.ones(nj, dtype=np.int64)]), body_pos, body_quat,
+                 np.full(nbody, -1), bm.ref_points, check_free=False)
+    return _finish(st, _f64(bm.times), _f64(qpos), st.body_pos, st.body_quat, bm._tol)
+
+
+def _plan_static(plan: object) -> _Static:
+    """The model part of a Plan's pack, cached on the plan's model structure when it has one.
+
+    ``Plan._st`` (plan.py's ``_ModelStructure``) is keyed by the bytes of every model
+    array it reads, so a model edited in place gets a new one; its copies are the
+    snapshot the plan was built on. Without it the model is read as it is now.
+    """
+    st = getattr(plan, "_st", None)
+    if st is not None:
+        hit = getattr(st, "_motion_pack_static", None)
+        if hit is not None:
+            return hit
+        try:
+            jnt = st.jnt
+            jntadr = [js[0] if js else 0 for js in st.jnt_of_body]
+            out = _static(jnt["qpos0"], jnt["type"], jnt["adr"], jnt["pos"], jnt["axis"], st.parent, jntadr,
+                          [len(js) for js in st.jnt_of_body], st.body_pos, st.body_quat,
+                          plan.model.body_mocapid, st.ref)
+        except (AttributeError, KeyError, TypeError):
+            out = None
+        if out is not None:
+            _world_identity(out)
+            st._motion_pack_static = out
+            return out
+    m = plan.model
+    out = _static(m.qpos0, m.jnt_type, m.jnt_qposadr, m.jnt_pos, m.jnt_axis, m.body_parentid, m.body_jntadr,
+                  m.body_jntnum, m.body_pos, m.body_quat, m.body_mocapid, plan.ref_points)
+    _world_identity(out)
+    return out
+
+
+def _world_identity(st: _Static) -> None:
+    """MuJoCo's world body sits at the origin with identity orientation."""
+    st.body_pos[0] = 0.0
+    st.body_quat[0] = (1.0, 0.0, 0.0, 0.0)
+
+
+def _pack_plan(plan: object) -> MotionPack:
+    st = _plan_static(plan)
+    body_pos = st.body_pos
+    body_quat = st.body_quat
+    mocap = np.flatnonzero(st.mocapid >= 0)
+    if mocap.size:
+        body_pos = body_pos.copy()
+        body_quat = body_quat.copy()
+        body_pos[mocap] = plan.mocap_pos[st.mocapid[mocap]]
+        body_quat[mocap] = plan.mocap_quat[st.mocapid[mocap]]
+    return _finish(st, _f64(plan.times), _f64(plan.qpos), body_pos, body_quat, getattr(plan, "_tol", DEFAULT))
+
+
+def pack_trajectory(traj: object) -> MotionPack:
+    """Pack a :class:`monitor.Plan` or :class:`monitor.BodyMotion` for the compiled kernels.
+
+    Raises:
+        InvalidInputError: ``traj`` is neither.
+        UnsupportedGeometryError: a free joint that is not the only joint of a world child.
+    """
+    if isinstance(traj, BodyMotion):
+        return _pack_body_motion(traj)
+    from monitor.motion.plan import Plan  # imports mujoco; BodyMotion users need not
+
+    if isinstance(traj, Plan):
+        return _pack_plan(traj)
+    raise InvalidInputError(f"traj must be a Plan or a BodyMotion, got {type(traj).__name__}")
+
+
+def poses_and_bounds(mp: MotionPack, t0: object, t1: object) -> tuple[np.ndarray, np.ndarray, MotionBounds]:
+    """Midpoint poses and certified bounds for N sub-intervals, in one compiled call.
+
+    A drop-in for ``traj.body_poses((t0 + t1) / 2)`` + ``traj.motion_bounds(t0, t1)``.
+
+    Args:
+        mp: the packed trajectory.
+        t0: (N,) sub-interval starts (s), inside the window.
+        t1: (N,) sub-interval ends (s), inside the window, t1 >= t0.
+
+    Returns:
+        positions (N, nbody, 3) m, rotations R_WB (N, nbody, 3, 3), and MotionBounds
+        (trans (N, nbody) m, angle (N, nbody) rad).
+
+    Raises:
+        InvalidInputError: shapes, NaN, or a sub-interval outside the window.
+    """
+    from monitor.motion import _kinematics as K
+
+    window = (float(mp.times[0]), float(mp.times[-1]))
+    a, b = K.check_interval_arrays(t0, t1, window)
+    N = a.shape[0]
+    nbody = mp.nbody
+    pos = np.empty((N, nbody, 3))
+    rot = np.empty((N, nbody, 3, 3))
+    trans = np.empty((N, nbody))
+    angle = np.empty((N, nbody))
+    KN.batch_bounds(mp, np.ascontiguousarray(a), np.ascontiguousarray(b), pos, rot, trans, angle)
+    return pos, rot, MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
+
+
+def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
+    """World poses at ``times`` (T,): positions (T, nbody, 3) m, rotations (T, nbody, 3, 3)."""
+    from monitor.motion import _kinematics as K
+
+    t = K.check_times_in_window(times, (float(mp.times[0]), float(mp.times[-1])))
+    pos = np.empty((t.shape[0], mp.nbody, 3))
+    rot = np.empty((t.shape[0], mp.nbody, 3, 3))
+    KN.batch_poses(mp, np.ascontiguousarray(t), pos, rot)
+    return pos, rot
+
+
+__all__ = ["MotionPack", "body_poses", "pack_trajectory", "poses_and_bounds"]

@@ -1,0 +1,327 @@
+"""Property tests of the compiled motion kernels (monitor.motion.kernel / pack).
+
+Oracles, independent of the kernels:
+* poses: ``Plan.body_poses`` (MuJoCo ``mj_kinematics``) and, for the bounds, an
+  independent interpolation (numpy ``interp`` + scipy ``Slerp``) fed into
+  ``mj_kinematics`` on a fresh ``MjData`` (helpers of tests/test_motion_bounds.py);
+* bounds: dense sampling (200 times + 20 random per sub-interval) at points near the
+  body and far from it (5-50 m) must never exceed trans + chord(angle) * |p - ref|;
+* the numpy implementation ``Plan.motion_bounds`` / ``BodyMotion.motion_bounds`` for
+  tightness (ratio reported; the kernel may be tighter or looser, it must be sound).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation, Slerp
+from test_motion_bounds import (
+    STRESS_XML,
+    _oracle_poses,
+    _oracle_qpos,
+    _rand_quat,
+    _random_chain_xml,
+    _random_qpos,
+)
+
+from monitor.errors import InvalidInputError
+from monitor.motion import kernel as KN
+from monitor.motion.base import chord
+from monitor.motion.bodymotion import BodyMotion
+from monitor.motion.pack import MotionPack, body_poses, pack_trajectory, poses_and_bounds
+from monitor.motion.plan import Plan
+
+N_SAMPLES = 200
+
+
+def _intervals(rng, times):
+    """Each segment, the whole window, 3 random sub-intervals and a tiny one."""
+    K = times.shape[0]
+    iv = [(times[k], times[k + 1]) for k in range(K - 1)] + [(times[0], times[-1])]
+    for _ in range(3):
+        a, b = np.sort(rng.uniform(times[0], times[-1], 2))
+        iv.append((a, b))
+    c = rng.uniform(times[0], times[-1])
+    w = 1e-3 * (times[-1] - times[0])
+    iv.append((max(c - w, times[0]), min(c + w, times[-1])))
+    return np.array([x[0] for x in iv]), np.array([x[1] for x in iv])
+
+
+def _check_samples(pos, mat, ref, trans, angle, rng, far=True, tag=""):
+    """Assert dense-sample deviations <= bound for every body; returns near-point tightness ratios.
+
+    pos (T+1, nbody, 3), mat (T+1, nbody, 3, 3): index 0 is the midpoint pose.
+    """
+    ratios = []
+    for b in range(1, pos.shape[1]):
+        near = ref[b] + rng.uniform(-0.5, 0.5, (12, 3))
+        pts = [near, ref[b][None], np.zeros((1, 3))]
+        if far:
+            d = rng.normal(size=(6, 3))
+            pts.append(ref[b] + d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(5, 50, (6, 1)))
+        pts = np.concatenate(pts)
+        world = pos[:, b, None, :] + np.einsum("tij,nj->tni", mat[:, b], pts)
+        dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
+        bound = trans[b] + chord(angle[b]) * np.linalg.norm(pts - ref[b], axis=-1)
+        viol = dev > bound
+        assert not viol.any(), f"{tag} body {b}: deviation {dev[viol]} > bound {bound[viol]}"
+        if trans[b] > 0 and dev[:12].max() > 1e-9:
+            ratios.append(dev[:12].max() / bound[:12][np.argmax(dev[:12])])
+    return ratios
+
+
+def _random_plan(rng):
+    m = mujoco.MjModel.from_xml_string(_random_chain_xml(rng))
+    K = int(rng.integers(2, 6))
+    times = np.cumsum(rng.uniform(0.05, 1.0, K)) + rng.uniform(-1, 1)
+    qpos = _random_qpos(rng, m, K)
+    mocap_pos = rng.uniform(-1, 1, (m.nmocap, 3)) if m.nmocap else None
+    mocap_quat = np.array([_rand_quat(rng) for _ in range(m.nmocap)]) if m.nmocap else None
+    return m, times, Plan(times, qpos, model=m, mocap_pos=mocap_pos, mocap_quat=mocap_quat)
+
+
+def test_pack_is_numba_typable_flat_arrays():
+    rng = np.random.default_rng(1)
+    _, _, plan = _random_plan(rng)
+    mp = pack_trajectory(plan)
+    assert isinstance(mp, MotionPack)
+    for name, arr in zip(mp._fields, mp, strict=True):
+        assert isinstance(arr, np.ndarray), name
+        assert arr.dtype in (np.float64, np.int64), name
+        assert arr.flags.c_contiguous, name
+
+
+def test_fk_matches_mujoco_random_trees():
+    """Kernel FK == Plan.body_poses (mj_kinematics) at waypoints and random times, incl. mocap."""
+    rng = np.random.default_rng(20261123)
+    worst = 0.0
+    for _ in range(60):
+        m, times, plan = _random_plan(rng)
+        mp = pack_trajectory(plan)
+        ts = np.concatenate([times, rng.uniform(times[0], times[-1], 5)])
+        pos, mat = body_poses(mp, ts)
+        ref_pos, ref_mat = plan.body_poses(ts)
+        np.testing.assert_allclose(pos, ref_pos, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(mat, ref_mat, rtol=0, atol=1e-12)
+        worst = max(worst, float(np.abs(pos - ref_pos).max(initial=0.0)))
+        # Single-body pose kernel agrees with the tree pass.
+        p = np.empty(3)
+        R = np.empty((3, 3))
+        for b in range(m.nbody):
+            KN.body_pose(mp, b, ts[-1], p, R)
+            np.testing.assert_array_equal(p, pos[-1, b])
+            np.testing.assert_array_equal(R, mat[-1, b])
+    print(f"\nkernel FK vs mj_kinematics: max |dp| = {worst:.2e} m")
+
+
+def test_random_trees_bounds_never_exceeded(record_property):
+    """Random hinge/slide/ball/free trees with mocap, K = 2..5, big and small motions."""
+    rng = np.random.default_rng(777001)
+    ratios = []
+    vs_plan = []
+    kinds = set()
+    n_cases = 0
+    for chain in range(120):
+        m, times, plan = _random_plan(rng)
+        kinds.update(int(x) for x in m.jnt_type)
+        mp = pack_trajectory(plan)
+        ta, tb = _intervals(rng, times)
+        pos_m, mat_m, mb = poses_and_bounds(mp, ta, tb)
+        ref_mb = plan.motion_bounds(ta, tb)
+        ref = plan.ref_points
+        np.testing.assert_array_equal(mp.ref_points, ref)
+        for i in range(ta.shape[0]):
+            ts = np.concatenate([np.linspace(ta[i], tb[i], N_SAMPLES), rng.uniform(ta[i], tb[i], 20)])
+            tm = 0.5 * (ta[i] + tb[i])
+            Q = _oracle_qpos(m, times, plan.qpos, np.concatenate([[tm], ts]))
+            pos, mat = _mocap_poses(m, Q, plan)
+            np.testing.assert_allclose(pos_m[i], pos[0], rtol=0, atol=1e-12)
+            tag = f"chain {chain} iv {i}"
+            ratios += _check_samples(pos, mat, ref, mb.trans[i], mb.angle[i], rng, tag=tag)
+            mv = ref_mb.trans[i] > 0
+            vs_plan += list(mb.trans[i][mv] / ref_mb.trans[i][mv])
+            n_cases += 1
+            # body_bound (ancestors only) gives the same numbers as the tree pass.
+            b = int(rng.integers(0, m.nbody))
+            p = np.empty(3)
+            R = np.empty((3, 3))
+            tr, an = KN.body_bound(mp, b, ta[i], tb[i], p, R)
+            assert tr == mb.trans[i, b] and an == mb.angle[i, b]
+            np.testing.assert_array_equal(p, pos_m[i, b])
+    assert kinds == {0, 1, 2, 3}
+    med = float(np.median(ratios))
+    med_plan = float(np.median(vs_plan))
+    record_property("kernel_tightness_median_near", med)
+    record_property("kernel_over_plan_trans_median", med_plan)
+    print(f"\nkernel bounds over {n_cases} intervals: median sampled-max/bound near = {med:.3f}; "
+          f"kernel trans / Plan trans: median {med_plan:.4f}, min {min(vs_plan):.4f}, max {max(vs_plan):.4f}")
+    assert len(ratios) > 300
+
+
+def _mocap_poses(m, Q, plan):
+    d = mujoco.MjData(m)
+    d.mocap_pos[:] = plan.mocap_pos
+    d.mocap_quat[:] = plan.mocap_quat
+    pos = np.empty((Q.shape[0], m.nbody, 3))
+    mat = np.empty((Q.shape[0], m.nbody, 3, 3))
+    for k in range(Q.shape[0]):
+        d.qpos[:] = Q[k]
+        mujoco.mj_kinematics(m, d)
+        pos[k] = d.xpos
+        mat[k] = d.xmat.reshape(-1, 3, 3)
+    return pos, mat
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_deep_subdivision(seed):
+    """2048 tiny sub-intervals (the checkers' regime): sound, and the velocity bound kicks in."""
+    rng = np.random.default_rng(seed)
+    m = mujoco.MjModel.from_xml_string(_random_chain_xml(rng))
+    while m.nv == 0:
+        m = mujoco.MjModel.from_xml_string(_random_chain_xml(rng))
+    times = np.cumsum(rng.uniform(0.1, 1.0, 4))
+    plan = Plan(times, _random_qpos(rng, m, 4), model=m)
+    mp = pack_trajectory(plan)
+    edges = np.linspace(times[0], times[-1], 2049)
+    _, _, mb = poses_and_bounds(mp, edges[:-1], edges[1:])
+    ref_mb = plan.motion_bounds(edges[:-1], edges[1:])
+    mv = ref_mb.trans > 0
+    np.testing.assert_array_equal(mb.trans > 0, mv)
+    # Same derivation: the compiled bounds equal the numpy ones up to rounding.
+    np.testing.assert_allclose(mb.trans[mv], ref_mb.trans[mv], rtol=1e-9)
+    for i in rng.choice(2048, 30, replace=False):
+        ts = np.linspace(edges[i], edges[i + 1], 50)
+        tm = 0.5 * (edges[i] + edges[i + 1])
+        pos, mat = _oracle_poses(m, _oracle_qpos(m, times, plan.qpos, np.concatenate([[tm], ts])))
+        _check_samples(pos, mat, plan.ref_points, mb.trans[i], mb.angle[i], rng, tag=f"iv {i}")
+
+
+@pytest.mark.parametrize("step", [1e-11, 1e-8, 1e-4])
+def test_large_coordinates_tiny_motions(step):
+    """1e4 m offsets, joint values ~1e3, motions down to 1e-11: the pads cover rounding."""
+    m = mujoco.MjModel.from_xml_string(STRESS_XML)
+    rng = np.random.default_rng(int(-np.log10(step)) + 100)
+    K = 3
+    q0 = np.array([1234.5, -876.0, *_rand_quat(rng), 9000.0, -7000.0, 5000.0, *_rand_quat(rng)])
+    qpos = np.tile(q0, (K, 1))
+    for k in range(1, K):
+        qpos[k, :2] += step * rng.normal(size=2) * 1e3
+        for a in (2, 9):
+            qq = qpos[0, a:a + 4] + step * rng.normal(size=4)
+            qpos[k, a:a + 4] = qq / np.linalg.norm(qq)
+        qpos[k, 6:9] += step * rng.normal(size=3) * 1e3
+    times = np.array([0.0, 0.5, 1.5]) + 1e4
+    plan = Plan(times, qpos, model=m)
+    mp = pack_trajectory(plan)
+    edges = np.linspace(times[0], times[-1], 65)
+    _, _, mb = poses_and_bounds(mp, edges[:-1], edges[1:])
+    for i in range(0, 64, 3):
+        ts = np.linspace(edges[i], edges[i + 1], 40)
+        tm = 0.5 * (edges[i] + edges[i + 1])
+        tt = np.concatenate([[tm], ts])
+        for pos, mat in (body_poses(mp, tt), plan.body_poses(tt),
+                         _oracle_poses(m, _oracle_qpos(m, times, plan.qpos, tt))):
+            for b in range(1, m.nbody):
+                spread = np.array([1, 1, 1, 1, 1, 100, 100, 100, 1e3, 0])[:, None]
+                pts = plan.ref_points[b] + rng.normal(size=(10, 3)) * spread
+                world = pos[:, b, None, :] + np.einsum("tij,nj->tni", mat[:, b], pts)
+                dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
+                r = np.linalg.norm(pts - plan.ref_points[b], axis=-1)
+                bound = mb.trans[i, b] + chord(mb.angle[i, b]) * r
+                assert (dev <= bound).all(), (step, i, b, dev, bound)
+
+
+def _random_body_motion(rng, K, nbody, big):
+    times = np.cumsum(rng.uniform(0.05, 1.0, K)) + rng.uniform(-5, 5)
+    off = rng.normal(size=3) * (1e4 if big else 1.0)
+    pos = off + rng.normal(size=(K, nbody, 3)) * (1e-6 if rng.random() < 0.3 else 1.0)
+    quat = rng.normal(size=(K, nbody, 4))
+    quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
+    pos[:, 0] = pos[0, 0]
+    quat[:, 0] = quat[0, 0]
+    hold = rng.random(nbody) < 0.2
+    pos[:, hold] = pos[0, hold]
+    quat[:, hold] = quat[0, hold]
+    return BodyMotion(times, pos, quat, ref_points=rng.uniform(-1, 1, (nbody, 3)))
+
+
+def _oracle_body_motion(bm, t):
+    """numpy interp + scipy Slerp, then quaternion -> matrix by scipy."""
+    nb = bm.nbody
+    pos = np.stack([np.stack([np.interp(t, bm.times, bm.pos[:, b, c]) for c in range(3)], -1)
+                    for b in range(nb)], 1)
+    mat = np.empty((t.shape[0], nb, 3, 3))
+    for b in range(nb):
+        q = bm.quat[:, b]
+        if (q == q[0]).all():
+            mat[:, b] = Rotation.from_quat(q[0, [1, 2, 3, 0]]).as_matrix()
+        else:
+            mat[:, b] = Slerp(bm.times, Rotation.from_quat(q[:, [1, 2, 3, 0]]))(t).as_matrix()
+    return pos, mat
+
+
+def test_body_motion_bounds_and_poses():
+    """BodyMotion path: poses equal BodyMotion.body_poses; bounds sound (scipy oracle)."""
+    rng = np.random.default_rng(99)
+    vs_ref = []
+    for trial in range(60):
+        bm = _random_body_motion(rng, int(rng.integers(2, 6)), int(rng.integers(1, 6)), big=trial % 3 == 0)
+        mp = pack_trajectory(bm)
+        ta, tb = _intervals(rng, bm.times)
+        pos_m, mat_m, mb = poses_and_bounds(mp, ta, tb)
+        P, R = bm.body_poses(0.5 * (ta + tb))
+        np.testing.assert_allclose(pos_m, P, rtol=0, atol=1e-12 * (1 + np.abs(P).max()))
+        np.testing.assert_allclose(mat_m, R, rtol=0, atol=1e-13)
+        ref_mb = bm.motion_bounds(ta, tb)
+        np.testing.assert_array_equal(mb.trans == 0, ref_mb.trans == 0)
+        mv = ref_mb.trans > 0
+        vs_ref += list(mb.trans[mv] / ref_mb.trans[mv])
+        for i in range(ta.shape[0]):
+            ts = np.concatenate([[0.5 * (ta[i] + tb[i])], np.linspace(ta[i], tb[i], N_SAMPLES)])
+            for pos, mat in (_oracle_body_motion(bm, ts), bm.body_poses(ts)):
+                _check_samples(pos, mat, bm.ref_points, mb.trans[i], mb.angle[i], rng, tag=f"trial {trial}")
+    print(f"\nBodyMotion: kernel trans / BodyMotion trans median {np.median(vs_ref):.4f}, "
+          f"max {np.max(vs_ref):.4f}")
+
+
+def test_huge_motions_never_nan():
+    """1e8 rad hinge jumps and 1e150 m slides: bounds are huge or inf, never NaN, and still sound."""
+    xml = """<mujoco><worldbody>
+      <body><joint type="hinge" axis="0 0 1" pos="1 0 0"/><geom size=".1" pos="0 1 0"/>
+        <body pos="0 2 0"><joint type="slide" axis="1 0 0"/><geom size=".1"/></body></body>
+    </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    rng = np.random.default_rng(5)
+    for hinge_jump, slide_jump in ((1e8, 1.0), (1.0, 1e150), (1e8, 1e300)):
+        qpos = np.array([[0.0, 0.0], [hinge_jump, slide_jump], [-hinge_jump, -slide_jump]])
+        times = np.array([0.0, 1.0, 2.0])
+        plan = Plan(times, qpos, model=m)
+        mp = pack_trajectory(plan)
+        ta, tb = _intervals(rng, times)
+        pos_m, _, mb = poses_and_bounds(mp, ta, tb)
+        assert not np.isnan(mb.trans).any() and not np.isnan(mb.angle).any()
+        assert (mb.angle <= np.pi).all()
+        assert (mb.trans[:, 1:] > 1.0).all()
+        if slide_jump < 1e100:
+            for i in range(ta.shape[0]):
+                ts = np.concatenate([[0.5 * (ta[i] + tb[i])], np.linspace(ta[i], tb[i], 50)])
+                pos, mat = body_poses(mp, ts)
+                _check_samples(pos, mat, plan.ref_points, mb.trans[i], mb.angle[i], rng, far=False)
+
+
+def test_errors_are_typed():
+    with pytest.raises(InvalidInputError, match="traj"):
+        pack_trajectory("not a trajectory")
+    bm = BodyMotion([0.0, 1.0], np.zeros((2, 2, 3)), np.tile([1.0, 0, 0, 0], (2, 2, 1)))
+    mp = pack_trajectory(bm)
+    with pytest.raises(InvalidInputError, match="window"):
+        poses_and_bounds(mp, [0.0], [2.0])
+    with pytest.raises(InvalidInputError, match="t0"):
+        poses_and_bounds(mp, [np.nan], [1.0])
+    with pytest.raises(InvalidInputError, match="window"):
+        body_poses(mp, [3.0])
+    # A static trajectory: exactly zero bounds and bit-exact poses.
+    pos, rot, mb = poses_and_bounds(mp, [0.0, 0.25], [1.0, 0.5])
+    assert (mb.trans == 0).all() and (mb.angle == 0).all()
+    assert (pos == 0).all()
