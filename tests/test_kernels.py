@@ -18,11 +18,11 @@ from scipy.spatial.transform import Rotation
 from monitor.bench import oracle
 from monitor.bench.cases import PairCase, ShapeSpec, _place, _random_shape
 from monitor.certify import kernels as K
-from monitor.certify._motion_standin import body_bound, body_pose, pack_trajectory
 from monitor.certify.packed import pack_shapes
 from monitor.geometry.distance import shape_distance
 from monitor.geometry.polytope import box_polytope, halfspace_shape, sphere_shape
 from monitor.motion.bodymotion import BodyMotion
+from monitor.motion.pack import pack_trajectory
 
 KINDS = [("box", "box"), ("hull", "box"), ("hull", "hull"), ("capsule", "box"), ("sphere", "hull"),
          ("capsule", "capsule"), ("sphere", "sphere")]
@@ -253,36 +253,6 @@ def test_unsupported_pairs():
     bm = _halfspace_motion(0.3, 0.3, 0.0)
     assert K.check_pair_window(gp, pack_trajectory(bm), 1, 2, (0, 1), 0.0, 1e-3)["verdict"] == "unsupported"
     assert K.check_pair_window(gp, pack_trajectory(bm), 0, 3, (0, 1), 0.0, 1e-3)["verdict"] == "unsupported"
-
-
-def test_motion_standin_bound_holds():
-    """The BodyMotion stand-in: pose equals BodyMotion.body_poses; dense samples obey the bound."""
-    rng = np.random.default_rng(8)
-    K_ = 4
-    times = np.sort(rng.uniform(0, 2, K_))
-    pos = rng.normal(size=(K_, 3, 3)) + np.array([0, 1e4, 0])
-    pos[:, 0] = 0.0
-    quat = Rotation.random(K_ * 3, random_state=rng).as_quat(scalar_first=True).reshape(K_, 3, 4)
-    quat[:, 0] = [1, 0, 0, 0]
-    bm = BodyMotion(times, pos, quat, ref_points=rng.normal(size=(3, 3)))
-    mp = pack_trajectory(bm)
-    p, R = np.empty(3), np.empty((3, 3))
-    pts = rng.normal(size=(20, 3)) * 2.0
-    for _ in range(20):
-        ta, tb = np.sort(rng.uniform(times[0], times[-1], 2))
-        ts = np.linspace(ta, tb, 101)
-        P, RR = bm.body_poses(ts)
-        for b in (1, 2):
-            trans, ang = body_bound(mp, b, ta, tb, p, R)
-            Pm, Rm = bm.body_poses(np.array([0.5 * (ta + tb)]))
-            assert np.allclose(p, Pm[0, b], atol=1e-9) and np.allclose(R, Rm[0, b], atol=1e-12)
-            ref = bm.ref_points[b]
-            for k in range(len(ts)):
-                d = np.linalg.norm((pts @ RR[k, b].T + P[k, b]) - (pts @ R.T + p), axis=1)
-                lim = trans + 2 * np.sin(min(ang, np.pi) / 2) * np.linalg.norm(pts - ref, axis=1)
-                assert (d <= lim + 1e-9).all()
-        body_pose(mp, 1, times[-1], p, R)
-        assert np.array_equal(p, pos[-1, 1])
 
 
 def test_matches_old_toleranced_path():

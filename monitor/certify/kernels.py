@@ -69,8 +69,8 @@ import math
 import numpy as np
 from numba import njit
 
-from monitor.certify._motion_standin import body_bound, body_pose
 from monitor.geometry._gjk import OUT_SIZE, _depth_at, _rotate, _transform, core_distance, halfspace_distance
+from monitor.motion.kernel import body_bound, body_pose
 
 # ---------------------------------------------------------------------------- codes
 
@@ -236,7 +236,7 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
 
 
 @njit(cache=True)
-def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats):
+def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
     Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
@@ -281,8 +281,8 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats):
     # coordinates of magnitude S enter the lever arms: pad their rounding
     S = levers[0] + levers[1] + _norm3(pA[0] - pB[0], pA[1] - pB[1], pA[2] - pB[2])
     S += _norm3(cA[0], cA[1], cA[2]) + _norm3(cB[0], cB[1], cB[2])
-    pad = 8.0 * mp.rel_pad * (best + (chA + chB) * S)
-    return best * (1.0 + 8.0 * mp.rel_pad) + pad
+    pad = 8.0 * rel_pad * (best + (chA + chB) * S)
+    return best * (1.0 + 8.0 * rel_pad) + pad
 
 
 @njit(cache=True)
@@ -300,7 +300,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
 
     Args:
         gp: :class:`monitor.certify.packed.GeomPack`.
-        mp: the motion pack (``body_pose`` / ``body_bound``).
+        mp: :class:`monitor.motion.pack.MotionPack` (poses and bounds: :mod:`monitor.motion.kernel`).
         ga, gb: geom indices.
         t0, t1: window (s).
         margin: clearance (m) below which the pair is in violation.
@@ -373,7 +373,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         if wt == wt and a >= wt:      # a confirmed violation earlier than this interval
             continue
         m = 0.5 * (a + b)
-        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats)
+        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad)
         lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
         spent += 1
         res[R_TESTS] += 1.0
