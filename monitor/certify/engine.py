@@ -283,6 +283,18 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
                     o1.verdict, o1.witness_time = "unresolved", None
         for (i, _ga, _gb, _), o in zip(ext_items, outs):
             outcomes[i] = ("extrusion", o)
+    if tol_items:  # issue 12: the compiled whole-shape stage first; what it certifies is done
+        from monitor.certify.kernels import whole_shape_stage
+        pre = whole_shape_stage(scene, plan, [(ga, gb) for _i, ga, gb in tol_items], (t0, t1), margin,
+                                epsilon, tol, bud)
+        for (i, ga, gb), r in zip(tol_items, pre):
+            if r is not None:
+                tests_total += r["tests"]
+                depth_max = max(depth_max, r["max_depth"])
+                results[i] = PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "toleranced",
+                                        r["tests"], r["max_depth"], (), float(r["clearance"]))
+                mix["toleranced/whole-shape"] = mix.get("toleranced/whole-shape", 0) + 1
+        tol_items = [x for x, r in zip(tol_items, pre) if r is None]
     if tol_items:
         from monitor.certify import toleranced
         items = [(ga.shape, ga.body_id, gb.shape, gb.body_id) for _i, ga, gb in tol_items]

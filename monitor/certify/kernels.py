@@ -65,6 +65,7 @@ coordinates of magnitude S that enter the lever arms. NaN anywhere never exclude
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 from numba import njit
@@ -497,6 +498,63 @@ def check_pair_window(gp, mp, ga: int, gb: int, window: tuple[float, float], mar
             "stopped": stopped}
 
 
+
+_SCENE_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+WHOLE_SHAPE_MAX_TESTS = 4096
+"""Distance tests one pair may spend in the engine's whole-shape stage before it falls through."""
+
+
+def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], margin: float, epsilon: float,
+                      tolerances, budget=None) -> list[dict | None]:
+    """Engine hook: try to certify toleranced-path pairs with the compiled whole-shape stage.
+
+    Args:
+        scene: the :class:`monitor.Scene` (packed once, cached per scene object).
+        plan: the trajectory (packed by :func:`monitor.motion.pack.pack_trajectory`).
+        geom_pairs: list of (GeomInfo a, GeomInfo b).
+        window: (t0, t1) s.
+        margin, epsilon: as in ``certify``.
+        tolerances: rounding pads and ``max_depth``.
+        budget: optional :class:`monitor.certify.common.Budget`; tests are charged to it and
+            the stage stops (returning None for the rest) once it is exhausted.
+
+    Returns:
+        Per pair the :func:`check_pair_window` result dict when it is ``"certified"``, else
+        None (the pair falls through to the existing checker unchanged). A trajectory the
+        motion packer does not support makes every entry None.
+    """
+    from monitor.errors import MonitorError
+    from monitor.motion.pack import pack_trajectory
+
+    out: list[dict | None] = [None] * len(geom_pairs)
+    if not geom_pairs or (budget is not None and budget.exhausted):
+        return out
+    try:
+        mp = pack_trajectory(plan)
+    except (MonitorError, TypeError, AttributeError):
+        return out
+    gp = _SCENE_PACKS.get(scene)
+    if gp is None:
+        from monitor.certify.packed import pack_scene
+        gp = pack_scene(scene).geoms
+        _SCENE_PACKS[scene] = gp
+    stack = np.empty((int(tolerances.max_depth) + 2, 3))
+    for k, (ga, gb) in enumerate(geom_pairs):
+        if budget is not None and budget.exhausted:
+            break
+        res = new_result()
+        v = pair_window(gp, mp, int(ga.id), int(gb.id), float(window[0]), float(window[1]), float(margin),
+                        float(epsilon), int(tolerances.max_depth), WHOLE_SHAPE_MAX_TESTS, MODE_CERTIFY_ONLY,
+                        float(tolerances.rel_pad), float(tolerances.abs_pad), stack, res)
+        if budget is not None:
+            budget.charge(int(res[R_TESTS]))
+        if v == CERTIFIED:
+            out[k] = {"verdict": "certified", "clearance": float(res[R_CLEAR]), "tests": int(res[R_TESTS]),
+                      "max_depth": int(res[R_DEPTH]), "paper_ball_wins": int(res[R_PAPER])}
+    return out
+
+
 __all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MODE_FULL", "MODE_CERTIFY_ONLY",
            "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
-           "check_pair_window"]
+           "check_pair_window", "whole_shape_stage"]
