@@ -70,7 +70,16 @@ import weakref
 import numpy as np
 from numba import njit
 
-from monitor.geometry._gjk import OUT_SIZE, _depth_at, _rotate, _transform, core_distance, halfspace_distance
+from monitor.geometry._gjk import (
+    OUT_SIZE,
+    _compact,
+    _depth_at,
+    _rotate,
+    _subalgorithm,
+    _transform,
+    core_distance,
+    halfspace_distance,
+)
 from monitor.motion.kernel import body_bound, body_pose
 
 # ---------------------------------------------------------------------------- codes
@@ -196,6 +205,93 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
             for r in range(3):
                 out[4 + r] = x[r]
                 out[7 + r] = x[r]
+
+
+@njit(cache=True)
+def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v, vn):
+    """A separating-axis lower bound > ``target`` on ``dist(core_a, core_b)``, else -inf (early-exit GJK).
+
+    The lean exclusion test of the whole-shape stage (§4): GJK on the posed cores in the
+    frame shifted by ``pa`` (as :func:`monitor.geometry._gjk.core_distance`), returning as
+    soon as the separating-axis bound of the current direction v,
+    ``(min_a v.a - max_b v.b) / |v| - pad``, exceeds ``target``. Any direction gives a
+    valid lower bound, so the bound does not depend on GJK's convergence; the pad
+    ``2 rel_pad S + abs_pad`` (S = largest coordinate) is core_distance's. -inf means
+    "not proven" (touching, overlapping, closer than target, or no progress): the caller
+    then runs the full :func:`posed_distance`. Work arrays: VA, VB (>= vertex counts, 3),
+    W (4, 3), IA, IB (4,) int64, lam (4,), v, vn (3,). Both geoms must be cores (no
+    half-spaces).
+    """
+    sa0, na = gp.vstart[ga], gp.vstart[ga + 1] - gp.vstart[ga]
+    sb0, nb = gp.vstart[gb], gp.vstart[gb + 1] - gp.vstart[gb]
+    S = 0.0
+    for i in range(na):
+        for r in range(3):
+            x = (Ra[r, 0] * gp.verts[sa0 + i, 0] + Ra[r, 1] * gp.verts[sa0 + i, 1]
+                 + Ra[r, 2] * gp.verts[sa0 + i, 2])
+            VA[i, r] = x
+            S = max(S, abs(x))
+    for i in range(nb):
+        for r in range(3):
+            x = (Rb[r, 0] * gp.verts[sb0 + i, 0] + Rb[r, 1] * gp.verts[sb0 + i, 1]
+                 + Rb[r, 2] * gp.verts[sb0 + i, 2] + (pb[r] - pa[r]))
+            VB[i, r] = x
+            S = max(S, abs(x))
+    pad = 2.0 * rel_pad * S + abs_pad
+    tiny = 8.0 * 2.0**-53 * S
+    tiny_len2 = (1e-14 * S) ** 2
+    tiny_area2 = (1e-14 * S * S) ** 2
+    k = 1
+    IA[0] = 0
+    IB[0] = 0
+    lam[0] = 1.0
+    for r in range(3):
+        W[0, r] = VA[0, r] - VB[0, r]
+        v[r] = W[0, r]
+    vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    for _it in range(64):
+        if not vv > tiny * tiny:
+            return -np.inf
+        sv = math.sqrt(vv)
+        ia, sa = 0, np.inf
+        for i in range(na):
+            d = VA[i, 0] * v[0] + VA[i, 1] * v[1] + VA[i, 2] * v[2]
+            if d < sa:
+                ia, sa = i, d
+        ib, sb = 0, -np.inf
+        for i in range(nb):
+            d = VB[i, 0] * v[0] + VB[i, 1] * v[1] + VB[i, 2] * v[2]
+            if d > sb:
+                ib, sb = i, d
+        lb = (sa - sb) / sv - pad
+        if lb > target:
+            return lb
+        if sv < target - pad:     # a point of A - B closer than target: cannot be proven
+            return -np.inf
+        vw = 0.0
+        for r in range(3):
+            vw += v[r] * (VA[ia, r] - VB[ib, r])
+        if vv - vw <= 1e-13 * vv:  # converged below target
+            return -np.inf
+        for q in range(k):
+            if IA[q] == ia and IB[q] == ib:
+                return -np.inf
+        for r in range(3):
+            W[k, r] = VA[ia, r] - VB[ib, r]
+        IA[k] = ia
+        IB[k] = ib
+        k += 1
+        mask, inside = _subalgorithm(W, k, lam, vn, tiny_len2, tiny_area2)
+        if inside:
+            return -np.inf
+        vnn = vn[0] * vn[0] + vn[1] * vn[1] + vn[2] * vn[2]
+        if not vnn < vv:
+            return -np.inf
+        k = _compact(mask, k, W, IA, IB, lam)
+        for r in range(3):
+            v[r] = vn[r]
+        vv = vnn
+    return -np.inf
 
 
 @njit(cache=True)
@@ -336,6 +432,16 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         levers[0] = _lever(gp, ga, mp.ref_points[gp.body[ga]])
     if gp.kind[gb] != -1:
         levers[1] = _lever(gp, gb, mp.ref_points[gp.body[gb]])
+    lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
+    rsum = gp.radius[ga] + gp.radius[gb]
+    VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
+    VB = np.empty((max(gp.vstart[gb + 1] - gp.vstart[gb], 1), 3))
+    W = np.zeros((4, 3))
+    IA = np.zeros(4, np.int64)
+    IB = np.zeros(4, np.int64)
+    lam = np.zeros(4)
+    v = np.empty(3)
+    vn = np.empty(3)
     spent = 0
     sp = int(res[R_SP])
     if res[R_STARTED] == 0.0:
@@ -375,11 +481,22 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             continue
         m = 0.5 * (a + b)
         bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad)
-        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
         spent += 1
         res[R_TESTS] += 1.0
         if depth > res[R_DEPTH]:
             res[R_DEPTH] = depth
+        if lean:
+            # core distance > margin + radii + bound (+ the subtraction pad) excludes I
+            target = margin + rsum + bound
+            target += rel_pad * (abs(target) + bound + margin) + abs_pad
+            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, rel_pad, abs_pad, VA, VB, W, IA, IB,
+                                  lam, v, vn)
+            if lb > target:
+                slack = lb - (target - margin)      # > margin: proven clearance over I
+                if slack < res[R_CLEAR]:
+                    res[R_CLEAR] = slack
+                continue
+        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
         if up + approx < margin:
             res[R_WTIME] = m
             for r in range(3):
@@ -499,6 +616,29 @@ def check_pair_window(gp, mp, ga: int, gb: int, window: tuple[float, float], mar
 
 
 
+@njit(cache=True)
+def _poses_agree(mp, bodies, times, P_W, R_WB):
+    """True if the packed motion reproduces the trajectory's own poses (T, nbody, 3 / 3, 3) at ``times``.
+
+    A guard of the engine hook: the certificate is about the trajectory's motion, so a
+    packed motion that interpolates differently (e.g. the other arc of an exact
+    half-turn slerp, where the sign test of the quaternion dot product is decided by
+    rounding) must not be used. Tolerance 1e-9 relative (rotation entries: absolute).
+    """
+    p = np.empty(3)
+    R = np.empty((3, 3))
+    for k in range(times.shape[0]):
+        for b in bodies:
+            body_pose(mp, b, times[k], p, R)
+            for r in range(3):
+                if not abs(p[r] - P_W[k, b, r]) <= 1e-9 * (1.0 + abs(P_W[k, b, r])):
+                    return False
+                for c in range(3):
+                    if not abs(R[r, c] - R_WB[k, b, r, c]) <= 1e-9:
+                        return False
+    return True
+
+
 _SCENE_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 WHOLE_SHAPE_MAX_TESTS = 4096
@@ -522,7 +662,9 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
     Returns:
         Per pair the :func:`check_pair_window` result dict when it is ``"certified"``, else
         None (the pair falls through to the existing checker unchanged). A trajectory the
-        motion packer does not support makes every entry None.
+        motion packer does not support, or whose packed poses differ from its own
+        ``body_poses`` at the window's start, midpoint, end or a waypoint segment's midpoint
+        inside the window, makes every entry None.
     """
     from monitor.errors import MonitorError
     from monitor.motion.pack import pack_trajectory
@@ -533,6 +675,15 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
     try:
         mp = pack_trajectory(plan)
     except (MonitorError, TypeError, AttributeError):
+        return out
+    bodies = np.unique(np.array([[ga.body_id, gb.body_id] for ga, gb in geom_pairs], np.int64))
+    t0, t1 = float(window[0]), float(window[1])
+    wp = np.asarray(getattr(plan, "times", [t0, t1]), np.float64)
+    mids = 0.5 * (wp[:-1] + wp[1:])
+    times = np.concatenate([[t0, 0.5 * (t0 + t1), t1], mids[(mids > t0) & (mids < t1)]])
+    P_W, R_WB = plan.body_poses(times)
+    if not _poses_agree(mp, bodies, times, np.ascontiguousarray(P_W, np.float64),
+                        np.ascontiguousarray(R_WB, np.float64)):
         return out
     gp = _SCENE_PACKS.get(scene)
     if gp is None:
