@@ -18,7 +18,7 @@ from scipy.spatial.transform import Rotation
 from monitor.bench import oracle
 from monitor.bench.cases import PairCase, ShapeSpec, _place, _random_shape
 from monitor.certify import kernels as K
-from monitor.certify.packed import pack_shapes
+from monitor.certify.packed import pack_scene, pack_shapes
 from monitor.geometry.distance import shape_distance
 from monitor.geometry.polytope import box_polytope, halfspace_shape, sphere_shape
 from monitor.motion.bodymotion import BodyMotion
@@ -275,3 +275,50 @@ def test_matches_old_toleranced_path():
 def test_random_pairs_sweep(seed):
     """Larger seeded sweep of the soundness test (run with -m slow)."""
     test_random_pairs_never_certify_a_collision(seed, (-1e-5, 1e-5, -1e-3, 1e-4, -1e-2, 2e-2))
+
+
+def _curved_scene(geom_xml):
+    import mujoco
+
+    from monitor import Scene
+    xml = ('<mujoco><worldbody><geom name="table" type="box" size="1 1 0.05" pos="0 0 -0.05"/>'
+           f'<body name="b" pos="0 0 1"><freejoint/>{geom_xml}</body></worldbody></mujoco>')
+    return Scene.from_model(mujoco.MjModel.from_xml_string(xml), pairs="all")
+
+
+@pytest.mark.parametrize("geom_xml, low, flat_fails", [
+    # lying cylinder (axis along y after the geom rotation): lowest point at z - r; the
+    # 16-gon prism has a vertex at the bottom, 2 % of r lower than the cylinder
+    ('<geom name="g" type="cylinder" size="0.1 0.2" pos="0.05 0 0" euler="90 0 0"/>', 0.1, True),
+    # ellipsoid with radii (0.3, 0.2, 0.1), tilted about z only: lowest point at z - 0.1
+    # (its tangent-plane polytope happens to touch it at the bottom: no polytope claim)
+    ('<geom name="g" type="ellipsoid" size="0.3 0.2 0.1" pos="0 0.02 0" euler="0 0 30"/>', 0.1, False),
+])
+def test_curved_geoms_exact_in_whole_shape_test(geom_xml, low, flat_fails):
+    """Closed form: the geom slides along x at height h over the table top (z = 0); min gap h - low.
+
+    A gap of 0.5 mm is below the circumscribed polytope's over-approximation (~2 % of the
+    radius), so only the exact support function can certify it; -0.5 mm must not certify.
+    """
+    scene = _curved_scene(geom_xml)
+    pk = pack_scene(scene)
+    g = scene.geom("g").id
+    assert pk.geoms.curve[g] > 0 and scene.geom("g").shape.approx_error > 1e-3
+    ga, gb = (int(x) for x in pk.pair_ids[0])
+    for gap, want in ((5e-4, "certified"), (-5e-4, "violation")):
+        z = low + gap
+        times = np.array([0.0, 1.0])
+        pos = np.zeros((2, scene.model.nbody, 3))
+        pos[:, 1] = [[-0.4, 0.0, z], [0.4, 0.0, z]]
+        quat = np.zeros((2, scene.model.nbody, 4))
+        quat[..., 0] = 1.0
+        bm = BodyMotion(times, pos, quat)
+        r = K.check_pair_window(pk.geoms, pack_trajectory(bm), ga, gb, (0.0, 1.0), 0.0, 1e-4)
+        if want == "certified":
+            assert r["verdict"] == "certified" and 0.0 < r["clearance"] <= gap
+        else:
+            assert r["verdict"] != "certified"
+        # the polytope alone cannot certify the clear case (the regression this stage fixes)
+        flat = pack_shapes([gi.shape for gi in scene.geoms], [gi.body_id for gi in scene.geoms])
+        r0 = K.check_pair_window(flat, pack_trajectory(bm), ga, gb, (0.0, 1.0), 0.0, 1e-4)
+        assert r0["verdict"] != "certified" or not flat_fails

@@ -208,6 +208,54 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
 
 
 @njit(cache=True)
+def _curved_support(gp, g, R, off, v, sign, pt):
+    """Max over the exact cylinder / ellipsoid g of (sign v) . x, posed by R and origin ``off``.
+
+    Closed-form support functions (issue 12, item 2): cylinder (radius r, half length h,
+    axis z of its frame) ``h(d) = r |d_xy| + h |d_z|``, ellipsoid ``h(d) = |diag(radii) d|``,
+    with d in the geom frame, plus ``d . centre``. The value is computed in closed form;
+    the extreme point (for GJK's simplex only) goes into ``pt`` (3,).
+    """
+    Rg = np.empty((3, 3))
+    c = np.empty(3)
+    for r in range(3):
+        c[r] = off[r]
+        for q in range(3):
+            c[r] += R[r, q] * gp.ccenter[g, q]
+            acc = 0.0
+            for j in range(3):
+                acc += R[r, j] * gp.cframe[g, j, q]
+            Rg[r, q] = acc
+    dl = np.empty(3)
+    for q in range(3):
+        dl[q] = sign * (Rg[0, q] * v[0] + Rg[1, q] * v[1] + Rg[2, q] * v[2])
+    val = sign * (c[0] * v[0] + c[1] * v[1] + c[2] * v[2])
+    loc = np.empty(3)
+    if gp.curve[g] == 1:
+        rad, hh = gp.cparam[g, 0], gp.cparam[g, 1]
+        rho = math.sqrt(dl[0] * dl[0] + dl[1] * dl[1])
+        val += rad * rho + hh * abs(dl[2])
+        if rho > 0.0:
+            loc[0], loc[1] = rad * dl[0] / rho, rad * dl[1] / rho
+        else:
+            loc[0], loc[1] = rad, 0.0
+        loc[2] = hh if dl[2] >= 0.0 else -hh
+    else:
+        e0, e1, e2 = gp.cparam[g, 0] * dl[0], gp.cparam[g, 1] * dl[1], gp.cparam[g, 2] * dl[2]
+        nrm = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        val += nrm
+        if nrm > 0.0:
+            loc[0] = gp.cparam[g, 0] * e0 / nrm
+            loc[1] = gp.cparam[g, 1] * e1 / nrm
+            loc[2] = gp.cparam[g, 2] * e2 / nrm
+        else:
+            loc[0], loc[1], loc[2] = gp.cparam[g, 0], 0.0, 0.0
+    for r in range(3):
+        pt[r] = c[r] + Rg[r, 0] * loc[0] + Rg[r, 1] * loc[1] + Rg[r, 2] * loc[2]
+    return val
+
+
+@njit(cache=True)
 def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v, vn):
     """A separating-axis lower bound > ``target`` on ``dist(core_a, core_b)``, else -inf (early-exit GJK).
 
@@ -220,7 +268,11 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
     "not proven" (touching, overlapping, closer than target, or no progress): the caller
     then runs the full :func:`posed_distance`. Work arrays: VA, VB (>= vertex counts, 3),
     W (4, 3), IA, IB (4,) int64, lam (4,), v, vn (3,). Both geoms must be cores (no
-    half-spaces).
+    half-spaces). A circumscribed cylinder / ellipsoid (``gp.curve > 0``) is replaced by
+    its exact geom through :func:`_curved_support`: the exact geom lies inside the polytope
+    (checked when packing), so S (from the polytope's vertices) still bounds its
+    coordinates, and a lower bound on the distance of the exact geoms is what a
+    certificate needs (the polytope only over-approximates them).
     """
     sa0, na = gp.vstart[ga], gp.vstart[ga + 1] - gp.vstart[ga]
     sb0, nb = gp.vstart[gb], gp.vstart[gb + 1] - gp.vstart[gb]
@@ -241,6 +293,14 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
     tiny = 8.0 * 2.0**-53 * S
     tiny_len2 = (1e-14 * S) ** 2
     tiny_area2 = (1e-14 * S * S) ** 2
+    curved_a = gp.curve[ga] > 0
+    curved_b = gp.curve[gb] > 0
+    zero = np.zeros(3)
+    off_b = np.empty(3)
+    for r in range(3):
+        off_b[r] = pb[r] - pa[r]
+    xa = np.empty(3)
+    xb = np.empty(3)
     k = 1
     IA[0] = 0
     IB[0] = 0
@@ -253,16 +313,26 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
         if not vv > tiny * tiny:
             return -np.inf
         sv = math.sqrt(vv)
-        ia, sa = 0, np.inf
-        for i in range(na):
-            d = VA[i, 0] * v[0] + VA[i, 1] * v[1] + VA[i, 2] * v[2]
-            if d < sa:
-                ia, sa = i, d
-        ib, sb = 0, -np.inf
-        for i in range(nb):
-            d = VB[i, 0] * v[0] + VB[i, 1] * v[1] + VB[i, 2] * v[2]
-            if d > sb:
-                ib, sb = i, d
+        if curved_a:
+            ia, sa = -1, -_curved_support(gp, ga, Ra, zero, v, -1.0, xa)
+        else:
+            ia, sa = 0, np.inf
+            for i in range(na):
+                d = VA[i, 0] * v[0] + VA[i, 1] * v[1] + VA[i, 2] * v[2]
+                if d < sa:
+                    ia, sa = i, d
+            for r in range(3):
+                xa[r] = VA[ia, r]
+        if curved_b:
+            ib, sb = -1, _curved_support(gp, gb, Rb, off_b, v, 1.0, xb)
+        else:
+            ib, sb = 0, -np.inf
+            for i in range(nb):
+                d = VB[i, 0] * v[0] + VB[i, 1] * v[1] + VB[i, 2] * v[2]
+                if d > sb:
+                    ib, sb = i, d
+            for r in range(3):
+                xb[r] = VB[ib, r]
         lb = (sa - sb) / sv - pad
         if lb > target:
             return lb
@@ -270,14 +340,15 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
             return -np.inf
         vw = 0.0
         for r in range(3):
-            vw += v[r] * (VA[ia, r] - VB[ib, r])
+            vw += v[r] * (xa[r] - xb[r])
         if vv - vw <= 1e-13 * vv:  # converged below target
             return -np.inf
-        for q in range(k):
-            if IA[q] == ia and IB[q] == ib:
-                return -np.inf
+        if not (curved_a or curved_b):
+            for q in range(k):
+                if IA[q] == ia and IB[q] == ib:
+                    return -np.inf
         for r in range(3):
-            W[k, r] = VA[ia, r] - VB[ib, r]
+            W[k, r] = xa[r] - xb[r]
         IA[k] = ia
         IB[k] = ib
         k += 1

@@ -52,6 +52,11 @@ class GeomPack(NamedTuple):
         mw: (M,) their weights.
         mstart: (G + 1,) int64 offsets into ``mpts``.
         rho_max: (G,) max of rho over the core vertices (1/m units of eq. 4), padded up.
+        curve: (G,) int64 exact curved geom behind a circumscribed polytope: 0 none,
+            1 cylinder (axis z of its frame), 2 ellipsoid.
+        cparam: (G, 3) cylinder (radius, half length, 0) / ellipsoid radii (m).
+        cframe: (G, 3, 3) rotation geom frame -> body frame of the curved geom.
+        ccenter: (G, 3) geom origin in the body frame (m).
     """
 
     verts: np.ndarray
@@ -70,6 +75,39 @@ class GeomPack(NamedTuple):
     mw: np.ndarray
     mstart: np.ndarray
     rho_max: np.ndarray
+    curve: np.ndarray
+    cparam: np.ndarray
+    cframe: np.ndarray
+    ccenter: np.ndarray
+
+
+CURVE_NONE = 0
+CURVE_CYLINDER = 1
+CURVE_ELLIPSOID = 2
+
+
+def exact_support(curve: int, param: np.ndarray, d_G: np.ndarray) -> float:
+    """Support function h(d) of the exact cylinder / ellipsoid (geom frame, centred)."""
+    if curve == CURVE_CYLINDER:
+        return float(param[0] * np.hypot(d_G[0], d_G[1]) + param[1] * abs(d_G[2]))
+    return float(np.linalg.norm(param * d_G))
+
+
+def _curved_ok(shape: ConvexShape, curve: int, param: np.ndarray, R_BG: np.ndarray, c_B: np.ndarray) -> bool:
+    """The exact geom lies in the packed polytope: h_exact(n_i) <= offset_i for every face normal.
+
+    Guards the frame bookkeeping: the exact shape is used only where it provably is the
+    geom the circumscribed polytope stands for (up to 1e-9 relative).
+    """
+    N, off = np.asarray(shape.normals, float), np.asarray(shape.offsets, float)
+    if N.ndim != 2 or len(N) == 0:
+        return False
+    scale = float(np.abs(param).max())
+    for n, o in zip(N, off):
+        h = exact_support(curve, param, R_BG.T @ n) + float(n @ c_B)
+        if not h <= o + 1e-9 * (scale + abs(o)):
+            return False
+    return True
 
 
 def _starts(counts: list[int]) -> np.ndarray:
@@ -82,12 +120,16 @@ def _cat(arrs: list[np.ndarray], width: int, dtype) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([a.reshape(-1, width) for a in arrs]), dtype=dtype)
 
 
-def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray) -> GeomPack:
+def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray,
+                curved: list[tuple | None] | None = None) -> GeomPack:
     """Pack shapes (body frames) with their body ids.
 
     Args:
         shapes: G shapes; None for a geom without a convex shape.
         bodies: (G,) body id of each geom.
+        curved: optional per geom None or (curve code, params (3,), R_BG (3, 3), c_B (3,))
+            of the exact cylinder / ellipsoid that a circumscribed polytope stands for.
+            Entries whose exact shape is not inside the polytope are ignored.
 
     Raises:
         InvalidInputError: a bad shape (message names ``shapes[i]``), or lengths differ.
@@ -100,6 +142,19 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         raise InvalidInputError(f"bodies has {len(bodies)} entries, shapes has {len(shapes)}")
     V, E, N, MP, MW = [], [], [], [], []
     kind, radius, offset, dpad, approx, rho_max = [], [], [], [], [], []
+    G = len(shapes)
+    curve = np.zeros(G, np.int64)
+    cparam = np.zeros((G, 3))
+    cframe = np.tile(np.eye(3), (G, 1, 1))
+    ccenter = np.zeros((G, 3))
+    for i, cv in enumerate(curved or []):
+        if cv is None or shapes[i] is None or shapes[i].kind != "polytope":
+            continue
+        code, par = int(cv[0]), np.asarray(cv[1], float)
+        R_BG, c_B = np.asarray(cv[2], float), np.asarray(cv[3], float)
+        if code in (CURVE_CYLINDER, CURVE_ELLIPSOID) and np.isfinite(par).all() and (par[:2] > 0).all() \
+                and _curved_ok(shapes[i], code, par, R_BG, c_B):
+            curve[i], cparam[i], cframe[i], ccenter[i] = code, par, R_BG, c_B
     for i, s in enumerate(shapes):
         if s is None:
             V.append(np.zeros((0, 3)))
@@ -140,7 +195,9 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         offset=np.asarray(offset, np.float64), dpad=np.asarray(dpad, np.float64),
         approx=np.asarray(approx, np.float64), body=np.ascontiguousarray(bodies),
         mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
-        mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64))
+        mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
+        curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
+        ccenter=np.ascontiguousarray(ccenter))
 
 
 class ScenePack(NamedTuple):
@@ -160,7 +217,37 @@ def pack_scene(scene) -> ScenePack:
     shapes = [g.shape for g in scene.geoms]
     bodies = [g.body_id for g in scene.geoms]
     pid = np.ascontiguousarray(np.asarray(scene.pair_ids, np.int64).reshape(-1, 2))
-    return ScenePack(pack_shapes(shapes, bodies), pid)
+    return ScenePack(pack_shapes(shapes, bodies, _curved_geoms(scene)), pid)
 
 
-__all__ = ["GeomPack", "ScenePack", "pack_shapes", "pack_scene", "KIND_HALFSPACE", "KIND_NONE"]
+def _quat_mat(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _curved_geoms(scene) -> list:
+    """Exact cylinder / ellipsoid data of the scene's circumscribed geoms (from the model arrays).
+
+    Reads ``geom_size`` / ``geom_pos`` / ``geom_quat`` (body frame) of the scene's MjModel
+    as plain arrays (no mujoco import); each entry is re-checked by :func:`_curved_ok`.
+    """
+    model = getattr(scene, "model", None)
+    if model is None:
+        return []
+    out: list = []
+    for g in scene.geoms:
+        code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
+        if code == CURVE_NONE or g.shape is None:
+            out.append(None)
+            continue
+        size = np.asarray(model.geom_size[g.id], float)
+        par = np.array([size[0], size[1], 0.0]) if code == CURVE_CYLINDER else size.copy()
+        c_B = np.asarray(model.geom_pos[g.id], float).copy()
+        out.append((code, par, _quat_mat(model.geom_quat[g.id]), c_B))
+    return out
+
+
+__all__ = ["GeomPack", "ScenePack", "pack_shapes", "pack_scene", "KIND_HALFSPACE", "KIND_NONE", "CURVE_NONE",
+           "CURVE_CYLINDER", "CURVE_ELLIPSOID", "exact_support"]
