@@ -322,3 +322,35 @@ def test_curved_geoms_exact_in_whole_shape_test(geom_xml, low, flat_fails):
         flat = pack_shapes([gi.shape for gi in scene.geoms], [gi.body_id for gi in scene.geoms])
         r0 = K.check_pair_window(flat, pack_trajectory(bm), ga, gb, (0.0, 1.0), 0.0, 1e-4)
         assert r0["verdict"] != "certified" or not flat_fails
+
+
+def test_engine_hook_certifies_and_confirms(monkeypatch):
+    """certify(): the whole-shape stage decides clear and colliding pairs; the old path agrees."""
+    from monitor.certify import kernels as kmod
+    from monitor.certify.engine import certify
+
+    rng = np.random.default_rng(31)
+    c = _case(rng, "box", "hull", rotating=True, both=True)
+    w = _perp(c, rng)
+    clear = _place(c, w, 2e-2, oracle.mujoco_distance)
+    hit = _place(c, w, -2e-2, oracle.mujoco_distance)
+    assert clear.nominal > 1e-2 and hit.nominal < -1e-2
+    cert = certify(clear.scene(16), clear.body_motion(), 0.0, 1e-3, "toleranced")
+    assert cert.verdict == "certified" and cert.stats["checker_mix"] == {"toleranced/whole-shape": 1}
+    assert 0.0 < cert.clearance <= clear.nominal + 1e-9
+    cert = certify(hit.scene(16), hit.body_motion(), 0.0, 1e-3, "toleranced")
+    assert cert.verdict == "violation" and cert.stats["checker_mix"] == {"toleranced/whole-shape": 1}
+    pr = cert.pairs[0]
+    t_w = cert.witness.time
+    assert pr.method == "toleranced" and pr.intervals[0][0] <= t_w == pr.intervals[0][1]
+    assert _confirm(hit, [s.convex_shape() for s in hit.shapes], t_w) < 0.0
+    # the first contact is not before the reported interval start: the Lipschitz oracle
+    # (2001 samples, half-step speed margin) proves [0, start] clear
+    ts = np.linspace(0.0, pr.intervals[0][0], 2001)
+    L = float(hit.speed_bounds().sum())
+    lo = np.array([oracle.distance_bounds(hit, t)[0] for t in ts])
+    assert (lo - 0.5 * L * (ts[1] - ts[0]) > 0).all()
+    monkeypatch.setattr(kmod, "whole_shape_stage", lambda scene, plan, pairs, *a, **k: [None] * len(pairs))
+    old = certify(hit.scene(16), hit.body_motion(), 0.0, 1e-3, "toleranced")
+    assert old.verdict == "violation"
+    assert abs(old.witness.time - t_w) < 0.05

@@ -287,12 +287,18 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         from monitor.certify.kernels import whole_shape_stage
         pre = whole_shape_stage(scene, plan, [(ga, gb) for _i, ga, gb in tol_items], (t0, t1), margin,
                                 epsilon, tol, bud)
-        for (i, ga, gb), r in zip(tol_items, pre):
+        for k, ((i, ga, gb), r) in enumerate(zip(tol_items, pre)):
+            w = None
+            if r is not None and r["verdict"] == "violation":  # re-confirmed by the engine's own rule
+                w = _find_witness(plan, ga, gb, np.array([r["witness_time"]]), margin, tol)
+                if w is None:
+                    pre[k] = r = None
             if r is not None:
                 tests_total += r["tests"]
                 depth_max = max(depth_max, r["max_depth"])
-                results[i] = PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "toleranced",
-                                        r["tests"], r["max_depth"], (), float(r["clearance"]))
+                iv = () if w is None else ((r["first_unresolved"], w.time),)
+                results[i] = PairResult((ga.name, gb.name), (ga.body, gb.body), r["verdict"], "toleranced",
+                                        r["tests"], r["max_depth"], iv, float(r["clearance"]), w)
                 mix["toleranced/whole-shape"] = mix.get("toleranced/whole-shape", 0) + 1
         tol_items = [x for x, r in zip(tol_items, pre) if r is None]
     if tol_items:

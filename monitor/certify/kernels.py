@@ -93,7 +93,11 @@ UNSUPPORTED = 4
 MODE_FULL = 0
 """Search the whole window: earliest confirmed violation, every unresolved interval counted."""
 MODE_CERTIFY_ONLY = 1
-"""Stop at the first confirmed violation or the first unresolved sub-interval (pre-filter use)."""
+"""Stop at the first unresolved sub-interval met before any confirmed violation (pre-filter use).
+
+A confirmed violation is refined as in MODE_FULL (earliest confirmed time, and
+``R_FIRST_UNRES`` = start of the earliest sub-interval before it that could be neither
+excluded nor confirmed: the first contact is not earlier than min(that, witness time))."""
 
 # layout of the result row (float64)
 R_VERDICT = 0
@@ -573,9 +577,6 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             for r in range(3):
                 res[R_WPOINT + r] = w[r]
             res[R_WUPPER] = up + approx
-            if mode == MODE_CERTIFY_ONLY:
-                sp = 0
-                break
             # everything on the stack is later than m: search [a, m] only
             sp = 0
             if depth < max_depth and a < m and bound >= epsilon:
@@ -587,7 +588,9 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 res[R_CLEAR] = slack
             continue
         if not (bound >= epsilon) or depth >= max_depth or not (a < m < b):
-            if wt == wt:               # refining an earlier witness: nothing more to find here
+            if wt == wt:               # refining an earlier witness: contact may start here
+                if not (res[R_FIRST_UNRES] <= a):
+                    res[R_FIRST_UNRES] = a
                 continue
             res[R_UNRES] += 1.0
             if not (res[R_FIRST_UNRES] == res[R_FIRST_UNRES]):
@@ -731,8 +734,9 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
             the stage stops (returning None for the rest) once it is exhausted.
 
     Returns:
-        Per pair the :func:`check_pair_window` result dict when it is ``"certified"``, else
-        None (the pair falls through to the existing checker unchanged). A trajectory the
+        Per pair a dict (``verdict`` "certified" with ``clearance``, or "violation" with
+        ``witness_time`` and ``first_unresolved``: the first contact is not earlier than it),
+        else None (the pair falls through to the existing checker unchanged). A trajectory the
         motion packer does not support, or whose packed poses differ from its own
         ``body_poses`` at the window's start, midpoint, end or a waypoint segment's midpoint
         inside the window, makes every entry None.
@@ -771,9 +775,14 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
                         float(tolerances.rel_pad), float(tolerances.abs_pad), stack, res)
         if budget is not None:
             budget.charge(int(res[R_TESTS]))
-        if v == CERTIFIED:
-            out[k] = {"verdict": "certified", "clearance": float(res[R_CLEAR]), "tests": int(res[R_TESTS]),
-                      "max_depth": int(res[R_DEPTH]), "paper_ball_wins": int(res[R_PAPER])}
+        if v == CERTIFIED or v == VIOLATION:
+            wt = float(res[R_WTIME])
+            fu = float(res[R_FIRST_UNRES])
+            out[k] = {"verdict": "certified" if v == CERTIFIED else "violation",
+                      "clearance": float(res[R_CLEAR]) if v == CERTIFIED else float("-inf"),
+                      "tests": int(res[R_TESTS]), "max_depth": int(res[R_DEPTH]),
+                      "paper_ball_wins": int(res[R_PAPER]), "witness_time": wt,
+                      "first_unresolved": min(fu, wt) if fu == fu else wt}
     return out
 
 
