@@ -1,0 +1,253 @@
+r"""Pack a scene's geom cores once into flat arrays for the compiled kernels (issue 12).
+
+One :class:`GeomPack` holds every geom of a :class:`monitor.Scene` (or of a plain list
+of shapes): core vertices, edges and face normals concatenated with offset tables, the
+radius, the kind code of :mod:`monitor.geometry._gjk` (-1 for half-spaces, -2 for
+geoms without a shape), the body of each geom, the over-approximation ``approx_error``
+of circumscribed cylinders/ellipsoids and the depth pad of the face normals (both
+from :mod:`monitor.geometry.distance`, whose validation is reused), plus, per geom,
+the Schröcker & Weber metric of its core (§2: feature points ``m_i`` and weights
+``w_i``) and ``rho_max``, the maximum of the distortion rate rho (eq. 4) over the
+core's vertices (rho is convex, so this is its maximum over the core).
+
+Everything is body frame, metres, float64 / int64 and C-contiguous, so a
+:class:`GeomPack` is a numba-typable tuple.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from monitor.errors import InvalidInputError
+from monitor.geometry.shapes import ConvexShape
+
+KIND_HALFSPACE = -1
+"""Kind code of a half-space geom (``normals[0] . x <= offset`` in the body frame)."""
+KIND_NONE = -2
+"""Kind code of a geom without a convex shape (hfield / sdf outside every candidate pair)."""
+
+_RHO_INFLATE = 1.0 + 1e-12
+"""Upward relative inflation of rho_max (covers the float evaluation of eq. 4)."""
+
+
+class GeomPack(NamedTuple):
+    """Flat arrays of G geoms (numba-typable).
+
+    Attributes:
+        verts: (V, 3) core vertices of all geoms, body frame (m).
+        vstart: (G + 1,) int64 offsets into ``verts``.
+        edges: (E, 2) int64 edges, vertex indices local to the geom.
+        estart: (G + 1,) int64 offsets into ``edges``.
+        normals: (N, 3) face normals (polytopes) / the plane normal (half-spaces).
+        nstart: (G + 1,) int64 offsets into ``normals``.
+        kind: (G,) int64 kind code (0 point, 1 segment, 2 polytope, -1 half-space, -2 none).
+        radius: (G,) radius (m).
+        offset: (G,) half-space offset (m; 0 otherwise).
+        dpad: (G,) depth pad of the face normals (m; inf: no depth certificate).
+        approx: (G,) over-approximation ``approx_error`` (m).
+        body: (G,) int64 body id of each geom.
+        mpts: (M, 3) metric feature points of all geoms (body frame, m).
+        mw: (M,) their weights.
+        mstart: (G + 1,) int64 offsets into ``mpts``.
+        rho_max: (G,) max of rho over the core vertices (1/m units of eq. 4), padded up.
+        curve: (G,) int64 exact curved geom behind a circumscribed polytope: 0 none,
+            1 cylinder (axis z of its frame), 2 ellipsoid.
+        cparam: (G, 3) cylinder (radius, half length, 0) / ellipsoid radii (m).
+        cframe: (G, 3, 3) rotation geom frame -> body frame of the curved geom.
+        ccenter: (G, 3) geom origin in the body frame (m).
+    """
+
+    verts: np.ndarray
+    vstart: np.ndarray
+    edges: np.ndarray
+    estart: np.ndarray
+    normals: np.ndarray
+    nstart: np.ndarray
+    kind: np.ndarray
+    radius: np.ndarray
+    offset: np.ndarray
+    dpad: np.ndarray
+    approx: np.ndarray
+    body: np.ndarray
+    mpts: np.ndarray
+    mw: np.ndarray
+    mstart: np.ndarray
+    rho_max: np.ndarray
+    curve: np.ndarray
+    cparam: np.ndarray
+    cframe: np.ndarray
+    ccenter: np.ndarray
+
+
+CURVE_NONE = 0
+CURVE_CYLINDER = 1
+CURVE_ELLIPSOID = 2
+
+
+def exact_support(curve: int, param: np.ndarray, d_G: np.ndarray) -> float:
+    """Support function h(d) of the exact cylinder / ellipsoid (geom frame, centred)."""
+    if curve == CURVE_CYLINDER:
+        return float(param[0] * np.hypot(d_G[0], d_G[1]) + param[1] * abs(d_G[2]))
+    return float(np.linalg.norm(param * d_G))
+
+
+def _curved_ok(shape: ConvexShape, curve: int, param: np.ndarray, R_BG: np.ndarray, c_B: np.ndarray) -> bool:
+    """The exact geom lies in the packed polytope: h_exact(n_i) <= offset_i for every face normal.
+
+    Guards the frame bookkeeping: the exact shape is used only where it provably is the
+    geom the circumscribed polytope stands for (up to 1e-9 relative).
+    """
+    N, off = np.asarray(shape.normals, float), np.asarray(shape.offsets, float)
+    if N.ndim != 2 or len(N) == 0:
+        return False
+    scale = float(np.abs(param).max())
+    for n, o in zip(N, off):
+        h = exact_support(curve, param, R_BG.T @ n) + float(n @ c_B)
+        if not h <= o + 1e-9 * (scale + abs(o)):
+            return False
+    return True
+
+
+def _starts(counts: list[int]) -> np.ndarray:
+    return np.concatenate([[0], np.cumsum(counts, dtype=np.int64)]).astype(np.int64)
+
+
+def _cat(arrs: list[np.ndarray], width: int, dtype) -> np.ndarray:
+    if not arrs:
+        return np.zeros((0, width), dtype)
+    return np.ascontiguousarray(np.concatenate([a.reshape(-1, width) for a in arrs]), dtype=dtype)
+
+
+def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray,
+                curved: list[tuple | None] | None = None) -> GeomPack:
+    """Pack shapes (body frames) with their body ids.
+
+    Args:
+        shapes: G shapes; None for a geom without a convex shape.
+        bodies: (G,) body id of each geom.
+        curved: optional per geom None or (curve code, params (3,), R_BG (3, 3), c_B (3,))
+            of the exact cylinder / ellipsoid that a circumscribed polytope stands for.
+            Entries whose exact shape is not inside the polytope are ignored.
+
+    Raises:
+        InvalidInputError: a bad shape (message names ``shapes[i]``), or lengths differ.
+    """
+    from monitor.geometry.distance import _core
+    from monitor.motion.metric import shape_metric
+
+    bodies = np.asarray(bodies, dtype=np.int64).reshape(-1)
+    if len(bodies) != len(shapes):
+        raise InvalidInputError(f"bodies has {len(bodies)} entries, shapes has {len(shapes)}")
+    V, E, N, MP, MW = [], [], [], [], []
+    kind, radius, offset, dpad, approx, rho_max = [], [], [], [], [], []
+    G = len(shapes)
+    curve = np.zeros(G, np.int64)
+    cparam = np.zeros((G, 3))
+    cframe = np.tile(np.eye(3), (G, 1, 1))
+    ccenter = np.zeros((G, 3))
+    for i, cv in enumerate(curved or []):
+        if cv is None or shapes[i] is None or shapes[i].kind != "polytope":
+            continue
+        code, par = int(cv[0]), np.asarray(cv[1], float)
+        R_BG, c_B = np.asarray(cv[2], float), np.asarray(cv[3], float)
+        if code in (CURVE_CYLINDER, CURVE_ELLIPSOID) and np.isfinite(par).all() and (par[:2] > 0).all() \
+                and _curved_ok(shapes[i], code, par, R_BG, c_B):
+            curve[i], cparam[i], cframe[i], ccenter[i] = code, par, R_BG, c_B
+    for i, s in enumerate(shapes):
+        if s is None:
+            V.append(np.zeros((0, 3)))
+            E.append(np.zeros((0, 2), np.int64))
+            N.append(np.zeros((0, 3)))
+            MP.append(np.zeros((0, 3)))
+            MW.append(np.zeros(0))
+            kind.append(KIND_NONE)
+            radius.append(0.0)
+            offset.append(0.0)
+            dpad.append(np.inf)
+            approx.append(0.0)
+            rho_max.append(np.inf)
+            continue
+        c = _core(s, f"shapes[{i}]")
+        V.append(c.P)
+        E.append(c.E)
+        N.append(c.N)
+        kind.append(KIND_HALFSPACE if c.code < 0 else int(c.code))
+        radius.append(float(c.radius))
+        offset.append(float(c.offset))
+        dpad.append(float(c.dpad))
+        approx.append(float(s.approx_error))
+        if c.code < 0:
+            MP.append(np.zeros((0, 3)))
+            MW.append(np.zeros(0))
+            rho_max.append(np.inf)
+        else:
+            m = shape_metric(s)
+            MP.append(np.asarray(m.points, float))
+            MW.append(np.asarray(m.weights, float))
+            rho_max.append(float(np.sqrt(np.max(m.rho2(c.P)))) * _RHO_INFLATE)
+    return GeomPack(
+        verts=_cat(V, 3, np.float64), vstart=_starts([len(v) for v in V]),
+        edges=_cat(E, 2, np.int64), estart=_starts([len(e) for e in E]),
+        normals=_cat(N, 3, np.float64), nstart=_starts([len(n) for n in N]),
+        kind=np.asarray(kind, np.int64), radius=np.asarray(radius, np.float64),
+        offset=np.asarray(offset, np.float64), dpad=np.asarray(dpad, np.float64),
+        approx=np.asarray(approx, np.float64), body=np.ascontiguousarray(bodies),
+        mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
+        mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
+        curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
+        ccenter=np.ascontiguousarray(ccenter))
+
+
+class ScenePack(NamedTuple):
+    """A scene packed once: its geoms and candidate pairs.
+
+    Attributes:
+        geoms: the :class:`GeomPack` (index == MuJoCo geom id).
+        pair_ids: (P, 2) int64 geom ids of the candidate pairs (scene order).
+    """
+
+    geoms: GeomPack
+    pair_ids: np.ndarray
+
+
+def pack_scene(scene) -> ScenePack:
+    """Pack a :class:`monitor.Scene` (all geoms, candidate pairs)."""
+    shapes = [g.shape for g in scene.geoms]
+    bodies = [g.body_id for g in scene.geoms]
+    pid = np.ascontiguousarray(np.asarray(scene.pair_ids, np.int64).reshape(-1, 2))
+    return ScenePack(pack_shapes(shapes, bodies, _curved_geoms(scene)), pid)
+
+
+def _quat_mat(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _curved_geoms(scene) -> list:
+    """Exact cylinder / ellipsoid data of the scene's circumscribed geoms (from the model arrays).
+
+    Reads ``geom_size`` / ``geom_pos`` / ``geom_quat`` (body frame) of the scene's MjModel
+    as plain arrays (no mujoco import); each entry is re-checked by :func:`_curved_ok`.
+    """
+    model = getattr(scene, "model", None)
+    if model is None:
+        return []
+    out: list = []
+    for g in scene.geoms:
+        code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
+        if code == CURVE_NONE or g.shape is None:
+            out.append(None)
+            continue
+        size = np.asarray(model.geom_size[g.id], float)
+        par = np.array([size[0], size[1], 0.0]) if code == CURVE_CYLINDER else size.copy()
+        c_B = np.asarray(model.geom_pos[g.id], float).copy()
+        out.append((code, par, _quat_mat(model.geom_quat[g.id]), c_B))
+    return out
+
+
+__all__ = ["GeomPack", "ScenePack", "pack_shapes", "pack_scene", "KIND_HALFSPACE", "KIND_NONE", "CURVE_NONE",
+           "CURVE_CYLINDER", "CURVE_ELLIPSOID", "exact_support"]
