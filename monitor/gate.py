@@ -49,7 +49,9 @@ import mujoco
 import numpy as np
 
 from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
 from monitor.errors import InvalidInputError
+from monitor.gate_policy import announce, applied_cost, block_reason, describe_gate, safety_keys
 from monitor.tolerances import DEFAULT, Tolerances
 
 _LOG = logging.getLogger("monitor.gate")
@@ -221,8 +223,17 @@ class StepReport:
 
     @property
     def cost(self) -> float:
-        """1.0 when the proposed window has a confirmed violation, else 0.0 (safety-gymnasium)."""
-        return 1.0 if self.verdict == "violation" else 0.0
+        """1.0 when the APPLIED window has a confirmed violation, else 0.0.
+
+        safety-gymnasium's convention: the cost of the transition that happened; the
+        proposal's own cost is ``info()["proposal_cost"]``.
+        """
+        return applied_cost(self)
+
+    @property
+    def block_reason(self) -> str:
+        """Why the proposal was replaced (``""`` if not); see :mod:`monitor.gate_policy`."""
+        return block_reason(self)
 
     def info(self, *, timing: bool = False) -> dict[str, Any]:
         """Fixed-shape summary for ``info["safety"]`` (stackable by vector envs).
@@ -240,13 +251,14 @@ class StepReport:
             of str, one per candidate pair), checker_mix (str, e.g. ``"culled:12 toleranced:3"``),
             witness_time (float s), witness_geoms ((2,) object array of str), witness_point ((3,) m),
             earliest_time (float s), clearance (float m), replaced (bool),
-            fallback_certified (bool), terminated (bool), time (float s)
-            and, if ``timing``, certify_us (float µs).
+            fallback_certified (bool), terminated (bool), time (float s),
+            version (int), proposal_cost (float), intervened (bool), block_reason (str)
+            (:mod:`monitor.gate_policy`) and, if ``timing``, certify_us (float µs).
         """
-        return safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
-                           replaced=self.replaced, fallback_certified=self.fallback_certified,
-                           terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
-                           certify_us=self.certify_us if timing else None)
+        return {**safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
+                              replaced=self.replaced, fallback_certified=self.fallback_certified,
+                              terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
+                              certify_us=self.certify_us if timing else None), **safety_keys(self)}
 
 
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
@@ -347,6 +359,19 @@ class Gate:
         tolerances: numerical tolerances.
         log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
             ``log`` is a path (e.g. ``env_id``, ``model_source``).
+        allowed: allowed-contact matrix (:func:`monitor.acm.as_acm`). Default ``"auto"``:
+            computed from the model at construction (Adjacent + Default in qpos0 /
+            keyframe 0 + Always from a small seeded sample, cached per model hash);
+            None checks every candidate pair. Allowed pairs are never gated and are
+            listed in every certificate with their reasons.
+        hazards: None (every candidate pair) or pattern items (:mod:`monitor.pairsel`)
+            selecting the checked pairs.
+        allow: pattern items whose pairs are allowed (reason User).
+        ongoing: ``"deepen"`` (default: a pair already in contact at the window start
+            may not deepen beyond ``penetration_tol``; every other pair keeps the full
+            margin, see :mod:`monitor.certify.ongoing`) or ``"violation"`` (plain
+            certify: such a pair is a violation).
+        penetration_tol: metres (default 5 mm), see ``ongoing``.
 
     Raises:
         InvalidInputError: on an unknown option, negative margin or epsilon <= 0.
@@ -358,7 +383,9 @@ class Gate:
                  fallback: Any = None, budget: Any = None, log: Any = None, frame_skip: int = 1,
                  reuse: bool = True, brake: bool = True, brake_horizon: float = 0.25,
                  brake_vel_tol: float = 1e-3, tolerances: Tolerances = DEFAULT,
-                 log_options: dict[str, Any] | None = None) -> None:
+                 log_options: dict[str, Any] | None = None, allowed: Any = "auto", hazards: Any = None,
+                 allow: Any = None, ongoing: str = "deepen",
+                 penetration_tol: float = DEFAULT_PENETRATION_TOL) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
         if on_violation not in ON_VIOLATION:
@@ -374,6 +401,8 @@ class Gate:
         if int(frame_skip) < 1:
             raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
         _make_budget(budget)  # validate early
+        self.penetration_tol = check_rule(ongoing, penetration_tol)
+        self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
         self.model = model
         self.pairs = pairs
         self.margin = float(margin)
@@ -411,8 +440,14 @@ class Gate:
         if self._scene is None:
             from monitor.scene import Scene
 
-            self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances)
+            self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances,
+                                           allowed=self.allowed, hazards=self.hazards, allow=self.allow)
+            announce(self)  # issue 13: say what is monitored; warn once when nothing is
         return self._scene
+
+    def describe(self) -> str:
+        """One line: pairs monitored, pairs allowed by reason, the ongoing-contact rule."""
+        return describe_gate(self)
 
     @property
     def npairs(self) -> int:
@@ -439,7 +474,8 @@ class Gate:
         todo, reused, keys = self._split_reuse(scene, plan)
         if todo is None:  # nothing reusable: one plain call
             cert = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                           budget=_make_budget(self.budget), tolerances=self.tolerances)
+                           budget=_make_budget(self.budget), tolerances=self.tolerances,
+                           ongoing=self.ongoing, penetration_tol=self.penetration_tol)
         else:
             cert = self._certify_subset(certify, scene, plan, todo, reused)
         if self.reuse:
@@ -481,7 +517,8 @@ class Gate:
         if todo:
             names = [scene.candidate_pairs[i] for i in todo]
             fresh = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names)
+                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names,
+                            ongoing=self.ongoing, penetration_tol=self.penetration_tol)
             by_geoms = {p.geoms: p for p in fresh.pairs}
             fresh_pairs = [by_geoms[tuple(scene.candidate_pairs[i])] for i in todo]
         else:
@@ -497,9 +534,10 @@ class Gate:
         stats["pairs"] = len(pairs)
         if fresh is None:
             return Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
-                               clearance, pairs, stats)
+                               clearance, pairs, stats, scene.allowed_pairs)
         return Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method, fresh.witness,
-                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats)
+                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats,
+                           scene.allowed_pairs)
 
     def _remember(self, cert: Certificate, keys: dict[int, bytes]) -> None:
         for i, key in keys.items():

@@ -183,7 +183,11 @@ class Scene:
         approximations: {geom name: approx_error (m)} for circumscribed shapes.
         facets: facet count used for cylinders and ellipsoids.
         tolerances: the :class:`Tolerances` used.
+        allowed_pairs: ((geom_a, geom_b, reason), ...) candidate pairs removed by the
+            ACM / ``allow=`` (never certified; listed in every certificate).
     """
+
+    allowed_pairs: tuple[tuple[str, str, str], ...] = ()
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
@@ -205,7 +209,8 @@ class Scene:
 
     @classmethod
     def from_model(cls, model: Any, pairs: str | Iterable[tuple[str | int, str | int]] = "mujoco",
-                   *, facets: int | None = None, tolerances: Tolerances = DEFAULT) -> Scene:
+                   *, facets: int | None = None, tolerances: Tolerances = DEFAULT, allowed: Any = None,
+                   hazards: Any = None, allow: Any = None) -> Scene:
         """Read every geom of ``model`` and select the candidate pairs.
 
         Args:
@@ -216,6 +221,13 @@ class Scene:
             facets: facet count of circumscribed cylinders/ellipsoids (>= 3);
                 default ``tolerances.facets`` (16).
             tolerances: numerical tolerances.
+            allowed: allowed-contact matrix (:func:`monitor.acm.as_acm`: None, ``"auto"``,
+                an :class:`monitor.acm.ACM`, a ``.json`` path or a list of pairs); its
+                pairs (except reason Never) are removed from the candidates and listed
+                in :attr:`allowed_pairs` with their reasons.
+            hazards: None, or pattern items (:mod:`monitor.pairsel`) selecting the
+                candidate pairs that are checked.
+            allow: pattern items whose candidate pairs are allowed (reason User).
 
         Returns:
             The scene.
@@ -246,6 +258,12 @@ class Scene:
                 seen[nm] = g
 
         pair_ids = cls._select_pairs(model, pairs, names)
+        allowed_rows: tuple[tuple[str, str, str], ...] = ()
+        if allowed is not None or hazards is not None or allow is not None:  # issue 13: pair policy
+            from monitor.acm import apply_policy
+
+            policy = apply_policy(model, pair_ids, pairs, allowed=allowed, hazards=hazards, allow=allow)
+            pair_ids, allowed_rows = policy.monitored, policy.allowed
         types = np.asarray(model.geom_type, dtype=np.int64)
         if len(pair_ids):
             in_pair = np.unique(pair_ids.ravel())
@@ -279,7 +297,9 @@ class Scene:
                 mocap=bool(body_mocap[b])))
         if isinstance(pairs, str) and pairs == "all":
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
-        return cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene.allowed_pairs = allowed_rows
+        return scene
 
     @staticmethod
     def _select_pairs(model: Any, pairs: Any, names: Sequence[str]) -> np.ndarray:

@@ -46,6 +46,7 @@ import numpy as np
 from monitor.certify.broadphase import halfspace_gaps, sphere_pair_gaps, swept_geom_spheres
 from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
 from monitor.certify.common import Budget, PairOutcome
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
 from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -110,7 +111,8 @@ def _make_budget(budget: Any) -> Budget | None:
 
 def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, method: str = "auto", *,
             window: tuple[float, float] | None = None, budget: Budget | dict | None = None,
-            tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None) -> Certificate:
+            tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None,
+            ongoing: str = "violation", penetration_tol: float = DEFAULT_PENETRATION_TOL) -> Certificate:
     """Certify that the planned motion keeps every candidate pair at least ``margin`` apart.
 
     Args:
@@ -123,6 +125,10 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         budget: None, a :class:`Budget`, or {"seconds": .., "tests": ..}.
         tolerances: numerical tolerances.
         pairs: optional subset of candidate pairs (geom-name pairs) to certify.
+        ongoing: ``"violation"`` (default: a pair closer than ``margin`` at t0 is a
+            violation) or ``"deepen"`` (such a pair is an ongoing contact and only has to
+            stay within ``penetration_tol`` of penetration; :mod:`monitor.certify.ongoing`).
+        penetration_tol: metres of penetration an ongoing contact may reach (``"deepen"``).
 
     Returns:
         The :class:`Certificate`.
@@ -155,12 +161,14 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     if not t1 > t0:
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
     bud = _make_budget(budget)
+    pen_tol = check_rule(ongoing, penetration_tol)
+    allowed = tuple(getattr(scene, "allowed_pairs", ()))
     sel = _select(scene, pairs)
     if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
         return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
-                                "budget_exhausted": False})
+                                "budget_exhausted": False}, allowed)
 
     moving = np.asarray(plan.moving_bodies(), bool)
     static = np.asarray(scene.body_static, bool)
@@ -354,8 +362,12 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud is not None and bud.exhausted)}
-    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
-                       ordered, stats)
+    cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
+                       ordered, stats, allowed)
+    if ongoing == "deepen":  # issue 13: contacts present at t0 (monitor/certify/ongoing.py)
+        cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
+                      budget=bud, tolerances=tol, penetration_tol=pen_tol)
+    return cert
 
 
 def _build_ordered(sel: list[int], cull_clear: list[float], ga: list[int], gb: list[int],
