@@ -7,9 +7,12 @@ pair with a :class:`Reason`:
 =========  ==========================================================================
 Adjacent   parent-child bodies (weld groups; neither the world, the child attached
            without a free joint), or two geoms welded together (same weld group)
-Default    in contact (static distance <= ``contact_tol``) in the reference pose:
-           keyframe K when the model has it, else ``qpos0`` (a model's ``qpos0`` may
-           put a body inside an obstacle, e.g. ``models/tunnel``; its keyframe does not)
+Default    in contact (static distance <= the pair's MuJoCo contact margin, max of the two
+           ``geom_margin``, + ``contact_tol``) in the reference pose
+           (keyframe K when the model has it, else ``qpos0``: a model's ``qpos0`` may
+           put a body inside an obstacle, e.g. ``models/tunnel``; its keyframe does
+           not) or at any step while the model settles from it for ``settle`` seconds
+           of passive simulation (zero control): resting objects, feet on the floor
 Always     in contact in every sampled configuration (a sampling result)
 Never      in contact in no sampled configuration (a sampling result)
 User       given by the user (``allow=`` patterns or an edited file)
@@ -75,9 +78,15 @@ DEFAULT_SAMPLES = 200
 AUTO_SAMPLES = 32
 """Samples of the ACM a gate computes at construction (``allowed="auto"``)."""
 CONTACT_TOL = 1e-4
-"""Metres: a pair whose exact static distance is at most this counts as "in contact"
-for Default / Always (an upper bound must be below it) and Never (the lower bound must
-stay above it). 0.1 mm covers MuJoCo's resting penetration and float noise."""
+"""Metres: a pair whose exact static distance is at most its MuJoCo contact margin (max of
+the two ``geom_margin``; Ant's feet rest 2 cm above the floor because of it) plus this counts
+as "in contact" for Default / Always (an upper bound must be below it) and Never (the lower
+bound must stay above it). 0.1 mm covers float noise."""
+SETTLE = 0.5
+"""Seconds of passive simulation (zero control) from the reference pose whose contacts are
+Default: the model's resting contacts (Ant's and Walker's feet on the floor, Pusher's object on
+the table). MuJoCo's contact list only proposes pairs; each is confirmed with the exact static
+distance at that state."""
 _UNLIMITED_SLIDE = 1.0  # m around qpos0 for unlimited slide / free-joint positions
 
 
@@ -312,6 +321,44 @@ def _poses(model: Any, qs: list[np.ndarray], key: int | None = None) -> tuple[np
     return pos, rot
 
 
+def _pair_margin(model: Any, a: int, b: int) -> float:
+    """MuJoCo's contact margin of a geom pair (m): contacts are active below it."""
+    return float(max(model.geom_margin[a], model.geom_margin[b]))
+
+
+def _settled_contacts(model: Any, geoms: Any, todo: list[tuple[int, int]], key: int | None,
+                      qpos: np.ndarray, settle: float, contact_tol: float) -> set[tuple[int, int]]:
+    """Pairs of ``todo`` in confirmed contact at some step of passive settling from ``qpos``."""
+    import mujoco
+
+    from monitor.geometry.distance import shape_distance
+
+    want = set(todo)
+    found: set[tuple[int, int]] = set()
+    d = mujoco.MjData(model)
+    if key is not None:
+        mujoco.mj_resetDataKeyframe(model, d, key)
+    d.qpos[:] = qpos
+    d.ctrl[:] = 0.0
+    nstep = int(math.ceil(settle / float(model.opt.timestep)))
+    for _ in range(nstep):
+        mujoco.mj_step(model, d)
+        if not d.ncon:
+            continue
+        g1 = np.asarray(d.contact.geom1[:d.ncon])
+        g2 = np.asarray(d.contact.geom2[:d.ncon])
+        for a, b in zip(np.minimum(g1, g2).tolist(), np.maximum(g1, g2).tolist()):
+            if (a, b) not in want or (a, b) in found:
+                continue
+            ga, gb = geoms[a], geoms[b]
+            X_a = (d.xmat[ga.body_id].reshape(3, 3).copy(), d.xpos[ga.body_id].copy())
+            X_b = (d.xmat[gb.body_id].reshape(3, 3).copy(), d.xpos[gb.body_id].copy())
+            dist = shape_distance(ga.shape, X_a, gb.shape, X_b)
+            if dist.upper <= contact_tol + _pair_margin(model, a, b):
+                found.add((a, b))
+    return found
+
+
 def _adjacent(model: Any, ga: int, gb: int) -> bool:
     import mujoco
 
@@ -331,6 +378,7 @@ def _adjacent(model: Any, ga: int, gb: int) -> bool:
 
 def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAMPLES,
                 keyframe: int | None = 0, seed: int = 0, contact_tol: float = CONTACT_TOL,
+                settle: float = SETTLE,
                 progress: Callable[[int, int], None] | None = None) -> ACM:
     """Compute the ACM of ``model`` over the candidate pairs of ``pairs``.
 
@@ -342,6 +390,7 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
             model has fewer keyframes or ``keyframe`` is None).
         seed: RNG seed (the result is deterministic given model, arguments and seed).
         contact_tol: metres; see :data:`CONTACT_TOL`.
+        settle: seconds of passive settling whose contacts are Default (:data:`SETTLE`; 0: none).
         progress: optional ``progress(done, total)`` called per sampled pair batch.
 
     Returns:
@@ -358,6 +407,8 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
     if keyframe is not None and (isinstance(keyframe, bool) or not isinstance(keyframe, int | np.integer)
                                  or keyframe < 0):
         raise InvalidInputError(f"keyframe must be an integer >= 0 or None, got {keyframe!r}")
+    if not (isinstance(settle, int | float) and math.isfinite(settle) and 0 <= settle <= 60):
+        raise InvalidInputError(f"settle must be a number of seconds in [0, 60], got {settle!r}")
     if not (isinstance(contact_tol, int | float) and math.isfinite(contact_tol) and contact_tol >= 0):
         raise InvalidInputError(f"contact_tol must be a finite number >= 0, got {contact_tol!r}")
     scene = Scene.from_model(model, pairs=pairs)
@@ -383,11 +434,16 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
         for pos, rot in ref_poses:
             _, up = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
                                          gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]))
-            hit |= bool(up[0] <= contact_tol)
+            hit |= bool(up[0] <= contact_tol + _pair_margin(model, a, b))
         if hit:
             entries[_key(ga.name, gb.name)] = Reason.DEFAULT
         else:
             rest.append((a, b))
+    if settle > 0 and rest:
+        settled = _settled_contacts(model, geoms, rest, refs[0][0], refs[0][1], settle, contact_tol)
+        for a, b in settled:
+            entries[_key(geoms[a].name, geoms[b].name)] = Reason.DEFAULT
+        rest = [p for p in rest if p not in settled]
     if samples and rest:
         rng = np.random.default_rng(seed)
         pos, rot = _poses(model, [_random_qpos(model, rng) for _ in range(int(samples))])
@@ -395,14 +451,16 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
             ga, gb = geoms[a], geoms[b]
             lo, up = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
                                           gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]))
-            if bool(np.all(up <= contact_tol)):
+            thr = contact_tol + _pair_margin(model, a, b)
+            if bool(np.all(up <= thr)):
                 entries[_key(ga.name, gb.name)] = Reason.ALWAYS
-            elif bool(np.all(lo > contact_tol)):
+            elif bool(np.all(lo > thr)):
                 entries[_key(ga.name, gb.name)] = Reason.NEVER
             if progress is not None:
                 progress(k + 1, len(rest))
     gen = {"pairs": pairs if isinstance(pairs, str) else "list", "samples": int(samples), "seed": int(seed),
-           "keyframe": int(keyframe) if use_key else None, "contact_tol": float(contact_tol)}
+           "keyframe": int(keyframe) if use_key else None, "contact_tol": float(contact_tol),
+           "settle": float(settle)}
     return ACM(entries, scene.model_hash, gen)
 
 
