@@ -378,7 +378,7 @@ def _adjacent(model: Any, ga: int, gb: int) -> bool:
 
 def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAMPLES,
                 keyframe: int | None = 0, seed: int = 0, contact_tol: float = CONTACT_TOL,
-                settle: float = SETTLE,
+                settle: float = SETTLE, reference: np.ndarray | None = None,
                 progress: Callable[[int, int], None] | None = None) -> ACM:
     """Compute the ACM of ``model`` over the candidate pairs of ``pairs``.
 
@@ -391,6 +391,8 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
         seed: RNG seed (the result is deterministic given model, arguments and seed).
         contact_tol: metres; see :data:`CONTACT_TOL`.
         settle: seconds of passive settling whose contacts are Default (:data:`SETTLE`; 0: none).
+        reference: optional (nq,) reference pose replacing keyframe / qpos0 (a gate uses the
+            first state it sees: an env's reset state).
         progress: optional ``progress(done, total)`` called per sampled pair batch.
 
     Returns:
@@ -421,8 +423,13 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
         else:
             todo.append((a, b))
     # Default: keyframe K when the model has it, else qpos0
-    use_key = keyframe is not None and int(keyframe) < int(model.nkey)
-    if use_key:
+    use_key = reference is None and keyframe is not None and int(keyframe) < int(model.nkey)
+    if reference is not None:
+        ref = np.asarray(reference, dtype=np.float64).reshape(-1)
+        if ref.shape != (int(model.nq),) or not np.all(np.isfinite(ref)):
+            raise InvalidInputError(f"reference must be a finite (nq,) = ({model.nq},) qpos")
+        refs = [(None, ref.copy())]
+    elif use_key:
         refs = [(int(keyframe), np.array(model.key_qpos[int(keyframe)], dtype=np.float64))]
     else:
         refs = [(None, np.array(model.qpos0, dtype=np.float64))]
@@ -460,29 +467,34 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
                 progress(k + 1, len(rest))
     gen = {"pairs": pairs if isinstance(pairs, str) else "list", "samples": int(samples), "seed": int(seed),
            "keyframe": int(keyframe) if use_key else None, "contact_tol": float(contact_tol),
-           "settle": float(settle)}
+           "settle": float(settle), "reference": "given" if reference is not None else
+           ("keyframe" if use_key else "qpos0")}
     return ACM(entries, scene.model_hash, gen)
 
 
 _AUTO_CACHE: dict[tuple, ACM] = {}
 
 
-def auto_acm(model: Any, pairs: Any = "mujoco") -> ACM:
+def auto_acm(model: Any, pairs: Any = "mujoco", reference: np.ndarray | None = None) -> ACM:
     """The gate's default ACM, cached per model hash and pairs mode in-process.
 
-    Adjacent + Default (qpos0, keyframe 0) + Always/Never from :data:`AUTO_SAMPLES` seeded samples.
+    Adjacent + Default (``reference`` qpos, else keyframe 0, else qpos0, and its settled
+    state) + Always/Never from :data:`AUTO_SAMPLES` seeded samples.
     """
     from monitor.scene import model_hash
 
     mode = pairs if isinstance(pairs, str) else repr(sorted(map(tuple, pairs)))
-    key = (model_hash(model), mode)
+    ref = None if reference is None else np.asarray(reference, dtype=np.float64).copy()
+    key = (model_hash(model), mode, None if ref is None else ref.tobytes())
     if key not in _AUTO_CACHE:
-        _AUTO_CACHE[key] = compute_acm(model, pairs=pairs, samples=AUTO_SAMPLES, keyframe=0, seed=0)
+        _AUTO_CACHE[key] = compute_acm(model, pairs=pairs, samples=AUTO_SAMPLES, keyframe=0, seed=0,
+                                       reference=ref)
     return _AUTO_CACHE[key]
 
 
 # ---------------------------------------------------------------------- pair policy
-def as_acm(allowed: Any, model: Any, pairs: Any = "mujoco") -> ACM | None:
+def as_acm(allowed: Any, model: Any, pairs: Any = "mujoco", reference: np.ndarray | None = None
+           ) -> ACM | None:
     """Normalise an ``allowed=`` argument to an :class:`ACM` validated against ``model`` (or None).
 
     Accepted: None, ``"auto"`` (:func:`auto_acm`), an :class:`ACM`, a file path (``Path``, or a
@@ -494,7 +506,7 @@ def as_acm(allowed: Any, model: Any, pairs: Any = "mujoco") -> ACM | None:
     if isinstance(allowed, ACM):
         return ACM.from_dict(allowed.to_dict(), names)  # validates names against the model
     if isinstance(allowed, str) and allowed == "auto":
-        return auto_acm(model, pairs)
+        return auto_acm(model, pairs, reference)
     if isinstance(allowed, Path) or (isinstance(allowed, str) and allowed.endswith(".json")):
         acm = ACM.load(allowed, names)
         from monitor.scene import model_hash
@@ -528,7 +540,7 @@ class PairPolicy:
 
 
 def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, allowed: Any = None,
-                 hazards: Any = None, allow: Any = None) -> PairPolicy:
+                 hazards: Any = None, allow: Any = None, reference: np.ndarray | None = None) -> PairPolicy:
     """Split candidate pairs into monitored and allowed (see :mod:`monitor.pairsel`).
 
     Args:
@@ -538,13 +550,14 @@ def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, all
         allowed: see :func:`as_acm`.
         hazards: None (every candidate) or pattern items selecting the checked pairs.
         allow: pattern items whose pairs are allowed with reason User.
+        reference: reference qpos for ``allowed="auto"`` (see :func:`auto_acm`).
 
     Returns:
         the :class:`PairPolicy`.
     """
     names = ModelNames.from_model(model)
     pair_ids = np.asarray(pair_ids, dtype=np.int64).reshape(-1, 2)
-    acm = as_acm(allowed, model, pairs)
+    acm = as_acm(allowed, model, pairs, reference)
     keep = np.ones(len(pair_ids), dtype=bool)
     not_hazard = 0
     if hazards is not None:

@@ -360,8 +360,10 @@ class Gate:
         log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
             ``log`` is a path (e.g. ``env_id``, ``model_source``).
         allowed: allowed-contact matrix (:func:`monitor.acm.as_acm`). Default ``"auto"``:
-            computed from the model at construction (Adjacent + Default in qpos0 /
-            keyframe 0 + Always from a small seeded sample, cached per model hash);
+            computed from the model when the scene is first needed (Adjacent + Default in
+            the reference pose: the first state the gate sees, i.e. ``data.qpos`` at the first
+            :meth:`decide` or an env's first reset, and its settled state + Always from a
+            small seeded sample; cached per model hash and reference);
             None checks every candidate pair. Allowed pairs are never gated and are
             listed in every certificate with their reasons.
         hazards: None (every candidate pair) or pattern items (:mod:`monitor.pairsel`)
@@ -403,6 +405,7 @@ class Gate:
         _make_budget(budget)  # validate early
         self.penetration_tol = check_rule(ongoing, penetration_tol)
         self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
+        self.reference_qpos: np.ndarray | None = None  # allowed="auto": Default's reference pose
         self.model = model
         self.pairs = pairs
         self.margin = float(margin)
@@ -441,7 +444,8 @@ class Gate:
             from monitor.scene import Scene
 
             self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances,
-                                           allowed=self.allowed, hazards=self.hazards, allow=self.allow)
+                                           allowed=self.allowed, hazards=self.hazards, allow=self.allow,
+                                           reference=self.reference_qpos)
             announce(self)  # issue 13: say what is monitored; warn once when nothing is
         return self._scene
 
@@ -632,6 +636,8 @@ class Gate:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
         t_win = float(data.time)
+        if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
+            self.reference_qpos = np.array(data.qpos)
         plan = predict(ctrl)
         cert, us = self._certify(plan)
         unsafe = self.is_unsafe(cert.verdict)

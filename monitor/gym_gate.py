@@ -21,11 +21,11 @@ decision into an ``env.step`` call, and reports in ``info``:
 
 Defaults that work on stock envs: the pairs checked are MuJoCo's candidate pairs
 minus the allowed-contact matrix computed from the model at construction
-(``allowed="auto"``, :mod:`monitor.acm`), and contacts already present when a
-window starts may deepen up to ``penetration_tol`` (``ongoing="deepen"``,
-:mod:`monitor.certify.ongoing`); every new contact is checked at full margin.
-``SafetyGate.describe()`` says what is monitored (also logged at construction; a
-gate that checks nothing warns once).
+(``allowed="auto"``, :mod:`monitor.acm`; its reference pose is the state after the
+first ``reset``), and contacts already present when a window starts may deepen up to
+``penetration_tol`` (``ongoing="deepen"``, :mod:`monitor.certify.ongoing`); every new
+contact is checked at full margin. ``SafetyGate.describe()`` says what is monitored
+(also logged at the first reset; a gate that checks nothing warns once).
 
 The action is assumed to be written to ``data.ctrl`` by the env (what
 gymnasium's ``MujocoEnv.do_simulation`` does) when ``predictor="rollout"``.
@@ -123,7 +123,6 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
                          allowed=allowed, hazards=hazards, allow=allow, ongoing=ongoing,
                          penetration_tol=penetration_tol)
-        self.gate.scene  # noqa: B018 - builds the scene and ACM now: says what is monitored
         self._obs: Any = None
 
     def describe(self) -> str:
@@ -179,6 +178,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         """Reset the wrapped env; ``info["safety"]`` has the same keys with verdict ``""``."""
         obs, info = self.env.reset(seed=seed, options=options)
         self.gate.reset()
+        if self.gate._scene is None and self.gate.reference_qpos is None:
+            # issue 13: the first reset state is the ACM's reference pose (scene built and announced now)
+            self.gate.reference_qpos = np.array(self.env.unwrapped.data.qpos)
         self._obs = obs
         info = dict(info)
         info["safety"] = safety_info(None, verdict="", applied_verdict="", replaced=False,

@@ -210,7 +210,7 @@ class Scene:
     @classmethod
     def from_model(cls, model: Any, pairs: str | Iterable[tuple[str | int, str | int]] = "mujoco",
                    *, facets: int | None = None, tolerances: Tolerances = DEFAULT, allowed: Any = None,
-                   hazards: Any = None, allow: Any = None) -> Scene:
+                   hazards: Any = None, allow: Any = None, reference: Any = None) -> Scene:
         """Read every geom of ``model`` and select the candidate pairs.
 
         Args:
@@ -228,6 +228,7 @@ class Scene:
             hazards: None, or pattern items (:mod:`monitor.pairsel`) selecting the
                 candidate pairs that are checked.
             allow: pattern items whose candidate pairs are allowed (reason User).
+            reference: (nq,) reference pose for ``allowed="auto"`` (default keyframe 0 / qpos0).
 
         Returns:
             The scene.
@@ -262,7 +263,8 @@ class Scene:
         if allowed is not None or hazards is not None or allow is not None:  # issue 13: pair policy
             from monitor.acm import apply_policy
 
-            policy = apply_policy(model, pair_ids, pairs, allowed=allowed, hazards=hazards, allow=allow)
+            policy = apply_policy(model, pair_ids, pairs, allowed=allowed, hazards=hazards, allow=allow,
+                                  reference=reference)
             pair_ids, allowed_rows = policy.monitored, policy.allowed
         types = np.asarray(model.geom_type, dtype=np.int64)
         if len(pair_ids):

@@ -60,8 +60,8 @@ def _run(env_id: str, steps: int = STEPS) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = SafetyGate(gym.make(env_id))
-    assert env.describe().startswith("monitor.Gate:")
     env.reset(seed=0)
+    assert env.describe().startswith("monitor.Gate:")
     env.action_space.seed(0)
     blocked, reasons, cost = 0, {}, 0.0
     for _ in range(steps):
@@ -96,6 +96,7 @@ def test_defaults_never_block_everything_heavy(env_id):
 
 def test_pusher_defaults_allow_the_resting_object_and_check_the_arm():
     env = SafetyGate(gym.make("Pusher-v5"))
+    env.reset(seed=0)
     allowed = {(a, b): r for a, b, r in env.gate.scene.allowed_pairs}
     assert allowed == {("table", "geom18"): "Default"}  # object/0 rests on the table
     assert ("table", "geom13") in env.gate.scene.candidate_pairs
@@ -103,11 +104,12 @@ def test_pusher_defaults_allow_the_resting_object_and_check_the_arm():
 
 
 def test_gate_with_nothing_to_check_warns_once():
+    env = SafetyGate(gym.make("Reacher-v5"))
     with pytest.warns(UserWarning, match="checks NOTHING"):
-        env = SafetyGate(gym.make("Reacher-v5"))
+        env.reset(seed=0)  # the pair policy is resolved at the first reset
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        env.reset(seed=0)
+        env.reset(seed=1)
         env.step(env.action_space.sample())
         env.gate._scene = None  # rebuilding the scene does not warn again
         env.gate.scene  # noqa: B018
@@ -118,9 +120,23 @@ def test_gate_with_nothing_to_check_warns_once():
 def test_ant_feet_rest_allowed_torso_floor_checked():
     """Ant: feet on the floor are allowed (Default); the torso hitting the floor is still checked."""
     env = SafetyGate(gym.make("Ant-v5"))
+    env.reset(seed=0)
     allowed = {(a, b) for a, b, _ in env.gate.scene.allowed_pairs}
     assert ("floor", "torso_geom") not in allowed
     assert ("floor", "torso_geom") in env.gate.scene.candidate_pairs
     assert {("floor", f) for f in ("left_ankle_geom", "right_ankle_geom", "third_ankle_geom",
                                    "fourth_ankle_geom")} == allowed
+    env.close()
+
+
+def test_default_reference_is_the_reset_state_not_qpos0():
+    """AGV: at qpos0 the tray plate touches the crate (a designed-away pose the env never visits);
+    the gate's ACM uses the first reset state, so that pair stays checked (regression)."""
+    pytest.importorskip("envs")
+    import envs  # noqa: F401
+
+    env = SafetyGate(gym.make("monitor/AGV-v0", schedule="straight"), predictor="plan")
+    env.reset(seed=0)
+    assert ("plate1", "crate_top") not in {tuple(sorted(p[:2])) for p in env.gate.scene.allowed_pairs}
+    assert ("crate_top", "plate1") in env.gate.scene.candidate_pairs
     env.close()
