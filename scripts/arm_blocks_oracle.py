@@ -35,18 +35,20 @@ from monitor.motion.plan import Plan
 _FULL = mujoco.mjtState.mjSTATE_INTEGRATION  # as the gate's rollout: includes ctrl, warm start
 
 
-def _min_distance(scene, plan) -> float:
-    """Minimum exact distance (upper bound) over monitored pairs at dense instants of ``plan``."""
+def _min_distance(scene, plan) -> tuple[float, tuple[str, str]]:
+    """(min exact distance (upper bound) over monitored pairs at dense instants of ``plan``, its pair)."""
     k = len(plan.times)
     ts = np.unique(np.concatenate([np.linspace(plan.times[i], plan.times[i + 1], 9) for i in range(k - 1)]))
     pos, rot = plan.body_poses(ts)
-    best = np.inf
+    best, which = np.inf, ("", "")
     for a, b in scene.pair_ids.tolist():
         ga, gb = scene.geoms[a], scene.geoms[b]
         _, up = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
                                      gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]))
-        best = min(best, float((up + ga.shape.approx_error + gb.shape.approx_error).min()))
-    return best
+        v = float((up + ga.shape.approx_error + gb.shape.approx_error).min())
+        if v < best:
+            best, which = v, (ga.name, gb.name)
+    return best, which
 
 
 def _oracle(model, data, action, nstep, brake_steps):
@@ -95,8 +97,8 @@ def main() -> None:
         s = info["safety"]
         if s["intervened"]:
             win, tail = _oracle(m, pre, np.asarray(action, float), gate.frame_skip, gate.brake_steps)
-            rows.append((s["block_reason"], policy.aim, _min_distance(gate.scene, win),
-                         _min_distance(gate.scene, tail)))
+            (dw, _), (dt, pt) = _min_distance(gate.scene, win), _min_distance(gate.scene, tail)
+            rows.append((s["block_reason"], policy.aim, dw, dt, pt))
         if term or trunc:
             obs, _ = gated.reset()
     gated.close()
@@ -109,6 +111,11 @@ def main() -> None:
         col = sum(1 for r in rows if r[k] < 0.0)
         close = sum(1 for r in rows if r[k] < args.margin)
         print(f"  {label:<22}: collides {col}/{n}, closer than the margin {close}/{n}")
+    print(f"  closest pair in window + tail (blocks): {dict(Counter(r[4] for r in rows))}")
+    free = [r for r in rows if r[1] == "free"]
+    print(f"  blocks while aiming at free space: {len(free)}; of them window+tail < margin "
+          f"{sum(r[3] < args.margin for r in free)}, collides {sum(r[3] < 0 for r in free)}; "
+          f"closest pairs {dict(Counter(r[4] for r in free))}")
     for reason in sorted({r[0] for r in rows}):
         sub = [r for r in rows if r[0] == reason]
         print(f"    {reason}: window < margin {sum(r[2] < args.margin for r in sub)}/{len(sub)}, "
