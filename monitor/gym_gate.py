@@ -20,9 +20,10 @@ decision into an ``env.step`` call, and reports in ``info``:
   confirmed violation on a monitored (hazard) pair, else 0.0.
 
 Defaults that work on stock envs: the pairs checked are MuJoCo's candidate pairs
-minus the allowed-contact matrix computed from the model at construction
-(``allowed="auto"``, :mod:`monitor.acm`; its reference pose is the state after the
-first ``reset``), and contacts already present when a window starts may deepen up to
+minus the allowed-contact matrix computed from the model at the first ``reset``
+(``allowed="auto"``, :mod:`monitor.acm`; its reference pose is the state after that
+reset, so resting contacts of the env's real start state are Default, not those of
+``qpos0``), and contacts already present when a window starts may deepen up to
 ``penetration_tol`` (``ongoing="deepen"``, :mod:`monitor.certify.ongoing`); every new
 contact is checked at full margin. ``SafetyGate.describe()`` says what is monitored
 (also logged at the first reset; a gate that checks nothing warns once).
