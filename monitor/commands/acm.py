@@ -86,6 +86,32 @@ def load_model(spec: str) -> tuple[Any, str]:
                             "or env id")
 
 
+def reset_qpos(spec: str) -> Any:
+    """The qpos after ``env.reset(seed=0)`` when ``spec`` is a Gymnasium env id, else None.
+
+    That is the reference pose a :class:`monitor.SafetyGate` uses for its default ACM.
+    """
+    import warnings
+
+    from monitor._paths import scene_path
+
+    if Path(spec).is_file() or "-v" not in spec:
+        return None
+    try:
+        scene_path(spec)
+        return None
+    except (FileNotFoundError, OSError):
+        pass
+    import gymnasium as gym
+    import numpy as np
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make(spec)
+        env.reset(seed=0)
+    return np.array(env.unwrapped.data.qpos)
+
+
 def run(args: argparse.Namespace) -> int:
     """Compute and write the ACM; returns the exit code."""
     from monitor.acm import DEFAULT_SAMPLES, compute_acm

@@ -10,7 +10,9 @@ allowed-contact matrix and ``--allow``). Patterns (:mod:`monitor.pairsel`):
   group:3       MuJoCo geom group 3
   A:B           (for --hazards/--allow) pairs with one geom in A and the other in B
 
-``--acm auto`` (default) computes the gate's default matrix (32 samples);
+``--acm auto`` (default) computes the gate's default matrix (32 samples; reference pose:
+the env's state after ``reset(seed=0)`` for an env id, as a SafetyGate does, else keyframe 0
+or qpos0);
 ``--acm FILE`` reads one written by ``python -m monitor acm``; ``--acm none``
 checks every candidate pair. MODEL is an MJCF path, a shipped scene name or a
 Gymnasium env id.
@@ -50,7 +52,7 @@ def _items(xs: list[str] | None) -> list | None:
 def run(args: argparse.Namespace) -> int:
     """Resolve and print the pair set; returns the exit code."""
     from monitor.acm import apply_policy, describe
-    from monitor.commands.acm import load_model
+    from monitor.commands.acm import load_model, reset_qpos
     from monitor.errors import MonitorError
     from monitor.pairsel import ModelNames
     from monitor.scene import Scene
@@ -63,8 +65,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         model, desc = load_model(args.model)
         scene = Scene.from_model(model, pairs=args.pairs)
+        ref = reset_qpos(args.model) if allowed == "auto" else None
         policy = apply_policy(model, scene.pair_ids, args.pairs, allowed=allowed,
-                              hazards=_items(args.hazards), allow=_items(args.allow))
+                              hazards=_items(args.hazards), allow=_items(args.allow), reference=ref)
     except MonitorError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
