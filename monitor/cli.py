@@ -1,4 +1,4 @@
-"""Command line: ``monitor {demo,review,bench,certify} ...`` (also ``python -m monitor ...``).
+"""Command line: ``monitor {demo,review,bench,certify,acm,pairs} ...`` (also ``python -m monitor ...``).
 
 Each subcommand lives in ``monitor/commands/<name>.py`` and exposes
 ``add_parser(subparsers)`` and ``run(args) -> int``. They are imported lazily so
@@ -19,6 +19,8 @@ SUBCOMMANDS = {
     "review": "Summarise, re-verify and report MCAP certificate logs.",
     "bench": "Benchmarks: run time against error, peers, scaling, gate overhead.",
     "certify": "Certify a library of plans from an .npz file.",
+    "acm": "Compute a model's allowed-contact matrix (JSON file).",
+    "pairs": "Print the pairs a gate will check, and the allowed ones with reasons.",
 }
 
 _ROLE = re.compile(r":(?:func|class|meth|mod|data|attr|obj|exc|ref):`~?([^`]+)`")

@@ -61,7 +61,9 @@ import mujoco
 import numpy as np
 
 from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
 from monitor.errors import InvalidInputError
+from monitor.gate_policy import announce, applied_cost, block_reason, describe_gate, safety_keys
 from monitor.tolerances import DEFAULT, Tolerances
 
 _LOG = logging.getLogger("monitor.gate")
@@ -233,8 +235,17 @@ class StepReport:
 
     @property
     def cost(self) -> float:
-        """1.0 when the proposed window has a confirmed violation, else 0.0 (safety-gymnasium)."""
-        return 1.0 if self.verdict == "violation" else 0.0
+        """1.0 when the APPLIED window has a confirmed violation, else 0.0.
+
+        safety-gymnasium's convention: the cost of the transition that happened; the
+        proposal's own cost is ``info()["proposal_cost"]``.
+        """
+        return applied_cost(self)
+
+    @property
+    def block_reason(self) -> str:
+        """Why the proposal was replaced (``""`` if not); see :mod:`monitor.gate_policy`."""
+        return block_reason(self)
 
     def info(self, *, timing: bool = False) -> dict[str, Any]:
         """Fixed-shape summary for ``info["safety"]`` (stackable by vector envs).
@@ -253,13 +264,14 @@ class StepReport:
             witness_time (float s), witness_geoms ((2,) object array of str), witness_point ((3,) m),
             earliest_time (float s), clearance (float m), replaced (bool),
             fallback_certified (bool), terminated (bool), time (float s), monitored_pairs (int:
-            candidate pairs checked, 0 when the gate monitors nothing)
-            and, if ``timing``, certify_us (float µs).
+            candidate pairs checked, 0 when the gate monitors nothing),
+            version (int), proposal_cost (float), intervened (bool), block_reason (str)
+            (:mod:`monitor.gate_policy`) and, if ``timing``, certify_us (float µs).
         """
-        return safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
-                           replaced=self.replaced, fallback_certified=self.fallback_certified,
-                           terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
-                           certify_us=self.certify_us if timing else None)
+        return {**safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
+                              replaced=self.replaced, fallback_certified=self.fallback_certified,
+                              terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
+                              certify_us=self.certify_us if timing else None), **safety_keys(self)}
 
 
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
@@ -353,6 +365,21 @@ def _budget_tests(tests: Any) -> int | None:
     return int(tests)
 
 
+def _no_candidate_pairs(model: mujoco.MjModel, pairs: Any) -> bool:
+    """True when ``pairs`` ("mujoco"/"all") selects no geom pair before any allowed-contact matrix.
+
+    MuJoCo's own filter only: no shapes are built. Explicit lists are validated by the scene.
+    """
+    if not isinstance(pairs, str):
+        return False
+    from monitor.scene import _filter_pairs
+
+    try:
+        return len(_filter_pairs(model, pairs)) == 0
+    except Exception:  # noqa: BLE001 - an unknown mode is reported by Scene.from_model, with its name
+        return False
+
+
 def _check_log(log: Any) -> None:
     """``log`` must be None, a path or an object with ``write_window`` (a MonitorLog)."""
     if isinstance(log, (str, os.PathLike)):
@@ -426,12 +453,29 @@ class Gate:
         tolerances: numerical tolerances.
         log_options: extra keyword arguments for :class:`monitor.log.MonitorLog` when
             ``log`` is a path (e.g. ``env_id``, ``model_source``).
+        allowed: allowed-contact matrix (:func:`monitor.acm.as_acm`). Default ``"auto"``:
+            computed from the model when the scene is first needed (Adjacent + Default in
+            the reference pose: the first state the gate sees, i.e. ``data.qpos`` at the first
+            :meth:`decide` or an env's first reset, and its settled state + Always from a
+            small seeded sample; cached per model hash and reference);
+            None checks every candidate pair. Allowed pairs are never gated and are
+            listed in every certificate with their reasons.
+        hazards: None (every candidate pair) or pattern items (:mod:`monitor.pairsel`)
+            selecting the checked pairs.
+        allow: pattern items whose pairs are allowed (reason User).
+        ongoing: ``"deepen"`` (default: a pair already in contact at the window start
+            may not deepen beyond ``penetration_tol``; every other pair keeps the full
+            margin, see :mod:`monitor.certify.ongoing`) or ``"violation"`` (plain
+            certify: such a pair is a violation).
+        penetration_tol: metres (default 5 mm), see ``ongoing``.
         action_shape: shape of the actions :meth:`decide` receives, against which an
             array ``fallback`` is checked (default ``(nu,)``: the action is the control).
 
     ``margin``, ``epsilon`` and ``tolerances`` may be reassigned (validated; the reuse
-    cache is keyed on them). The scene is built at construction; a gate with no
-    candidate pairs warns (``UserWarning``) once, at construction, since it checks nothing.
+    cache is keyed on them). A gate whose model has no candidate pairs under
+    ``pairs`` warns (``UserWarning``) once, at construction, since it checks nothing; the scene
+    itself is built at the first decision (``allowed="auto"`` needs the first state as its
+    reference pose), and then warns once more if the allowed-contact matrix left nothing.
 
     Raises:
         InvalidInputError: on an unknown option, a bad ``log``, ``fallback``, ``budget`` or
@@ -445,7 +489,9 @@ class Gate:
                  reuse: bool = True, brake: bool = True, brake_horizon: float = 0.25,
                  brake_vel_tol: float = 1e-3, tolerances: Tolerances = DEFAULT,
                  log_options: dict[str, Any] | None = None,
-                 action_shape: tuple[int, ...] | None = None) -> None:
+                 action_shape: tuple[int, ...] | None = None, allowed: Any = "auto", hazards: Any = None,
+                 allow: Any = None, ongoing: str = "deepen",
+                 penetration_tol: float = DEFAULT_PENETRATION_TOL) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidInputError(f"Gate needs a mujoco.MjModel, got {type(model).__name__}")
         if on_violation not in ON_VIOLATION:
@@ -461,6 +507,9 @@ class Gate:
         self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._cache_context: tuple[Any, ...] | None = None
         self._scene_builds = 0
+        self.penetration_tol = check_rule(ongoing, penetration_tol)
+        self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
+        self.reference_qpos: np.ndarray | None = None  # allowed="auto": Default's reference pose
         self.model = model
         self.pairs = pairs
         self.margin = margin
@@ -494,7 +543,8 @@ class Gate:
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
                       "reused_pairs": 0, "pairs": 0}
         self._warned = False
-        if not self.scene.candidate_pairs:
+        if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
+            self._warned_empty = True
             where = self._log_options.get("env_id") or _model_name(model) or "the model"
             warnings.warn(
                 f"monitor.Gate on {where}: no candidate pairs to check under pairs={pairs!r}, so every "
@@ -539,7 +589,8 @@ class Gate:
     def _reuse_context(self) -> tuple[Any, ...]:
         """Everything a reused pair result depends on besides the two bodies' poses."""
         version = getattr(self.scene, "version", 0)
-        return (self._margin, self._epsilon, self._tolerances, self._scene_builds, version)
+        return (self._margin, self._epsilon, self._tolerances, self._scene_builds, version, self.ongoing,
+                self.penetration_tol)
 
     def _sync_scene(self) -> None:
         """Re-read the live model into the scene (``Scene.sync``, when the scene has it)."""
@@ -554,9 +605,16 @@ class Gate:
         if self._scene is None:
             from monitor.scene import Scene
 
-            self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances)
+            self._scene = Scene.from_model(self.model, pairs=self.pairs, tolerances=self.tolerances,
+                                           allowed=self.allowed, hazards=self.hazards, allow=self.allow,
+                                           reference=self.reference_qpos)
             self._scene_builds += 1
+            announce(self)  # issue 13: say what is monitored; warn once when nothing is
         return self._scene
+
+    def describe(self) -> str:
+        """One line: pairs monitored, pairs allowed by reason, the ongoing-contact rule."""
+        return describe_gate(self)
 
     @property
     def npairs(self) -> int:
@@ -584,7 +642,8 @@ class Gate:
         todo, reused, keys = self._split_reuse(scene, plan)
         if todo is None:  # nothing reusable: one plain call
             cert = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                           budget=_make_budget(self.budget), tolerances=self.tolerances)
+                           budget=_make_budget(self.budget), tolerances=self.tolerances,
+                           ongoing=self.ongoing, penetration_tol=self.penetration_tol)
         else:
             cert = self._certify_subset(certify, scene, plan, todo, reused)
         if self.reuse:
@@ -630,7 +689,8 @@ class Gate:
         if todo:
             names = [scene.candidate_pairs[i] for i in todo]
             fresh = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names)
+                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names,
+                            ongoing=self.ongoing, penetration_tol=self.penetration_tol)
             by_geoms = {p.geoms: p for p in fresh.pairs}
             fresh_pairs = [by_geoms[tuple(scene.candidate_pairs[i])] for i in todo]
         else:
@@ -646,9 +706,10 @@ class Gate:
         stats["pairs"] = len(pairs)
         if fresh is None:
             return Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
-                               clearance, pairs, stats)
+                               clearance, pairs, stats, scene.allowed_pairs)
         return Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method, fresh.witness,
-                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats)
+                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats,
+                           scene.allowed_pairs)
 
     def _remember(self, cert: Certificate, keys: dict[int, bytes]) -> None:
         for i, key in keys.items():
@@ -675,9 +736,13 @@ class Gate:
         return np.asarray(fb, dtype=np.float64)
 
     def reset(self) -> None:
-        """Forget the committed brake (call when the caller's state is reset)."""
+        """Forget the committed brake; the log starts a new episode (call when the state is reset)."""
         self._committed = None
         self._tail = None
+        if self._log is not None and not getattr(self._log, "closed", False):
+            new_episode = getattr(self._log, "new_episode", None)
+            if callable(new_episode):
+                new_episode()
 
     def _tail_covers(self, data: mujoco.MjData, n: int) -> Certificate | None:
         """The committed tail's certificate if it contains the next ``n`` substeps.
@@ -746,6 +811,8 @@ class Gate:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
         t_win = float(data.time)
+        if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
+            self.reference_qpos = np.array(data.qpos)
         plan = predict(ctrl)
         cert, us = self._certify(plan)
         unsafe = self.is_unsafe(cert.verdict)
@@ -876,10 +943,12 @@ class Gate:
         log = self._open_log()
         if log is None:
             return
-        log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, r.replaced)
+        why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
+        log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, r.replaced,
+                         reason=why)
         if r.replaced and not r.fallback_certified and r.fallback_certificate is not None:
             log.write_window(r.time, applied_plan, r.fallback_certificate, r.applied_ctrl,
-                             r.applied_ctrl, True)
+                             r.applied_ctrl, True, reason=why)
 
     def close(self) -> None:
         """Finish the log if the gate opened it."""

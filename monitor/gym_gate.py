@@ -4,10 +4,29 @@
 the ``MjModel``/``MjData`` through ``env.unwrapped``, turns the gate's
 decision into an ``env.step`` call, and reports in ``info``:
 
-* ``info["safety"]``: the fixed-shape dict of :meth:`monitor.gate.StepReport.info`
-  (verdict, checker per pair, witness, earliest time, clearance, replaced, ...).
-* ``info["cost"]``: 1.0 when the proposed action's window has a confirmed
-  violation, else 0.0 (safety-gymnasium's convention in the 5-tuple API).
+* ``info["safety"]`` (an API, layout version ``info["safety"]["version"]`` = 2,
+  :data:`monitor.gate_policy.SAFETY_INFO_VERSION`): the fixed-shape dict of
+  :meth:`monitor.gate.StepReport.info` (verdict, checker per pair, witness, earliest
+  time, clearance, replaced, ...), plus
+
+  - ``proposal_cost``: 1.0 when the *proposed* action's window has a confirmed
+    violation on a monitored pair (blocked or not), else 0.0;
+  - ``intervened``: True when the proposed action was replaced;
+  - ``block_reason``: ``""`` or, comma-joined, ``"proposal_violation"`` |
+    ``"proposal_uncertain"`` | ``"brake_tail_uncertified"``, then
+    ``"fallback_uncertain"`` when the replacement did not certify either.
+* ``info["cost"]``: the cost of the transition that happened (safety-gymnasium's
+  convention in the 5-tuple API): 1.0 when the *applied* action's window has a
+  confirmed violation on a monitored (hazard) pair, else 0.0.
+
+Defaults that work on stock envs: the pairs checked are MuJoCo's candidate pairs
+minus the allowed-contact matrix computed from the model at the first ``reset``
+(``allowed="auto"``, :mod:`monitor.acm`; its reference pose is the state after that
+reset, so resting contacts of the env's real start state are Default, not those of
+``qpos0``), and contacts already present when a window starts may deepen up to
+``penetration_tol`` (``ongoing="deepen"``, :mod:`monitor.certify.ongoing`); every new
+contact is checked at full margin. ``SafetyGate.describe()`` says what is monitored
+(also logged at the first reset; a gate that checks nothing warns once).
 
 Wrappers between the gate and the MuJoCo env. The gate predicts the control the
 env will actually apply: it walks the chain from the wrapped env down to
@@ -41,8 +60,10 @@ import gymnasium
 import mujoco
 import numpy as np
 
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL
 from monitor.errors import InvalidInputError
 from monitor.gate import Gate, StepReport, safety_info
+from monitor.gate_policy import safety_keys
 
 _W = gymnasium.wrappers
 _PASS_THROUGH_STEPS = frozenset({
@@ -126,6 +147,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             gymnasium's step-determinism check in ``check_env``; the time is always
             in ``gate.last_report.certify_us`` and ``gate.summary()``.
         brake: recoverability check with a committed brake (see :class:`monitor.Gate`).
+        allowed, hazards, allow, ongoing, penetration_tol: pair policy and the
+            ongoing-contact rule, see :class:`monitor.Gate` (defaults ``"auto"``, None,
+            None, ``"deepen"``, 0.005 m).
 
     Raises:
         InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data, an option is invalid,
@@ -136,11 +160,14 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     def __init__(self, env: gymnasium.Env, *, predictor: str | Callable[..., Any] = "rollout",
                  pairs: Any = "mujoco", margin: float = 0.0, epsilon: float = 1e-3,
                  on_violation: str = "block", fallback: Any = None, budget: Any = None, log: Any = None,
-                 unsafe: str = "uncertain", timing: bool = False, brake: bool = True) -> None:
+                 unsafe: str = "uncertain", timing: bool = False, brake: bool = True,
+                 allowed: Any = "auto", hazards: Any = None, allow: Any = None, ongoing: str = "deepen",
+                 penetration_tol: float = DEFAULT_PENETRATION_TOL) -> None:
         gymnasium.utils.RecordConstructorArgs.__init__(
             self, predictor=predictor, pairs=pairs, margin=margin, epsilon=epsilon,
             on_violation=on_violation, fallback=fallback, budget=budget, log=log, unsafe=unsafe,
-            timing=timing, brake=brake)
+            timing=timing, brake=brake, allowed=allowed, hazards=hazards, allow=allow, ongoing=ongoing,
+            penetration_tol=penetration_tol)
         gymnasium.Wrapper.__init__(self, env)
         u = env.unwrapped
         model, data = getattr(u, "model", None), getattr(u, "data", None)
@@ -184,9 +211,14 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          on_violation=on_violation, unsafe=unsafe, budget=budget, log=log,
                          fallback=gate_fallback, brake=brake,
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
-                         action_shape=inner_shape)
+                         action_shape=inner_shape, allowed=allowed, hazards=hazards, allow=allow,
+                         ongoing=ongoing, penetration_tol=penetration_tol)
         self._unwrapped = u
         self._obs: Any = None
+
+    def describe(self) -> str:
+        """What the gate monitors (pairs, allowed pairs by reason, ongoing-contact rule)."""
+        return self.gate.describe()
 
     # ----------------------------------------------------------------- helpers
     @staticmethod
@@ -314,7 +346,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)
-        info["cost"] = report.cost
+        info["cost"] = report.cost  # the applied window's (monitor.gate_policy)
         return obs, reward, bool(terminated or report.terminated), truncated, info
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -322,12 +354,16 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         """Reset the wrapped env; ``info["safety"]`` has the same keys with verdict ``""``."""
         obs, info = self.env.reset(seed=seed, options=options)
         self.gate.reset()
+        if self.gate._scene is None and self.gate.reference_qpos is None:
+            # issue 13: the first reset state is the ACM's reference pose (scene built and announced now)
+            self.gate.reference_qpos = np.array(self.env.unwrapped.data.qpos)
         self._obs = obs
         info = dict(info)
         info["safety"] = safety_info(None, verdict="", applied_verdict="", replaced=False,
                                      fallback_certified=True, terminated=False,
                                      time=float(self.env.unwrapped.data.time),
                                      certify_us=0.0 if self.timing else None, npairs=self.gate.npairs)
+        info["safety"].update(safety_keys(None))
         info["cost"] = 0.0
         return obs, info
 

@@ -250,7 +250,11 @@ class Scene:
         tolerances: the :class:`Tolerances` used.
         version: 0 at construction, +1 each time :meth:`sync` rebuilt the scene after an
             in-place edit of the model.
+        allowed_pairs: ((geom_a, geom_b, reason), ...) candidate pairs removed by the
+            ACM / ``allow=`` (never certified; listed in every certificate).
     """
+
+    allowed_pairs: tuple[tuple[str, str, str], ...] = ()
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
@@ -269,6 +273,7 @@ class Scene:
         self._by_name = {g.name: g for g in geoms}
         self.version = 0
         self._pairs_spec: Any = "mujoco"  # set by from_model: the pairs argument, for rebuilds
+        self._acm_spec: dict[str, Any] = {}  # set by from_model: allowed/hazards/allow/reference
         # a scene built by hand without an MjModel (tests, pure-geometry use) has nothing to watch
         self._snapshot = _Snapshot(model) if model is not None else None
 
@@ -300,7 +305,7 @@ class Scene:
         what = ", ".join(changed)
         try:
             fresh = Scene.from_model(self.model, pairs=self._pairs_spec, facets=self.facets,
-                                     tolerances=self.tolerances)
+                                     tolerances=self.tolerances, **self._acm_spec)
         except (InvalidInputError, UnsupportedGeometryError) as exc:
             raise ModelMismatchError(f"the scene's MjModel was edited in place ({what}) and the scene "
                                      f"cannot be rebuilt: {exc}") from exc
@@ -309,6 +314,7 @@ class Scene:
         self.body_names = fresh.body_names
         self.body_static = fresh.body_static
         self.approximations = fresh.approximations
+        self.allowed_pairs = fresh.allowed_pairs
         self._by_name = fresh._by_name
         self._snapshot = fresh._snapshot
         for cached in ("candidate_pairs", "model_hash"):
@@ -320,7 +326,8 @@ class Scene:
 
     @classmethod
     def from_model(cls, model: Any, pairs: str | Iterable[tuple[str | int, str | int]] = "mujoco",
-                   *, facets: int | None = None, tolerances: Tolerances = DEFAULT) -> Scene:
+                   *, facets: int | None = None, tolerances: Tolerances = DEFAULT, allowed: Any = None,
+                   hazards: Any = None, allow: Any = None, reference: Any = None) -> Scene:
         """Read every geom of ``model`` and select the candidate pairs.
 
         Args:
@@ -331,6 +338,14 @@ class Scene:
             facets: facet count of circumscribed cylinders/ellipsoids (>= 3);
                 default ``tolerances.facets`` (16).
             tolerances: numerical tolerances.
+            allowed: allowed-contact matrix (:func:`monitor.acm.as_acm`: None, ``"auto"``,
+                an :class:`monitor.acm.ACM`, a ``.json`` path or a list of pairs); its
+                pairs (except reason Never) are removed from the candidates and listed
+                in :attr:`allowed_pairs` with their reasons.
+            hazards: None, or pattern items (:mod:`monitor.pairsel`) selecting the
+                candidate pairs that are checked.
+            allow: pattern items whose candidate pairs are allowed (reason User).
+            reference: (nq,) reference pose for ``allowed="auto"`` (default keyframe 0 / qpos0).
 
         Returns:
             The scene.
@@ -374,6 +389,13 @@ class Scene:
                 seen[nm] = g
 
         pair_ids = cls._select_pairs(model, pairs, names)
+        allowed_rows: tuple[tuple[str, str, str], ...] = ()
+        if allowed is not None or hazards is not None or allow is not None:  # issue 13: pair policy
+            from monitor.acm import apply_policy
+
+            policy = apply_policy(model, pair_ids, pairs, allowed=allowed, hazards=hazards, allow=allow,
+                                  reference=reference)
+            pair_ids, allowed_rows = policy.monitored, policy.allowed
         types = np.asarray(model.geom_type, dtype=np.int64)
         if len(pair_ids):
             in_pair = np.unique(pair_ids.ravel())
@@ -409,6 +431,8 @@ class Scene:
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
         scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
         scene._pairs_spec = pairs
+        scene._acm_spec = {"allowed": allowed, "hazards": hazards, "allow": allow, "reference": reference}
+        scene.allowed_pairs = allowed_rows
         return scene
 
     @staticmethod

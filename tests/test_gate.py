@@ -145,7 +145,10 @@ def test_policies(mode):
     info = r.info()
     assert info["verdict"] == "violation" and info["replaced"] == (mode != "warn")
     assert info["witness_geoms"].tolist() == ["a", "b"] and info["witness_point"].shape == (3,)
-    assert r.cost == 1.0
+    # issue 13: info["cost"] is the applied window's; the proposal's is proposal_cost
+    assert r.cost == (1.0 if mode == "warn" else 0.0) and info["proposal_cost"] == 1.0
+    assert info["intervened"] == (mode != "warn")
+    assert info["block_reason"] == ("" if mode == "warn" else "proposal_violation")
 
 
 def test_unsafe_violation_admits_uncertain():

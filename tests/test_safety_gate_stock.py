@@ -31,7 +31,9 @@ def _run(env_id, steps):
         v = info["safety"]["verdict"]
         assert v in VERDICTS
         counts[v] += 1
-        assert info["cost"] == (1.0 if v == "violation" else 0.0)
+        # issue 13: cost of the applied window; the proposal's cost is a separate key
+        assert info["cost"] == (1.0 if info["safety"]["applied_verdict"] == "violation" else 0.0)
+        assert info["safety"]["proposal_cost"] == (1.0 if v == "violation" else 0.0)
         assert info["safety"]["checker"].shape == (env.gate.npairs,)
         if term or trunc:
             env.reset()

@@ -82,6 +82,9 @@ class PairResult:
         clearance: certified lower bound (m) on the pair's distance over the window
             (may be <= 0 or -inf when unknown).
         witness: :class:`Witness` if verdict is ``"violation"``.
+        note: ``""``, or why the pair was judged by a special rule, e.g.
+            ``"ongoing contact: penetration <= 0.005 m"`` (see
+            :mod:`monitor.certify.ongoing`); notes of that rule start with ``"ongoing"``.
     """
 
     geoms: tuple[str, str]
@@ -93,14 +96,18 @@ class PairResult:
     intervals: tuple[tuple[float, float], ...] = ()
     clearance: float = float("-inf")
     witness: Witness | None = None
+    note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable form."""
-        return {"geoms": list(self.geoms), "bodies": list(self.bodies), "verdict": self.verdict,
-                "method": self.method, "tests": int(self.tests), "max_depth": int(self.max_depth),
-                "intervals": [[float(a), float(b)] for a, b in self.intervals],
-                "clearance": _f(self.clearance),
-                "witness": self.witness.to_dict() if self.witness else None}
+        """JSON-serialisable form (``note`` only when non-empty)."""
+        out = {"geoms": list(self.geoms), "bodies": list(self.bodies), "verdict": self.verdict,
+               "method": self.method, "tests": int(self.tests), "max_depth": int(self.max_depth),
+               "intervals": [[float(a), float(b)] for a, b in self.intervals],
+               "clearance": _f(self.clearance),
+               "witness": self.witness.to_dict() if self.witness else None}
+        if self.note:
+            out["note"] = self.note
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> PairResult:
@@ -111,7 +118,7 @@ class PairResult:
                    int(d.get("tests", 0)), int(d.get("max_depth", 0)),
                    tuple((float(a), float(b)) for a, b in d.get("intervals", [])),
                    float("-inf") if c is None else float(c),
-                   Witness.from_dict(d["witness"]) if d.get("witness") else None)
+                   Witness.from_dict(d["witness"]) if d.get("witness") else None, str(d.get("note", "")))
 
 
 @dataclass(frozen=True)
@@ -131,6 +138,9 @@ class Certificate:
         pairs: one :class:`PairResult` per candidate pair, in scene order.
         stats: totals, e.g. ``pairs``, ``pairs_culled``, ``tests``, ``max_depth``,
             ``wall_seconds``, ``checker_mix`` ({method: count}).
+        allowed: ((geom_a, geom_b, reason), ...) candidate pairs that were NOT checked
+            because the allowed-contact matrix allows them (reasons ``Adjacent``,
+            ``Default``, ``Always``, ``User``; see :mod:`monitor.acm`), for audit.
     """
 
     verdict: Verdict
@@ -143,6 +153,12 @@ class Certificate:
     clearance: float
     pairs: tuple[PairResult, ...] = ()
     stats: dict[str, Any] = field(default_factory=dict)
+    allowed: tuple[tuple[str, str, str], ...] = ()
+
+    @property
+    def ongoing(self) -> tuple[tuple[str, str], ...]:
+        """Pairs judged by the ongoing-contact rule (in contact at the window start)."""
+        return tuple(p.geoms for p in self.pairs if p.note.startswith("ongoing"))
 
     def __post_init__(self) -> None:
         if self.verdict not in _RANK:
@@ -160,7 +176,8 @@ class Certificate:
                 "witness": self.witness.to_dict() if self.witness else None,
                 "earliest_time": _f(self.earliest_time), "clearance": _f(self.clearance),
                 "pairs": [p.to_dict() for p in self.pairs],
-                "stats": _jsonable(self.stats)}
+                "stats": _jsonable(self.stats),
+                **({"allowed": [list(a) for a in self.allowed]} if self.allowed else {})}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Certificate:
@@ -173,7 +190,8 @@ class Certificate:
                        None if d.get("earliest_time") is None else float(d["earliest_time"]),
                        float("-inf") if c is None else float(c),
                        tuple(PairResult.from_dict(p) for p in d.get("pairs", [])),
-                       dict(d.get("stats", {})))
+                       dict(d.get("stats", {})),
+                       tuple((str(a), str(b), str(r)) for a, b, r in d.get("allowed", [])))
         except (KeyError, TypeError, IndexError, ValueError) as exc:
             raise InvalidInputError(f"malformed certificate dict: {exc!r}") from exc
 

@@ -52,6 +52,7 @@ from monitor.certify.common import (
     PairOutcome,
     active_budget,
 )
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
 from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -158,7 +159,8 @@ def _make_budget(budget: Any) -> Budget:
 
 def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, method: str = "auto", *,
             window: tuple[float, float] | None = None, budget: Budget | dict | None = None,
-            tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None) -> Certificate:
+            tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None,
+            ongoing: str = "violation", penetration_tol: float = DEFAULT_PENETRATION_TOL) -> Certificate:
     """Certify that the planned motion keeps every candidate pair at least ``margin`` apart.
 
     Args:
@@ -175,6 +177,10 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
             left unfinished are "uncertain" (method ``"budget"`` when no checker ran).
         tolerances: numerical tolerances.
         pairs: optional subset of candidate pairs (geom-name pairs) to certify.
+        ongoing: ``"violation"`` (default: a pair closer than ``margin`` at t0 is a
+            violation) or ``"deepen"`` (such a pair is an ongoing contact and only has to
+            stay within ``penetration_tol`` of penetration; :mod:`monitor.certify.ongoing`).
+        penetration_tol: metres of penetration an ongoing contact may reach (``"deepen"``).
 
     Returns:
         The :class:`Certificate`. ``stats["pairs"] == 0`` together with
@@ -216,19 +222,25 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
     if not t1 > t0:
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
     bud = _make_budget(budget)
+    pen_tol = check_rule(ongoing, penetration_tol)
+    allowed = tuple(getattr(scene, "allowed_pairs", ()))
     sel = _select(scene, pairs)
     if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
         return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
-                                "budget_exhausted": False, "nothing_checked": True})
+                                "budget_exhausted": False, "nothing_checked": True}, allowed)
     stage = _stage_budget(bud, len(sel))
     with active_budget(stage):
-        return _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0)
+        cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
+    if ongoing == "deepen":  # issue 13: contacts present at t0 (monitor/certify/ongoing.py)
+        cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
+                      budget=bud, tolerances=tol, penetration_tol=pen_tol)
+    return cert
 
 
 def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
-             bud: Budget, tol: Tolerances, sel: list[int], wall0: float) -> Certificate:
+             bud: Budget, tol: Tolerances, sel: list[int], wall0: float, allowed: tuple) -> Certificate:
     """The pipeline of :func:`certify` on validated arguments (``bud`` is the active budget).
 
     Every stage may end early with :class:`BudgetExhausted` (raised by the motion, polled
@@ -445,7 +457,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
     cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
-                       ordered, stats)
+                       ordered, stats, allowed)
     if len(ordered) >= 10_000:  # learn the assembly cost on big scenes (small ones are noise)
         per_pair = (time.perf_counter() - fin0) / len(ordered)
         _FINALISE_SECONDS_PER_PAIR[0] = max(_FINALISE_SECONDS_PER_PAIR[0], min(per_pair, 1e-4))

@@ -1,0 +1,217 @@
+"""The ongoing-contact rule: pairs already in contact when a window starts.
+
+Plain :func:`monitor.certify` treats a pair whose start distance is below the
+margin as a violation at t0 (a body starting inside another is a violation).
+A gate on a real task needs a different question for such a pair: *does this
+action deepen the contact beyond a set penetration?* With
+``certify(..., ongoing="deepen", penetration_tol=d)``:
+
+* A pair is **ongoing** when its exact static distance at t0 cannot be proven
+  larger than the margin (``lower <= margin``). Every other pair (in particular a
+  *new* contact with a hazard while another contact is ongoing) keeps the full
+  rule: clearance > margin over the whole window.
+* An ongoing pair is acceptable iff its penetration never exceeds ``d`` during
+  the window, certified soundly: the pair is re-certified at margin 0 with its
+  shapes *shrunk* by ``s <= d``:
+
+  - the rounded radii (sphere / capsule radius) are reduced, A's first, then B's;
+  - a half-space (MuJoCo plane) is moved inwards along its normal.
+
+  Both are exact: for a core C swept by radius r, the signed distance of
+  ``C + B(r - x)`` to any convex set is the original signed distance plus x
+  (distance and penetration depth of Minkowski sums add radii), and the signed
+  distance of a convex set to ``{n.x <= o - x}`` is the original plus x. So a
+  certificate of the shrunk pair (sd_shrunk > 0 at every instant) proves
+  sd_original > -s >= -d: penetration < d at every instant of the continuous motion.
+  ``s`` is ``d * (1 - 1e-9)`` when the pair has enough radius / a half-space, so
+  rounding in the shrinking cannot make s exceed d.
+* Polytope cores cannot be eroded exactly (the support function of an eroded
+  polytope drops by more than x at its corners), so a pair with too little
+  radius and no half-space (box on box, cylinder on box) is shrunk by what its
+  radii allow: certified => penetration < s (a stronger statement); otherwise it
+  is "uncertain" with the note ``"ongoing contact, polytope cores"``, never a
+  "violation" (its witness only shows penetration > s, not > d).
+* A confirmed witness of a fully shrunk pair shows penetration > s: the pair's
+  result is a "violation" whose witness distance is the original distance
+  (shrunk distance - s).
+
+Every pair judged this way carries a ``PairResult.note`` starting with
+``"ongoing"``; :attr:`Certificate.ongoing` lists them and
+``stats["ongoing"]`` / ``stats["penetration_tol"]`` record the rule's use.
+The certificate's ``clearance`` includes the ongoing pairs' (negative) bounds.
+
+Pure: numpy only (no MuJoCo).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
+from monitor.errors import InvalidInputError
+from monitor.geometry.shapes import ConvexShape
+
+DEFAULT_PENETRATION_TOL = 0.005
+"""Metres of penetration an ongoing contact may reach within a window (5 mm: above
+MuJoCo's typical resting penetration of soft contacts, ~1 mm, below any geometry
+feature that matters for a collision)."""
+ONGOING_RULES = ("violation", "deepen")
+_REL = 1e-9  # relative safety factor on the shrink amount (rounding of r - x, o - x)
+POLYTOPE_NOTE = "ongoing contact, polytope cores"
+
+
+def check_rule(ongoing: Any, penetration_tol: Any) -> float:
+    """Validate ``ongoing`` / ``penetration_tol``; returns the tolerance as a float."""
+    if ongoing not in ONGOING_RULES:
+        raise InvalidInputError(f"ongoing must be one of {ONGOING_RULES}, got {ongoing!r}")
+    try:
+        d = float(penetration_tol)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"penetration_tol must be a number (m), got {penetration_tol!r}") from None
+    if not math.isfinite(d) or d <= 0:
+        raise InvalidInputError(f"penetration_tol must be finite and > 0 (m), got {penetration_tol!r}")
+    return d
+
+
+def shrink_pair(sa: ConvexShape, sb: ConvexShape, d: float) -> tuple[ConvexShape, ConvexShape, float]:
+    """Shrink a pair's shapes so that their signed distance grows by exactly ``s <= d``.
+
+    Returns:
+        (shrunk A, shrunk B, s) with s the achieved shrink (m); s < d*(1-1e-9) only when
+        the radii are used up and neither shape is a half-space.
+    """
+    want = d * (1.0 - _REL)
+    left = want
+    out = []
+    for s in (sa, sb):
+        x = min(float(s.radius), left)
+        if x > 0:
+            s = replace(s, radius=0.0 if x >= s.radius else float(s.radius) - x)
+            left -= x
+        out.append(s)
+    for k in (0, 1):
+        if left > 0 and out[k].kind == "halfspace":
+            n = np.asarray(out[k].normals[0], dtype=np.float64)
+            out[k] = out[k].transformed(np.eye(3), -left * n / float(np.linalg.norm(n)))
+            left = 0.0
+    return out[0], out[1], want - max(left, 0.0)
+
+
+class _PairScene:
+    """A scene-like view with per-pair (shrunk) geom copies for :func:`monitor.certify`."""
+
+    allowed_pairs: tuple = ()
+
+    def __init__(self, scene: Any, geoms: list[Any], pair_ids: list[tuple[int, int]],
+                 names: list[tuple[str, str]]) -> None:
+        self.model = scene.model
+        self.geoms = tuple(geoms)
+        self.pair_ids = np.asarray(pair_ids, dtype=np.int64).reshape(-1, 2)
+        self.candidate_pairs = tuple(names)
+        self.body_names = scene.body_names
+        self.body_static = scene.body_static
+        self.tolerances = getattr(scene, "tolerances", None)
+        self._scene = scene
+
+    @property
+    def model_hash(self) -> str:
+        return self._scene.model_hash
+
+
+def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: Certificate, *,
+           margin: float, epsilon: float, method: str, budget: Any, tolerances: Any,
+           penetration_tol: float) -> Certificate:
+    """Apply the ongoing-contact rule to a certificate of plain :func:`monitor.certify`.
+
+    Args:
+        certify_fn: :func:`monitor.certify.engine.certify` (passed in: no import cycle).
+        scene: the scene ``cert`` was computed on.
+        plan: the plan.
+        cert: the plain certificate (start-inside rule).
+        margin, epsilon, method, budget, tolerances: as given to ``certify``.
+        penetration_tol: d (m), see module docstring.
+
+    Returns:
+        the certificate with ongoing pairs re-judged (unchanged when there are none).
+    """
+    from monitor.geometry.distance import shape_distance
+
+    cand = [k for k, p in enumerate(cert.pairs) if p.verdict != "certified"]
+    if not cand:
+        return cert
+    t0 = float(cert.window[0])
+    pos, rot = plan.body_poses(np.array([t0]))
+    geoms = list(scene.geoms)
+    pair_rows: list[tuple[int, int]] = []
+    names: list[tuple[str, str]] = []
+    meta: list[tuple[int, float]] = []  # (index in cert.pairs, achieved shrink)
+    for k in cand:
+        p = cert.pairs[k]
+        ga, gb = scene.geom(p.geoms[0]), scene.geom(p.geoms[1])
+        dist = shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
+                              gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]), tolerances=tolerances)
+        if dist.lower > margin:
+            continue  # clear at t0: a new contact, the full rule stands
+        sa, sb, s = shrink_pair(ga.shape, gb.shape, penetration_tol)
+        ia, ib = len(geoms), len(geoms) + 1
+        geoms.append(replace(ga, id=ia, shape=sa))
+        geoms.append(replace(gb, id=ib, shape=sb))
+        pair_rows.append((ia, ib))
+        names.append(p.geoms)
+        meta.append((k, s))
+    if not meta:
+        return cert
+    view = _PairScene(scene, geoms, pair_rows, names)
+    sub = certify_fn(view, plan, margin=0.0, epsilon=epsilon, method=method, window=tuple(cert.window),
+                     budget=budget, tolerances=tolerances)
+    full = penetration_tol * (1.0 - _REL)
+    pairs = list(cert.pairs)
+    for (k, s), r in zip(meta, sub.pairs):
+        tol_txt = f"{penetration_tol:g} m"
+        clear = r.clearance - s if math.isfinite(r.clearance) else r.clearance
+        if s >= full:
+            if r.verdict == "certified":
+                note = f"ongoing contact: penetration < {tol_txt} certified"
+            elif r.verdict == "violation":
+                note = f"ongoing contact: penetration exceeds {tol_txt}"
+            else:
+                note = f"ongoing contact: penetration < {tol_txt} not proven"
+            w = r.witness
+            if w is not None:
+                w = Witness(w.time, w.geoms, w.point, float(w.distance) - s)
+            pairs[k] = replace(r, clearance=clear, witness=w, note=note)
+        elif r.verdict == "certified":
+            pairs[k] = replace(r, clearance=clear,
+                               note=f"ongoing contact: penetration < {s:g} m certified (polytope cores)")
+        else:
+            pairs[k] = replace(r, verdict="uncertain", witness=None, clearance=-math.inf,
+                               intervals=r.intervals or ((t0, float(cert.window[1])),),
+                               note=f"{POLYTOPE_NOTE}: penetration < {tol_txt} cannot be certified "
+                                    f"(only {s:g} m of radius to shrink)")
+    return _recombine(cert, pairs, len(meta), penetration_tol)
+
+
+def _recombine(cert: Certificate, pairs: list[PairResult], n_ongoing: int, tol: float) -> Certificate:
+    verdict = combine_verdicts([p.verdict for p in pairs])
+    wits = [p.witness for p in pairs if p.verdict == "violation" and p.witness is not None]
+    witness = min(wits, key=lambda w: w.time) if wits else None
+    earliest = None
+    if verdict != "certified":
+        starts = [p.intervals[0][0] for p in pairs if p.verdict != "certified" and p.intervals]
+        starts += [w.time for w in wits]
+        earliest = float(min(starts)) if starts else float(cert.window[0])
+    clears = [p.clearance for p in pairs if p.method != "culled" or math.isfinite(p.clearance)]
+    clearance = float(min(clears)) if clears else math.inf
+    stats = dict(cert.stats)
+    stats["ongoing"] = n_ongoing
+    stats["penetration_tol"] = tol
+    return replace(cert, verdict=verdict, witness=witness, earliest_time=earliest, clearance=clearance,
+                   pairs=tuple(pairs), stats=stats)
+
+
+__all__ = ["deepen", "shrink_pair", "check_rule", "DEFAULT_PENETRATION_TOL", "ONGOING_RULES", "POLYTOPE_NOTE"]
