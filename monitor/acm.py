@@ -7,8 +7,9 @@ pair with a :class:`Reason`:
 =========  ==========================================================================
 Adjacent   parent-child bodies (weld groups; neither the world, the child attached
            without a free joint), or two geoms welded together (same weld group)
-Default    in contact (static distance <= the pair's MuJoCo contact margin, max of the two
-           ``geom_margin``, + ``contact_tol``) in the reference pose
+Default    in resting contact (static distance <= the pair's MuJoCo contact margin, max of the
+           two ``geom_margin``, + ``contact_tol``, and no deeper than ``RESTING_MAX_DEPTH``) in the
+           reference pose
            (keyframe K when the model has it, else ``qpos0``: a model's ``qpos0`` may
            put a body inside an obstacle, e.g. ``models/tunnel``; its keyframe does
            not) or at any step while the model settles from it for ``settle`` seconds
@@ -82,6 +83,12 @@ CONTACT_TOL = 1e-4
 the two ``geom_margin``; Ant's feet rest 2 cm above the floor because of it) plus this counts
 as "in contact" for Default / Always (an upper bound must be below it) and Never (the lower
 bound must stay above it). 0.1 mm covers float noise."""
+RESTING_MAX_DEPTH = 5e-3
+"""Metres: a pair counts as a resting (Default) contact only if its exact static distance is
+also provably no deeper than this (lower bound >= -RESTING_MAX_DEPTH). Resting contacts under
+MuJoCo's soft contacts penetrate by a fraction of a millimetre to a few millimetres; a deeper
+overlap in the reference pose (e.g. a randomised reset that places a body inside a wall) is a
+hazard state, not a contact that belongs to the task, and stays checked."""
 SETTLE = 0.5
 """Seconds of passive simulation (zero control) from the reference pose whose contacts are
 Default: the model's resting contacts (Ant's and Walker's feet on the floor, Pusher's object on
@@ -354,7 +361,7 @@ def _settled_contacts(model: Any, geoms: Any, todo: list[tuple[int, int]], key: 
             X_a = (d.xmat[ga.body_id].reshape(3, 3).copy(), d.xpos[ga.body_id].copy())
             X_b = (d.xmat[gb.body_id].reshape(3, 3).copy(), d.xpos[gb.body_id].copy())
             dist = shape_distance(ga.shape, X_a, gb.shape, X_b)
-            if dist.upper <= contact_tol + _pair_margin(model, a, b):
+            if dist.upper <= contact_tol + _pair_margin(model, a, b) and dist.lower >= -RESTING_MAX_DEPTH:
                 found.add((a, b))
     return found
 
@@ -439,9 +446,9 @@ def compute_acm(model: Any, *, pairs: Any = "mujoco", samples: int = DEFAULT_SAM
         ga, gb = geoms[a], geoms[b]
         hit = False
         for pos, rot in ref_poses:
-            _, up = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
-                                         gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]))
-            hit |= bool(up[0] <= contact_tol + _pair_margin(model, a, b))
+            lo, up = shape_distance_batch(ga.shape, (rot[:, ga.body_id], pos[:, ga.body_id]),
+                                          gb.shape, (rot[:, gb.body_id], pos[:, gb.body_id]))
+            hit |= bool(up[0] <= contact_tol + _pair_margin(model, a, b) and lo[0] >= -RESTING_MAX_DEPTH)
         if hit:
             entries[_key(ga.name, gb.name)] = Reason.DEFAULT
         else:
@@ -537,6 +544,9 @@ class PairPolicy:
     allowed: tuple[tuple[str, str, str], ...]
     not_hazard: int
     never: tuple[tuple[str, str], ...]
+    acm: ACM | None = None
+    """The resolved matrix (``"auto"`` computed once): a scene rebuilt after a model edit reuses
+    it, so an in-place edit (domain randomisation) can never add allowed pairs."""
 
 
 def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, allowed: Any = None,
@@ -578,7 +588,7 @@ def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, all
             allowed_rows.append((na, nb, r.value))
         elif r is Reason.NEVER:
             never.append((na, nb))
-    return PairPolicy(pair_ids[keep], tuple(allowed_rows), not_hazard, tuple(never))
+    return PairPolicy(pair_ids[keep], tuple(allowed_rows), not_hazard, tuple(never), acm)
 
 
 def describe(policy: PairPolicy, names: ModelNames, *, limit: int | None = None) -> list[str]:

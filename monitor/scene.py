@@ -390,6 +390,7 @@ class Scene:
 
         pair_ids = cls._select_pairs(model, pairs, names)
         allowed_rows: tuple[tuple[str, str, str], ...] = ()
+        policy = None
         if allowed is not None or hazards is not None or allow is not None:  # issue 13: pair policy
             from monitor.acm import apply_policy
 
@@ -431,7 +432,10 @@ class Scene:
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
         scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
         scene._pairs_spec = pairs
-        scene._acm_spec = {"allowed": allowed, "hazards": hazards, "allow": allow, "reference": reference}
+        # rebuilds after model edits reuse the matrix resolved now ("auto" is not recomputed on an
+        # edited model: an edit must never turn a hazard into an allowed pair)
+        frozen = policy.acm if allowed is not None and policy is not None else allowed
+        scene._acm_spec = {"allowed": frozen, "hazards": hazards, "allow": allow, "reference": reference}
         scene.allowed_pairs = allowed_rows
         return scene
 

@@ -3,7 +3,9 @@
 A gymnasium MuJoCo env (the tunnel, subclassed so no wrapper sits between the gate and
 the env) whose ``reset`` scales the wall's and the ball's sizes and moves the wall at
 random, IN PLACE on the env's MjModel, as domain-randomisation code does. A
-``SafetyGate`` with default settings runs 50 short episodes of random velocity commands.
+``SafetyGate`` runs 50 short episodes of random velocity commands, once with the strict
+contract (``allowed=None, ongoing="violation"``) and once with the stock defaults (an
+allowed-contact matrix and the ongoing-contact rule), each against its own oracle.
 
 Oracle (independent of ``monitor``): the ball is a sphere on a slide joint and the wall an
 axis-aligned box, so their signed distance is closed-form from the LIVE model arrays at
@@ -24,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL
 from monitor.envs.tunnel_v0 import TunnelEnv
 from monitor.gym_gate import SafetyGate
 
@@ -63,17 +66,29 @@ def _ball_wall_distance(m, x: np.ndarray) -> np.ndarray:
     return outside + inside - float(m.geom_size[ball][0])
 
 
-def _classify(m, x0: float, x1: float) -> str:
+def _classify(m, x0: float, x1: float, rule: str = "strict") -> str:
+    """"collides" is a proof that the window breaks the gate's contract under ``rule``.
+
+    ``"strict"`` (``ongoing="violation"``): any contact (d < 0) anywhere in the window.
+    ``"deepen"`` (the gate's default, :mod:`monitor.certify.ongoing`): a window that starts
+    clear may not make contact; one that starts in contact (d(x0) <= 0, the margin being 0)
+    may not reach a penetration deeper than ``DEFAULT_PENETRATION_TOL``.
+    """
     x = np.linspace(x0, x1, N_SAMPLES)
     d = _ball_wall_distance(m, x)
-    if (d < 0).any():
+    lip = abs(x1 - x0) / (2 * (N_SAMPLES - 1))
+    floor = 0.0
+    if rule == "deepen" and d[0] <= 0.0:
+        floor = -DEFAULT_PENETRATION_TOL
+    if (d < floor).any():
         return "collides"
-    return "clear" if (d > abs(x1 - x0) / (2 * (N_SAMPLES - 1))).all() else "ambiguous"
+    return "clear" if (d > floor + lip).all() else "ambiguous"
 
 
-def _run(episodes: int, steps: int, seed: int) -> dict[str, int]:
+def _run(episodes: int, steps: int, seed: int, rule: str = "strict") -> dict[str, int]:
     env = RandomisedTunnel(seed=seed, x0=-0.09, reset_noise=0.05)
-    gate = SafetyGate(env)
+    # "strict": the plain certify contract; "deepen": the stock defaults (ACM "auto", ongoing contacts)
+    gate = SafetyGate(env, allowed=None, ongoing="violation") if rule == "strict" else SafetyGate(env)
     m = env.unwrapped.model
     rng = np.random.default_rng(seed + 1)
     counts = {"windows": 0, "proposed_collides": 0, "proposed_certified": 0, "applied_certified": 0}
@@ -87,20 +102,23 @@ def _run(episodes: int, steps: int, seed: int) -> dict[str, int]:
             counts["windows"] += 1
             q = np.asarray(rep.plan.qpos)[:, 0]
             assert len(q) == 2  # frame_skip=1: one MuJoCo step, lerped
-            proposed = _classify(m, float(q[0]), float(q[-1]))
+            proposed = _classify(m, float(q[0]), float(q[-1]), rule)
+            if rule == "deepen":  # the wall pair is never allowed away: an allowed pair is listed
+                assert not rep.certificate.allowed, rep.certificate.allowed
             counts["proposed_collides"] += proposed == "collides"
             if rep.verdict == "certified":
                 counts["proposed_certified"] += 1
                 assert proposed != "collides", (ep, q, m.geom_size[m.geom("ball").id])
             if rep.applied_verdict == "certified":
                 counts["applied_certified"] += 1
-                assert _classify(m, x_before, x_after) != "collides", (ep, x_before, x_after)
+                assert _classify(m, x_before, x_after, rule) != "collides", (ep, x_before, x_after)
     gate.close()
     return counts
 
 
-def test_domain_randomised_tunnel_never_certifies_a_collision():
-    counts = _run(episodes=50, steps=4, seed=0)
+@pytest.mark.parametrize("rule", ["strict", "deepen"])
+def test_domain_randomised_tunnel_never_certifies_a_collision(rule):
+    counts = _run(episodes=50, steps=4, seed=0, rule=rule)
     assert counts["proposed_collides"] >= 10, counts  # the run exercises real collisions
     assert counts["proposed_certified"] >= 20, counts  # and certifies clear ones
 

@@ -289,7 +289,7 @@ def test_step_with_non_numeric_ctrl_is_a_typed_error():
 @pytest.mark.parametrize(("kwargs", "name"), [
     ({"log": 123}, "log"),
     ({"log": object()}, "log"),
-    ({"log": "/nonexistent-dir-h11b/x.mcap"}, "log"),
+    ({"log": "/proc/version/x.mcap"}, "log"),  # a directory that cannot be created
     ({"fallback": [1, 2, 3]}, "fallback"),  # the tunnel has one actuator
     ({"fallback": [np.nan]}, "fallback"),
     ({"fallback": "stop"}, "fallback"),
@@ -323,7 +323,7 @@ def test_reuse_cache_is_keyed_on_the_margin():
 
     m = _static_pair_model(0.1)
     d = mujoco.MjData(m)
-    gate = Gate(m, pairs="all")
+    gate = Gate(m, pairs="all", allowed=None, ongoing="violation")  # the plain certify contract
     assert gate.step(d, np.zeros(0)).verdict == "certified"
     assert gate.step(d, np.zeros(0)).certificate.stats.get("reused_pairs") == 1  # the cache is in use
     gate.margin = 0.2
@@ -374,7 +374,7 @@ def test_committed_tail_is_not_reused_after_a_setting_changed():
     """The committed brake's tail was certified at margin 0; at margin 0.5 (the wall is ~0.3 m away)
     the brake window must be re-certified, not taken from that tail."""
     m, d = _tunnel()
-    gate = Gate(m)
+    gate = Gate(m, ongoing="violation")  # strict: within the margin at t0 is a violation
     assert gate.step(d, np.array([1.0])).verdict == "certified"  # commits a brake and its tail
     assert gate._tail is not None
     gate.margin = 0.5
@@ -386,6 +386,7 @@ def test_committed_tail_is_not_reused_after_a_setting_changed():
 
 def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
     m, d = _tunnel()
-    gate = Gate(m, margin=0.5, fallback=lambda data: [0.0, 0.0])  # the wall is within 0.5 m: blocked
+    gate = Gate(m, margin=0.5, fallback=lambda data: [0.0, 0.0],  # the wall is within 0.5 m: blocked
+                ongoing="violation")
     with pytest.raises(InvalidInputError, match="fallback"):
         gate.step(d, np.array([1.0]))

@@ -173,7 +173,7 @@ def test_brake_and_hold_fallback_work_through_rescale_action():
 def test_array_fallback_is_an_action_through_the_wrappers():
     """fallback=[0.0] under RescaleAction(0, 1): the env receives -6 m/s (away from the wall)."""
     env = SafetyGate(RescaleAction(gym.make("monitor/Tunnel-v0"), 0.0, 1.0), fallback=np.array([0.0]),
-                     margin=0.5)  # the wall is within 0.5 m: every proposal is blocked
+                     margin=0.5, ongoing="violation")  # the wall is within 0.5 m: every proposal is blocked
     env.reset(seed=0)
     info = env.step(np.array([1.0]))[4]
     assert info["safety"]["replaced"]

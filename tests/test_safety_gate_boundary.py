@@ -100,7 +100,8 @@ def test_second_gate_on_a_claimed_path_writes_a_sibling(tmp_path):
 
 
 def test_callable_fallback_with_a_bad_return_value_is_a_typed_error():
-    env = SafetyGate(gym.make("monitor/Tunnel-v0"), margin=0.5, fallback=lambda env, obs: [0.0, 0.0])
+    env = SafetyGate(gym.make("monitor/Tunnel-v0"), margin=0.5, fallback=lambda env, obs: [0.0, 0.0],
+                     ongoing="violation")
     env.reset(seed=0)
     with pytest.raises(InvalidInputError, match="fallback"):
         env.step(np.array([1.0]))

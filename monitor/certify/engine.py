@@ -349,12 +349,18 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             outcomes[i] = ("extrusion", o)
     if tol_items:  # issue 12: the compiled whole-shape stage first; what it certifies is done
         from monitor.certify.kernels import whole_shape_stage
-        pre = whole_shape_stage(scene, plan, [(ga, gb) for _i, ga, gb in tol_items], (t0, t1), margin,
-                                epsilon, tol, bud)
+        try:
+            pre = whole_shape_stage(scene, plan, [(ga, gb) for _i, ga, gb in tol_items], (t0, t1), margin,
+                                    epsilon, tol, bud)
+        except BudgetExhausted:  # nothing decided here: the pairs go on (and end "uncertain" below)
+            pre = [None] * len(tol_items)
         for k, ((i, ga, gb), r) in enumerate(zip(tol_items, pre)):
             w = None
             if r is not None and r["verdict"] == "violation":  # re-confirmed by the engine's own rule
-                w = _find_witness(plan, ga, gb, np.array([r["witness_time"]]), margin, tol)
+                try:
+                    w = _find_witness(plan, ga, gb, np.array([r["witness_time"]]), margin, tol)
+                except BudgetExhausted:
+                    w = None
                 if w is None:
                     pre[k] = r = None
             if r is not None:

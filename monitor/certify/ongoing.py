@@ -10,7 +10,12 @@ action deepen the contact beyond a set penetration?* With
   larger than the margin (``lower <= margin``). Every other pair (in particular a
   *new* contact with a hazard while another contact is ongoing) keeps the full
   rule: clearance > margin over the whole window.
-* An ongoing pair is acceptable iff its penetration never exceeds ``d`` during
+* An ongoing pair that is provably apart at t0 (``0 < lower - d``, i.e. inside the
+  margin but not touching) may close by at most ``d``: it is re-certified at margin 0
+  with A's radius *inflated* by ``x = (lower - d)(1 + 1e-9)`` (exact: the signed
+  distance drops by exactly x), so certified => clearance > lower - d > 0 at every
+  instant; it can never be driven into contact under this rule.
+* Any other ongoing pair is acceptable iff its penetration never exceeds ``d`` during
   the window, certified soundly: the pair is re-certified at margin 0 with its
   shapes *shrunk* by ``s <= d``:
 
@@ -157,7 +162,15 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
                               gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]), tolerances=tolerances)
         if dist.lower > margin:
             continue  # clear at t0: a new contact, the full rule stands
-        sa, sb, s = shrink_pair(ga.shape, gb.shape, penetration_tol)
+        floor = float(dist.lower) - penetration_tol
+        if floor > 0.0:
+            # within the margin but provably apart: it may close by at most penetration_tol,
+            # never down to contact. Inflating a radius by x is exact (sd drops by exactly x),
+            # so certifying the inflated pair at margin 0 proves sd > x >= floor.
+            x = floor * (1.0 + _REL)
+            sa, sb, s = replace(ga.shape, radius=float(ga.shape.radius) + x), gb.shape, -x
+        else:  # touching or penetrating: penetration may not exceed penetration_tol
+            sa, sb, s = shrink_pair(ga.shape, gb.shape, penetration_tol)
         ia, ib = len(geoms), len(geoms) + 1
         geoms.append(replace(ga, id=ia, shape=sa))
         geoms.append(replace(gb, id=ib, shape=sb))
@@ -174,7 +187,19 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     for (k, s), r in zip(meta, sub.pairs):
         tol_txt = f"{penetration_tol:g} m"
         clear = r.clearance - s if math.isfinite(r.clearance) else r.clearance
-        if s >= full:
+        if s < 0:  # inflated: the floor is a clearance, not a penetration
+            floor_txt = f"{-s:.3g} m"
+            if r.verdict == "certified":
+                note = f"ongoing (within margin): clearance > {floor_txt} certified"
+            elif r.verdict == "violation":
+                note = f"ongoing (within margin): clearance falls below {floor_txt}"
+            else:
+                note = f"ongoing (within margin): clearance > {floor_txt} not proven"
+            w = r.witness
+            if w is not None:
+                w = Witness(w.time, w.geoms, w.point, float(w.distance) - s)
+            pairs[k] = replace(r, clearance=clear, witness=w, note=note)
+        elif s >= full:
             if r.verdict == "certified":
                 note = f"ongoing contact: penetration < {tol_txt} certified"
             elif r.verdict == "violation":
