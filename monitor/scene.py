@@ -12,7 +12,8 @@ capsule    segment + radius (exact)
 box        polytope (exact)
 mesh       convex hull of all compiled ``mesh_vert`` (float32, mesh frame == geom
            frame): exact for MuJoCo's hull; with ``maxhullvert`` a superset of
-           MuJoCo's reduced hull (which MuJoCo itself does not always respect)
+           MuJoCo's reduced hull (which MuJoCo itself does not always respect);
+           validated with trimesh, one warning per non-convex mesh (extra hull volume)
 cylinder   circumscribed regular prism (``facets`` sides), reported
 ellipsoid  circumscribed tangent-plane polytope, reported
 plane      half-space ``{z <= 0}`` in the geom frame (exact; MuJoCo planes are
@@ -199,6 +200,71 @@ def _to_body(shape_G: ConvexShape, R_BG: np.ndarray, p_BG: np.ndarray) -> Convex
     return ConvexShape(s.kind, s.points, s.radius, s.edges, s.faces, s.normals, off, s.approx_error)
 
 
+NONCONVEX_REL_TOL = 1e-6
+"""Relative extra hull volume, ``(V_hull - V_mesh) / V_hull``, above which a closed mesh
+counts as non-convex for the warning of :func:`_check_mesh` (float32 vertices; a convex
+mesh's two volumes agree to ~1e-12 relative)."""
+
+_MESH_CHECKS: dict[bytes, str | None] = {}
+"""Mesh content digest -> warning text (None: convex). Filled by :func:`_check_mesh`, so a
+mesh is examined, and warned about, once per process however often scenes are rebuilt."""
+
+
+def _check_mesh(model: Any, mid: int, g: int) -> None:
+    """Validate mesh ``mid`` (used by geom ``g``) with trimesh; warn once if it is not convex.
+
+    Builds a ``trimesh.Trimesh`` from the compiled ``mesh_vert`` (V, 3) and ``mesh_face``
+    (F, 3) of the mesh. Certification treats every mesh as the convex hull of its vertices
+    (sound, conservative), so a non-convex mesh only costs clearance: one
+    ``warnings.warn`` per mesh names the geom and the hull's extra volume (m^3 and %) for a
+    closed mesh, or says the mesh is open and not convex. Results are cached by mesh
+    content (:data:`_MESH_CHECKS`).
+
+    Raises:
+        InvalidInputError: non-finite vertices, or face indices outside the mesh's vertices
+            (e.g. after an in-place edit of ``mesh_vert``/``mesh_face``).
+    """
+    import warnings
+
+    va, vn = int(model.mesh_vertadr[mid]), int(model.mesh_vertnum[mid])
+    fa, fn = int(model.mesh_faceadr[mid]), int(model.mesh_facenum[mid])
+    V = np.asarray(model.mesh_vert[va:va + vn], dtype=np.float64)
+    F = np.asarray(model.mesh_face[fa:fa + fn], dtype=np.int64)
+    key = hashlib.blake2b(V.tobytes() + b"|" + F.tobytes(), digest_size=16).digest()
+    if key in _MESH_CHECKS:
+        return
+    mesh_name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MESH, mid) or f"#{mid}"
+    geom_name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or f"#{g}"
+    what = f"mesh {mesh_name!r} (geom {geom_name!r})"
+    if vn == 0 or not np.isfinite(V).all():
+        raise InvalidInputError(f"{what}: mesh_vert has {'no' if vn == 0 else 'non-finite'} vertices")
+    if fn and (F.min() < 0 or F.max() >= vn):
+        raise InvalidInputError(f"{what}: mesh_face indexes outside its {vn} vertices")
+    message = None
+    if fn:
+        import trimesh
+
+        mesh = trimesh.Trimesh(vertices=V, faces=F, process=False, validate=False)
+        try:
+            hull_volume = float(mesh.convex_hull.volume)
+        except Exception:  # noqa: BLE001 - flat/degenerate hull (thickened in _geom_shape)
+            hull_volume = 0.0
+        if mesh.is_volume:
+            extra = hull_volume - float(mesh.volume)
+            if hull_volume > 0 and extra > NONCONVEX_REL_TOL * hull_volume:
+                message = (f"{what} is not convex; it is certified as its convex hull, which adds "
+                           f"{extra:.3g} m^3 ({100 * extra / hull_volume:.3g}% of the hull) "
+                           f"(sound but conservative: clearances near it are underestimated)")
+        elif not trimesh.convex.is_convex(mesh):
+            message = (f"{what} is not a closed volume and not convex; it is certified as the convex "
+                       f"hull of its vertices ({hull_volume:.3g} m^3), sound but conservative")
+    if len(_MESH_CHECKS) > 4096:
+        _MESH_CHECKS.clear()
+    _MESH_CHECKS[key] = message
+    if message is not None:
+        warnings.warn(message, UserWarning, stacklevel=2)
+
+
 def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape | None:
     """Shape of geom ``g`` in its geom frame (None for unsupported types)."""
     t = int(model.geom_type[g])
@@ -224,6 +290,7 @@ def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape
         # full mesh, so certifying against it would be unsound (red-team test
         # test_fn_mesh_maxhullvert_reduced_hull). The hull of all vertices contains both.
         V = np.asarray(model.mesh_vert[a:a + n], dtype=np.float64)
+        _check_mesh(model, mid, g)
         try:
             return polytope_from_points(V)
         except InvalidInputError:

@@ -1,4 +1,4 @@
-"""Benchmarks: run time against error, peers, seed reproductions, gate overhead, scaling.
+"""Benchmarks: run time against error, peers, seed reproductions, gate overhead, scaling, review cost.
 
 Run with ``python -m monitor bench [--quick] [--out DIR] [--suite NAME ...]``.
 
@@ -10,7 +10,7 @@ Modules:
   of the static distance with an analytic Lipschitz margin; exact LP for translations).
 * :mod:`monitor.bench.peers`: python-fcl ``continuousCollide``, MuJoCo sampling with
   ``mj_geomDistance`` and ipctk Tight-Inclusion CCD, each import-guarded.
-* :mod:`monitor.bench.suites`: the five suites; each returns a JSON-serialisable dict.
+* :mod:`monitor.bench.suites`: the six suites; each returns a JSON-serialisable dict.
 * :mod:`monitor.bench.report`: machine info, ``results.json``, ``results.md`` and the plots.
 
 Timing rules: medians of interleaved repetitions, ratios measured in the same run,
@@ -19,7 +19,7 @@ never one absolute time.
 
 from __future__ import annotations
 
-SUITES = ("accuracy", "peers", "seeds", "gate", "scaling")
+SUITES = ("accuracy", "peers", "seeds", "gate", "scaling", "review")
 """Suite names accepted by ``--suite`` (in run order)."""
 
 __all__ = ["SUITES"]

@@ -1,4 +1,4 @@
-"""The five benchmark suites.
+"""The six benchmark suites.
 
 Each ``suite_*(cfg)`` returns a JSON-serialisable dict with ``markdown`` (list of
 table strings) and ``figures`` (PNG names in ``cfg.out``), or ``{"skipped": reason}``
@@ -1256,6 +1256,94 @@ def _nary(cfg: BenchConfig) -> dict[str, Any]:
     return {"rows": rows}
 
 
+# ------------------------------------------------------------------------------ suite 6: review cost
+_REVIEW_XML = """<mujoco><worldbody>
+<body name="table" pos=".6 0 .2"><geom name="top" type="box" size=".2 .3 .02"/></body>
+<body name="arm" pos="0 0 .3"><joint type="hinge" axis="0 0 1"/>
+<geom name="link" type="capsule" fromto="0 0 0 .3 0 0" size=".03"/></body>
+</worldbody></mujoco>"""
+
+
+def _write_review_log(path: Path, n_windows: int, seed: int) -> None:
+    """An ``n_windows``-window MCAP log of synthetic certificates (~2 % not certified).
+
+    Episodes of 500 windows of 10 ms; every non-certified window is a blocked action,
+    as a gate writes it. The certificates are built directly (no certification run):
+    this measures the log and the review, not the checkers.
+    """
+    import types
+
+    import mujoco
+
+    from monitor.certify.certificate import Certificate, PairResult, Witness
+    from monitor.log import MonitorLog
+
+    model = mujoco.MjModel.from_xml_string(_REVIEW_XML)
+    rng = np.random.default_rng(seed)
+    pair, bodies = ("link", "top"), ("arm", "table")
+    with MonitorLog(path, model=model, metadata={"bench": "review"}) as log:
+        for k in range(n_windows):
+            t0 = 0.01 * (k % 500)
+            verdict = "violation" if k % 97 == 5 else "uncertain" if k % 89 == 3 else "certified"
+            ok = verdict == "certified"
+            w = Witness(t0, pair, np.array([0.5, 0.0, 0.2]), -1e-3) if verdict == "violation" else None
+            clearance = 0.01 if ok else float("-inf")
+            pr = PairResult(pair, bodies, verdict, "toleranced", 5, 2, (), clearance, w)
+            cert = Certificate(verdict, (t0, t0 + 0.01), 0.001, 1e-3, "auto", w, None if ok else t0,
+                               clearance, (pr,), {"wall_seconds": float(rng.uniform(1e-4, 1e-2))})
+            plan = types.SimpleNamespace(times=np.array([t0, t0 + 0.01]),
+                                         qpos=np.array([[0.001 * k], [0.001 * k + 0.01]]), model=model)
+            log.write_window(t0, plan, cert, np.array([0.1]), np.array([0.1]), replaced=not ok)
+
+
+def suite_review(cfg: BenchConfig) -> dict[str, Any]:
+    """Per-window cost of reviewing a log: ``read_log``, ``analyze``, ``render_text``.
+
+    Writes one N-window log (N = 2000 quick, 10 000 full, 50 smoke) with
+    :class:`monitor.log.MonitorLog` (journal, finalised into an indexed file on close),
+    then times each review step ``cfg.reps`` times, interleaved; medians are reported in
+    total seconds and microseconds per window. Writing and closing are timed once.
+    """
+    from monitor.log import read_log
+    from monitor.review import analyze, render_text
+
+    n = 50 if cfg.smoke else 2000 if cfg.quick else 10_000
+    path = cfg.out / f"review_{n}.mcap"
+    t = time.perf_counter()
+    _write_review_log(path, n, cfg.seed)
+    t_write = time.perf_counter() - t  # includes close (finalise: chunked, indexed file)
+    times: dict[str, list[float]] = {"read_log": [], "analyze": [], "render_text": []}
+    text = ""
+    for _ in range(max(1, cfg.reps)):
+        t = time.perf_counter()
+        contents = read_log(path, progress=False)
+        t1 = time.perf_counter()
+        entry = analyze(contents)
+        t2 = time.perf_counter()
+        text = render_text({"logs": [entry], "total": None})
+        t3 = time.perf_counter()
+        times["read_log"].append(t1 - t)
+        times["analyze"].append(t2 - t1)
+        times["render_text"].append(t3 - t2)
+    if entry["windows"] != n:
+        raise RuntimeError(f"review read {entry['windows']} of the {n} windows written")
+    med = {k: float(np.median(v)) for k, v in times.items()}
+    med["review (sum)"] = sum(med.values())
+    rows = [{"step": "write + close (once)", "seconds": t_write, "us_per_window": 1e6 * t_write / n}]
+    rows += [{"step": k, "seconds": v, "us_per_window": 1e6 * v / n} for k, v in med.items()]
+    size = path.stat().st_size
+    cfg.log(f"[bench] review: {n} windows ({size / 1e6:.2f} MB): read_log + analyze + render_text "
+            f"{1e6 * med['review (sum)'] / n:.0f} us/window (median of {len(times['read_log'])})")
+    path.unlink(missing_ok=True)  # the log is scratch; keep --out to the report
+    md = [
+        f"Review cost on a {n}-window log ({size / 1e6:.2f} MB, ~2 % of windows not certified), "
+        f"medians of {len(times['read_log'])} repetitions:",
+        report.table(rows, ["step", "seconds", "us_per_window"], ["step", "total (s)", "µs / window"]),
+        f"`render_text` output: {len(text.splitlines())} lines.",
+    ]
+    return {"windows": n, "file_bytes": size, "rows": rows, "markdown": md, "figures": []}
+
+
 def finalize(cfg: BenchConfig, results: dict[str, Any]) -> None:
     """Cross-suite touches after all suites ran: redraw time-vs-epsilon with the peer lines."""
     acc = results["suites"].get("accuracy", {})
@@ -1272,6 +1360,7 @@ SUITE_FUNCS = {
     "seeds": suite_seeds,
     "gate": suite_gate,
     "scaling": suite_scaling,
+    "review": suite_review,
 }
 
 

@@ -2,7 +2,8 @@
 
 Writes ``results.json``, ``results.md`` and the PNG plots to ``--out``. Suites:
 accuracy (run time against error), peers (python-fcl, MuJoCo sampling, ipctk),
-seeds (paper reproductions), gate (overhead on gymnasium envs), scaling.
+seeds (paper reproductions), gate (overhead on gymnasium envs), scaling,
+review (per-window cost of read_log + analyze + render_text on an N-window log).
 A suite whose dependency is missing is recorded as skipped, never silently dropped;
 an exception inside a suite is recorded in the results and the exit code is 1.
 """

@@ -123,6 +123,9 @@ def _read_npz(path: str | Path) -> dict[str, np.ndarray]:
     if head == b"\x93NUMPY":
         raise InvalidInputError(f"{path}: is a single .npy array, not an .npz library (save the plans with "
                                 f"np.savez(..., times=..., qpos=...))")
+    if not zipfile.is_zipfile(p):  # a text file, a pickle, ...: one line, no numpy "allow_pickle" hint
+        raise InvalidInputError(f"{path}: not a readable .npz file (not a zip archive); save the plans with "
+                                f"np.savez(..., times=..., qpos=...)")
     arrays: dict[str, np.ndarray] = {}
     try:
         with zipfile.ZipFile(p) as z:
