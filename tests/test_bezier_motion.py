@@ -198,3 +198,12 @@ def test_bezier_certify_no_false_negatives_quick():
 def test_bezier_certify_no_false_negatives_200(seed):
     """200 seeded cases in two halves of 100 (each run stays short)."""
     _run_bezier_hunt(100, seed)
+
+
+def test_logging_a_bezier_motion_is_a_typed_error():
+    """The log format has no Bézier plan kind yet: the writer must refuse, not drop or re-interpret it."""
+    from monitor.log.writer import _plan_payload
+
+    rng = np.random.default_rng(4)
+    with pytest.raises(InvalidInputError, match="BezierMotion"):
+        _plan_payload(random_motion(rng))

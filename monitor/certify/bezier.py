@@ -22,9 +22,12 @@ by at most ~ (d + 1) n u max|H|. We enlarge R by
 ``sqrt(M) (1 + max|m_i|) sqrt(12) * 16 (d + 1) (n + 1) u max|H| / min w`` (M = total mass),
 which bounds the metric norm of that perturbation of the P_k.
 
-Also here: :func:`quaternion_motion` builds the degree-8 rational motion on SE(3) from a
-degree-4 quaternion polynomial (rotation = quadratic form / |Q|^2) and degree-8 translation
-control points sharing the weights |Q|^2; and :func:`paper72_case` the section 7.2 setting.
+The curves themselves (:class:`RationalBezier`, :class:`RigidBezier`, :func:`quaternion_motion`)
+live in :mod:`monitor.motion.bezier` (re-exported here); :class:`monitor.motion.bezier.BezierMotion`
+makes them a Trajectory for :func:`monitor.certify`. The paper's section 7 fixtures
+(``paper71_motion``, ``octagon``, ``paper72_case``, ``run_paper72``) are in
+:mod:`monitor.bench.paper_bezier`. This module only uses the public subdivision interface of
+:mod:`monitor.certify.toleranced` (``BallProvider``, ``Frontier``, ``PairData``, ``subdivide``).
 """
 
 from __future__ import annotations
