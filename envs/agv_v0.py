@@ -1,7 +1,7 @@
 """``monitor/AGV-v0``: Cameron's AGV and overhead trays, driven by a schedule.
 
 Scene: ``models/agv_trays/scene.xml`` (or ``scene_skewed.xml``), schedules from
-:func:`monitor.certify.extrusion_scenes.schedule` (see the scene's README). The
+:func:`monitor.bench.extrusion_scenes.schedule` (see the scene's README). The
 scene has three slide joints and no actuators: the env is *kinematic*. The
 trays follow the schedule in real time t. The vehicle follows its own
 scheduled path at a rate chosen by the agent: the action a (in [0, 2]) advances
@@ -46,7 +46,7 @@ class AgvEnv(gymnasium.Env):
 
     def __init__(self, schedule: str = "weaving", skewed: bool = False, dt: float = 0.1,
                  render_mode: str | None = None) -> None:
-        from monitor.certify.extrusion_scenes import schedule as get_schedule
+        from monitor.bench.extrusion_scenes import schedule as get_schedule
 
         path = scene("agv_trays")
         if skewed:

@@ -164,7 +164,7 @@ def _run_agv(schedule, mode, steps, rate=1.0):
 
 
 def test_agv_straight_schedule_violation_found_in_its_window():
-    from monitor.certify.extrusion_scenes import STRAIGHT_FIRST_CONTACT
+    from monitor.bench.extrusion_scenes import STRAIGHT_FIRST_CONTACT
 
     rows = _run_agv("straight", "warn", 100)
     first = next(i for i, r in enumerate(rows) if r[0] == "violation")

@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from monitor.certify.extrusion import check_pairs, earliest_violation, search_many
-from monitor.certify.extrusion_scenes import (
+from monitor.bench.extrusion_scenes import (
     AGV_BOXES,
     STRAIGHT_FIRST_CONTACT,
     TRAY_BOXES,
@@ -18,6 +17,7 @@ from monitor.certify.extrusion_scenes import (
     schedule,
     sphere_cube_pair,
 )
+from monitor.certify.extrusion import check_pairs, earliest_violation, search_many
 from monitor.geometry.distance import shape_distance, shape_distance_batch
 
 NEAR_MISS = 3 * math.sqrt(2) - 4

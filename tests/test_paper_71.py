@@ -1,6 +1,6 @@
 """Reproduction of Schröcker & Weber section 7.1: fixed octagon vs moving octagon, degree-8 motion.
 
-How the motion was built (monitor.certify.bezier.paper71_motion): a degree-4 quaternion
+How the motion was built (monitor.bench.paper_bezier.paper71_motion): a degree-4 quaternion
 polynomial Q(t) (5 Bernstein control quaternions, tilting the octagon by up to ~50 degrees
 about varying axes) gives the rotation R(t) = M(Q)/|Q|^2, exactly rigid, numerator and
 denominator of degree 8; the translation is a degree-8 rational Bézier curve with the
@@ -20,7 +20,8 @@ we subdivide breadth first and report all intervals, so our colliding count is l
 import numpy as np
 from scipy.optimize import linprog
 
-from monitor.certify.bezier import check_bezier, first_interval_bezier, octagon, paper71_motion
+from monitor.bench.paper_bezier import octagon, paper71_motion
+from monitor.certify.bezier import check_bezier, first_interval_bezier
 from monitor.certify.toleranced import fixed_features, moving_features
 
 EPS = 0.02
@@ -106,7 +107,7 @@ def test_depth_first_order_like_listing_1():
 
 def test_paper72_small_n_never_certifies_a_colliding_square_pair():
     """Section 7.2 setting at n = 2 (16 square pairs, global and per-square masses)."""
-    from monitor.certify.bezier import paper72_case
+    from monitor.bench.paper_bezier import paper72_case
 
     for mass in ("global", "per-square"):
         case = paper72_case(2, "collision", mass)

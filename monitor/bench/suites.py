@@ -738,8 +738,8 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
         import mujoco
 
         from monitor._paths import models_dir
+        from monitor.bench.extrusion_scenes import schedule
         from monitor.certify.engine import certify
-        from monitor.certify.extrusion_scenes import schedule
         from monitor.motion.plan import Plan
         from monitor.scene import Scene
     except ImportError as exc:
@@ -804,7 +804,8 @@ def _sw_rows(cfg: BenchConfig) -> dict[str, Any]:
     polygon-against-fat-polygon tests (``unit_tests``), summed over the n^4 pairs.
     """
     try:
-        from monitor.certify.bezier import check_bezier, octagon, paper71_motion, paper72_case
+        from monitor.bench.paper_bezier import octagon, paper71_motion, paper72_case
+        from monitor.certify.bezier import check_bezier
         from monitor.certify.common import Budget
         from monitor.certify.toleranced import fixed_features, moving_features
     except ImportError as exc:

@@ -913,6 +913,12 @@ class _Frontier:
     extra: Any = None      # ball-provider state per item (e.g. Bézier control points)
 
 
+# Public names of the subdivision state for ball providers outside this module
+# (monitor.certify.bezier): a frontier of (pair, [t0, t1]) items and a prepared pair.
+Frontier = _Frontier
+PairData = _PairData
+
+
 class BallProvider:
     """Interface: per-item g = (L (N,3,3), p (N,3)) and radius R (N,) for a frontier."""
 
@@ -1270,4 +1276,4 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
 
 __all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
            "subdivide", "check_pairs", "BallProvider", "SubdivisionResult", "first_interval_dfs",
-           "fat_units_fire", "prefilter_separated", "frontier_over_cap"]
+           "fat_units_fire", "prefilter_separated", "frontier_over_cap", "Frontier", "PairData"]

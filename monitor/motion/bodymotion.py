@@ -1,9 +1,14 @@
-r"""Explicit per-body motions: world poses at waypoints, lerp + slerp per body.
+r"""Explicit per-body motions: world poses at waypoints, lerp + slerp or screw per body.
 
 :class:`BodyMotion` implements the :class:`monitor.motion.base.Trajectory`
-protocol without a MuJoCo model (numpy only): each body's origin is lerped and
-its orientation slerped (shortest arc, about the body origin) between waypoint
-poses.
+protocol without a MuJoCo model (numpy only). Two interpolations between
+consecutive waypoint poses:
+
+* ``"lerp_slerp"`` (default): each body's origin is lerped and its orientation
+  slerped (shortest arc, about the body origin).
+* ``"screw"``: the SE(3) geodesic, a constant world twist (screw linear
+  interpolation, :mod:`monitor.motion._screw`). The orientation is the same
+  slerp; the origin follows a helix about the screw axis instead of a line.
 
 Motion bound (derivation). For body b on [ta, tb] with midpoint m, origin x(t),
 rotation R(t) and reference point r = ``ref_points[b]`` (body frame): for any
@@ -25,6 +30,32 @@ of numbers of that size), the angle by rel_pad * (path length + 1) and then
 both by ``Tolerances.pad``-style terms as in :mod:`monitor.motion.plan`.
 A body whose pose is identical at all waypoints gets exactly zero (lerp is
 ``a + s (b - a)`` and slerp of equal quaternions returns them bit-exactly).
+
+Screw motion bound (derivation). The rotation is the slerp, so ``angle`` is the
+same as above. For a body point p, X(t)p - X(m)p = [X(t)r - X(m)r] + (R(t) - R(m))(p - r)
+with r = ``ref_points[b]``, and the second term is at most chord(angle) ||p - r||;
+so ``trans`` only has to bound the displacement of the reference point's world
+image y(t) = X(t) r. On one segment (constant twist (omega, v) per unit parameter,
+duration h) y moves on a helix about the screw axis and, by
+:func:`monitor.motion._screw.helix_span`, for a parameter span sigma
+
+    |y(s0 + sigma) - y(s0)| = sigma sqrt(d^2 + (sinc(|omega| sigma / 2) P)^2)
+                            = sqrt((|v_par| dt)^2 + (chord(|omega| dt) dist(y, axis))^2)
+
+exactly (dt = sigma h; axial advance and chord of the circle are orthogonal), which
+grows with sigma (|omega| sigma <= pi). So on the segment holding the midpoint m the
+maximum over [ta, tb] is this expression at the larger of m - ta, tb - m (clipped
+to the segment). For a piece of [ta, tb] beyond an interior waypoint w (towards the
+end of [ta, tb]): |y(t) - y(m)| <= |y(w) - y(m)| + helix span from w to t, with the
+first term computed from the exact waypoint pose. This is the same piece structure
+as the rotation bound, and it is exact when [ta, tb] holds no waypoint. In the
+contract's terms (per point p, using ||p - axis|| <= ||p - r|| + dist(y(m), axis)):
+this ``trans`` is at most |v_par| h_half + chord(|omega| h_half) dist(y(m), axis),
+with h_half = (tb - ta) / 2 inside one segment.
+Rounding: the computed twist reproduces the end waypoint up to a few ulps of
+max|x| + max|v| + max|r|; the implemented curve and the computed helix constants
+deviate from the ideal helix by the same order, so ``trans`` is padded by
+16 rel_pad (1 + pi) (max|x| + max|v| + max|r|) and then as for lerp_slerp.
 """
 
 from __future__ import annotations
@@ -33,6 +64,7 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
+from monitor.motion import _screw as S
 from monitor.motion.base import MotionBounds, WindowTimes, chord
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -49,15 +81,24 @@ class BodyMotion(WindowTimes):
             bounds (default: the body origins). Choose them near the geometry:
             the bound grows with the distance from them.
         tolerances: rounding pads and the quaternion norm tolerance.
+        interpolation: ``"lerp_slerp"`` (default: lerp of the origin, slerp of the
+            orientation) or ``"screw"`` (constant twist between waypoint poses, the
+            SE(3) geodesic; see the module docstring).
 
     Raises:
         InvalidInputError: NaN/inf, wrong shapes, non-increasing times, fewer
-            than 2 waypoints, non-unit quaternions, or a moving world body
-            (body 0); the message names the offending index.
+            than 2 waypoints, non-unit quaternions, a moving world body
+            (body 0), or an unknown ``interpolation``; the message names the
+            offending index or argument.
     """
 
+    INTERPOLATIONS = ("lerp_slerp", "screw")
+
     def __init__(self, times: object, pos: object, quat: object, *, ref_points: object = None,
-                 tolerances: Tolerances = DEFAULT):
+                 tolerances: Tolerances = DEFAULT, interpolation: str = "lerp_slerp"):
+        if not isinstance(interpolation, str) or interpolation not in self.INTERPOLATIONS:
+            raise InvalidInputError(
+                f"interpolation must be one of {self.INTERPOLATIONS}, got {interpolation!r}")
         t = K.check_times(times)
         p = K.as_float_array("pos", pos)
         q = K.as_float_array("quat", quat)
@@ -99,10 +140,41 @@ class BodyMotion(WindowTimes):
         ref_norm = np.linalg.norm(ref, axis=-1)
         self._scale = float(np.max(np.linalg.norm(p, axis=-1), initial=0.0)) + 3.0 * float(
             np.max(ref_norm, initial=0.0))
+        self._interp = interpolation
+        if interpolation == "screw":
+            self._init_screw()
+
+    def _init_screw(self) -> None:
+        """Per segment and rotating body: twist (omega, v) per unit parameter and helix constants."""
+        p, ref = self._pos, self._ref
+        Km1, nbody = p.shape[0] - 1, p.shape[1]
+        self._omega = np.zeros((Km1, nbody, 3))
+        self._v = np.zeros((Km1, nbody, 3))
+        self._hx_d = np.zeros((Km1, nbody))
+        self._hx_P = np.zeros((Km1, nbody))
+        self._hx_th = np.zeros((Km1, nbody))
+        # world image of each body's reference point at the waypoints (K, nbody, 3)
+        self._ref_W = p + np.einsum("kbij,bj->kbi", K.quat_to_mat(self._quat), ref)
+        seg = np.arange(Km1)
+        for b in np.flatnonzero(self._rotating):
+            om = self._tracks[b].angular_velocity(seg, np.ones(Km1))
+            v = S.twist_translation(om, p[:-1, b], p[1:, b])
+            d, P = S.helix_speeds(om, v, self._ref_W[:-1, b])
+            self._omega[:, b], self._v[:, b] = om, v
+            self._hx_d[:, b], self._hx_P[:, b] = d, P
+            self._hx_th[:, b] = np.linalg.norm(om, axis=-1)
+        vmag = float(np.max(np.abs(self._v), initial=0.0))
+        refmag = float(np.max(np.abs(ref), initial=0.0))
+        self._screw_pad = 16.0 * self._tol.rel_pad * (1.0 + np.pi) * (self._pos_mag + vmag + refmag)
 
     def __repr__(self) -> str:
         return (f"BodyMotion(K={self._times.shape[0]}, window=({self.t0!r}, {self.t1!r}), "
-                f"moving bodies={int(self._moving.sum())}/{self.nbody})")
+                f"moving bodies={int(self._moving.sum())}/{self.nbody}, interpolation={self._interp!r})")
+
+    @property
+    def interpolation(self) -> str:
+        """``"lerp_slerp"`` or ``"screw"``."""
+        return self._interp
 
     @property
     def pos(self) -> np.ndarray:
@@ -128,6 +200,12 @@ class BodyMotion(WindowTimes):
         i, s, at_end = self._seg.locate(t) if loc is None else loc
         pos = K.lerp_values(self._pos, i, s, at_end)
         quat = np.stack([tr.interp(i, s, at_end) for tr in self._tracks], axis=1)
+        if self._interp == "screw":
+            for b in np.flatnonzero(self._rotating):
+                x = S.screw_point(self._omega[i, b], self._v[i, b], s, self._pos[i, b])
+                x[s == 0.0] = self._pos[i[s == 0.0], b]
+                x[at_end] = self._pos[-1, b]
+                pos[:, b] = x
         return pos, quat
 
     def body_poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -173,10 +251,36 @@ class BodyMotion(WindowTimes):
                     th = np.minimum(th * (1.0 + tol.rel_pad) + tol.abs_pad, np.pi)
                 else:
                     th = np.zeros(N)
-                T = dx + chord(th) * np.linalg.norm(self._ref[b])
+                if self._interp == "screw" and self._rotating[b]:
+                    T = self._screw_ref_deviation(b, xm[:, b], qm[:, b], iv) + self._screw_pad
+                else:
+                    T = dx + chord(th) * np.linalg.norm(self._ref[b])
                 trans[:, b] = T * (1.0 + tol.rel_pad) + tol.abs_pad + tol.scale_pad * self._scale
                 angle[:, b] = th
         return trans, angle
+
+    def _screw_ref_deviation(self, b: int, xm: np.ndarray, qm: np.ndarray,
+                             iv: K.IntervalVertices) -> np.ndarray:
+        """Max over t in [ta, tb] of |y(t) - y(m)| (N,) for the helix pieces (module docstring)."""
+        times = self._times
+        h = np.diff(times)
+        Km2 = times.shape[0] - 2
+        d, P, th = self._hx_d[:, b], self._hx_P[:, b], self._hx_th[:, b]
+        i = iv.loc_m[0]
+        left = np.maximum(iv.tm - iv.near_left, 0.0) / h[i]
+        right = np.maximum(iv.near_right - iv.tm, 0.0) / h[i]
+        dev = S.helix_span(d[i], P[i], th[i], np.maximum(left, right))
+        if iv.C:
+            ym = xm + np.einsum("nij,j->ni", K.quat_to_mat(qm), self._ref[b])
+            d_w = np.linalg.norm(self._ref_W[iv.idx, b] - ym[:, None, :], axis=-1)
+            t_w = times[iv.idx]
+            is_left = t_w <= iv.tm[:, None]
+            k = np.clip(np.where(is_left, iv.idx - 1, iv.idx), 0, Km2)
+            sigma = np.abs(iv.outer_t - t_w) / h[k]
+            w = d_w + S.helix_span(d[k], P[k], th[k], sigma)
+            w = np.where(iv.valid, w, 0.0)
+            dev = np.maximum(dev, w.max(axis=1))
+        return dev
 
     def moving_bodies(self) -> np.ndarray:
         """(nbody,) bool: True where the body's waypoint poses are not all identical."""

@@ -216,6 +216,13 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
 
 
 def _pack_body_motion(bm: BodyMotion) -> MotionPack:
+    interp = getattr(bm, "interpolation", "lerp_slerp")
+    if interp != "lerp_slerp":
+        # the compiled kernels implement lerp + slerp only; packing a screw motion would
+        # silently certify a different path
+        raise UnsupportedGeometryError(
+            f"pack_trajectory: BodyMotion interpolation {interp!r} is not supported by the compiled "
+            "kernels (lerp_slerp only); use the Trajectory protocol (body_poses / motion_bounds)")
     pos = bm.pos
     quat = bm.quat
     K, nbody = pos.shape[0], pos.shape[1]
@@ -300,7 +307,8 @@ def pack_trajectory(traj: object) -> MotionPack:
 
     Raises:
         InvalidInputError: ``traj`` is neither.
-        UnsupportedGeometryError: a free joint that is not the only joint of a world child.
+        UnsupportedGeometryError: a free joint that is not the only joint of a world child, or a
+            BodyMotion whose interpolation is not ``"lerp_slerp"`` (e.g. ``"screw"``).
     """
     if isinstance(traj, BodyMotion):
         return _pack_body_motion(traj)
