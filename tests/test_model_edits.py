@@ -265,3 +265,22 @@ def test_every_plan_field_is_seen_by_is_current():
         assert not plan.is_current(), f
         getattr(m, f).flat[0] = old
         assert plan.is_current(), f
+
+
+def test_compiled_stage_sees_an_edit_that_only_collides_mid_window():
+    """The compiled whole-shape stage caches packed geometry per scene: after an in-place edit
+    whose start pose is still clear (so the engine's start-pose test cannot catch it), the
+    stage must use the rebuilt shapes, not the cached ones."""
+    xml = """<mujoco><worldbody>
+      <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.5 0 0"/>
+      <body name="b"><joint name="h" type="hinge" axis="0 0 1"/>
+        <geom name="ball" type="sphere" size="0.1" pos="0.3 0 0"/></body>
+    </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    plan = monitor.Plan([0.0, 0.1], [[-1.0], [1.0]], m)  # a rotating pass, 0.15 m from the post face
+    cert = monitor.certify(scene, plan)
+    assert cert.verdict == "certified" and "toleranced/whole-shape" in cert.stats["checker_mix"], cert.stats
+    m.geom_size[m.geom("ball").id][0] = 0.17  # start still clear (0.35 m), the pass now overlaps 2 cm
+    cert = monitor.certify(scene, monitor.Plan([0.0, 0.1], [[-1.0], [1.0]], m))
+    assert cert.verdict == "violation", cert.stats

@@ -760,11 +760,15 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
     if not _poses_agree(mp, bodies, times, np.ascontiguousarray(P_W, np.float64),
                         np.ascontiguousarray(R_WB, np.float64)):
         return out
-    gp = _SCENE_PACKS.get(scene)
-    if gp is None:
+    # keyed on the scene's current geoms tuple too: Scene.sync() replaces it when it rebuilds the
+    # shapes after an in-place model edit, so a stale pack is never used
+    cached = _SCENE_PACKS.get(scene)
+    if cached is not None and cached[0] is scene.geoms:
+        gp = cached[1]
+    else:
         from monitor.certify.packed import pack_scene
         gp = pack_scene(scene).geoms
-        _SCENE_PACKS[scene] = gp
+        _SCENE_PACKS[scene] = (scene.geoms, gp)
     stack = np.empty((int(tolerances.max_depth) + 2, 3))
     for k, (ga, gb) in enumerate(geom_pairs):
         if budget is not None and budget.exhausted:
