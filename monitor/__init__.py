@@ -3,7 +3,8 @@
 Public API (imported lazily so that ``import monitor`` stays cheap and the
 algorithms never pull in gymnasium or mcap):
 
-* Scene and trajectories: :class:`Scene`, :class:`Plan`, :class:`BodyMotion`
+* Scene and trajectories: :class:`Scene`, :class:`Plan`, :class:`BodyMotion` (lerp/slerp or screw),
+  :class:`BezierMotion` / :class:`RigidBezier` (rational Bézier motions)
 * Certification: :func:`certify`, :class:`Certificate`, :class:`PairResult`, :class:`Witness`
 * Gating: :class:`Gate` (plain MuJoCo), :class:`SafetyGate` (gymnasium wrapper)
 * Logs: :class:`MonitorLog` (``monitor.log``)
@@ -22,6 +23,8 @@ _LAZY = {
     "GeomInfo": "monitor.scene",
     "Plan": "monitor.motion.plan",
     "BodyMotion": "monitor.motion.bodymotion",
+    "BezierMotion": "monitor.motion.bezier",
+    "RigidBezier": "monitor.motion.bezier",
     "certify": "monitor.certify.engine",
     "Certificate": "monitor.certify.certificate",
     "PairResult": "monitor.certify.certificate",

@@ -329,7 +329,10 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     if msg.get("kind", "plan") == "bodymotion":
         from monitor.motion.bodymotion import BodyMotion
 
-        return BodyMotion(times, np.asarray(msg["pos"], np.float64), np.asarray(msg["quat"], np.float64))
+        # the interpolation decides the motion between waypoints: replay exactly the logged one
+        # (older logs have none: lerp + slerp); an unknown value is an InvalidInputError
+        return BodyMotion(times, np.asarray(msg["pos"], np.float64), np.asarray(msg["quat"], np.float64),
+                          interpolation=str(msg.get("interpolation", "lerp_slerp")))
     if msg.get("kind", "plan") != "plan":
         raise InvalidInputError(f"logged plan kind {_short(msg.get('kind'), 40)} is unknown")
     from monitor.motion.plan import Plan

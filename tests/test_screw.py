@@ -240,8 +240,6 @@ def test_screw_certify_no_false_negatives_200(seed):
     _run_screw_hunt(100, seed)
 
 
-@pytest.mark.xfail(strict=True, reason="monitor/log/writer.py and monitor/review.py do not record "
-                   "BodyMotion.interpolation yet (lead: see docs/notes/issue-14-motions.md)")
 def test_screw_bodymotion_log_roundtrip_keeps_interpolation():
     """A logged screw motion must replay as a screw motion, never silently as lerp + slerp."""
     from monitor.log.writer import _plan_payload

@@ -294,7 +294,8 @@ def _plan_payload(plan: Any) -> dict[str, Any]:
                 "mocap_quat": getattr(plan, "mocap_quat", None)}
     if hasattr(plan, "pos") and hasattr(plan, "quat"):
         return {"kind": "bodymotion", "times": np.asarray(plan.times, np.float64),
-                "pos": np.asarray(plan.pos, np.float64), "quat": np.asarray(plan.quat, np.float64)}
+                "pos": np.asarray(plan.pos, np.float64), "quat": np.asarray(plan.quat, np.float64),
+                "interpolation": str(getattr(plan, "interpolation", "lerp_slerp"))}
     raise InvalidInputError(f"plan must be a monitor.Plan or BodyMotion, got {type(plan).__name__}")
 
 
