@@ -74,11 +74,10 @@ from monitor.geometry._gjk import (
     OUT_SIZE,
     _compact,
     _depth_at,
-    _rotate,
     _subalgorithm,
-    _transform,
     core_distance,
     halfspace_distance,
+    pose_relative,
 )
 from monitor.motion.kernel import body_bound, body_pose
 
@@ -178,18 +177,7 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
     needs a translation of at least d_A + d_B: ``upper = -(d_A + d_B)`` (the same
     certificate as ``distance._depth_lp``, at GJK's point instead of the LP optimum).
     """
-    VA = np.empty((PA.shape[0], 3))
-    VB = np.empty((PB.shape[0], 3))
-    z = np.zeros(3)
-    d = np.empty(3)
-    for r in range(3):
-        d[r] = pb[r] - pa[r]
-    _transform(PA, Ra, z, VA)
-    _transform(PB, Rb, d, VB)
-    WNA = np.empty((NA.shape[0], 3))
-    WNB = np.empty((NB.shape[0], 3))
-    _rotate(NA, Ra, WNA)
-    _rotate(NB, Rb, WNB)
+    VA, VB, WNA, WNB = pose_relative(PA, Ra, pa, NA, PB, Rb, pb, NB)
     pad = out[10]
     x = np.empty(3)
     for k in range(3):      # candidates: GJK's point, the vertex centroids of A and of B

@@ -728,6 +728,29 @@ def _edge_perp_bound(VA, VB, EA, EB, v):
 
 
 @njit(cache=True)
+def pose_relative(PA, RA, tA, NA, PB, RB, tB, NB):
+    """Both cores posed in the world frame shifted by ``tA`` (A's translation becomes 0).
+
+    Working relative to A keeps far-from-origin scenes (1e4 m) accurate.
+
+    Returns:
+        VA (nA, 3), VB (nB, 3) posed vertices; WNA (fA, 3), WNB (fB, 3) rotated face normals.
+    """
+    VA = np.empty((PA.shape[0], 3))
+    VB = np.empty((PB.shape[0], 3))
+    d = np.empty(3)
+    for r in range(3):
+        d[r] = tB[r] - tA[r]
+    _transform(PA, RA, np.zeros(3), VA)
+    _transform(PB, RB, d, VB)
+    WNA = np.empty((NA.shape[0], 3))
+    WNB = np.empty((NB.shape[0], 3))
+    _rotate(NA, RA, WNA)
+    _rotate(NB, RB, WNB)
+    return VA, VB, WNA, WNB
+
+
+@njit(cache=True)
 def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a, dpad_b, rel_pad,
                   abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
@@ -754,18 +777,7 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
     xc = np.empty(3)
     na = PA.shape[0]
     nb = PB.shape[0]
-    VA = np.empty((na, 3))
-    VB = np.empty((nb, 3))
-    d = np.empty(3)
-    z = np.zeros(3)
-    for r in range(3):
-        d[r] = tB[r] - tA[r]
-    _transform(PA, RA, z, VA)
-    _transform(PB, RB, d, VB)
-    WNA = np.empty((NA.shape[0], 3))
-    WNB = np.empty((NB.shape[0], 3))
-    _rotate(NA, RA, WNA)
-    _rotate(NB, RB, WNB)
+    VA, VB, WNA, WNB = pose_relative(PA, RA, tA, NA, PB, RB, tB, NB)
     S = 0.0
     for i in range(na):
         for r in range(3):
