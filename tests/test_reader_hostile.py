@@ -18,6 +18,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from mcap_rewrite import rewrite
 
 from monitor.certify.certificate import Certificate, PairResult, Witness
 from monitor.cli import main
@@ -102,26 +103,7 @@ def _record(opcode: int, body: bytes) -> bytes:
 
 def _with_attachments(src: Path, dst: Path, replace: dict[str, bytes | None]) -> None:
     """Copy a log, replacing (bytes) or dropping (None) the named attachments."""
-    from mcap.reader import make_reader
-    from mcap.writer import Writer
-
-    with open(src, "rb") as fi, open(dst, "wb") as fo:
-        r = make_reader(fi)
-        w = Writer(fo, use_chunking=False)
-        w.start(library=r.get_header().library)
-        s = r.get_summary()
-        smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
-        cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
-                for cid, c in s.channels.items()}
-        for m in r.iter_metadata():
-            w.add_metadata(m.name, m.metadata)
-        for a in r.iter_attachments():
-            data = replace.get(a.name, a.data)
-            if data is not None:
-                w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, data)
-        for _, ch, m in r.iter_messages(log_time_order=False):
-            w.add_message(cmap[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
-        w.finish()
+    rewrite(src, dst, attachments=lambda name, data: replace.get(name, data))
 
 
 # --------------------------------------------------------------------------- zeros, sparse, floods

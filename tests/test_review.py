@@ -11,14 +11,12 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from mcap.reader import make_reader
-from mcap.writer import Writer
+from mcap_rewrite import rewrite
 
 import monitor.review as review
 from monitor.certify.certificate import Certificate, PairResult, Witness
 from monitor.cli import main
 from monitor.log import MonitorLog, read_log, topics
-from monitor.log.digest import METADATA_DIGEST
 
 REPO = Path(__file__).resolve().parents[1]
 ARM = REPO / "models" / "arm" / "scene.xml"
@@ -151,29 +149,12 @@ def _consistent_log(path, model, yaws):
 
 def rewrite_plan(src: Path, dst: Path, index: int, edit) -> None:
     """Copy a finished log record by record, applying ``edit(payload)`` to one plan message."""
-    with open(src, "rb") as fi, open(dst, "wb") as fo:
-        r = make_reader(fi)
-        w = Writer(fo, use_chunking=False)
-        w.start(library=r.get_header().library)
-        s = r.get_summary()
-        smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
-        cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
-                for cid, c in s.channels.items()}
-        for m in r.iter_metadata():
-            if m.name == METADATA_DIGEST:  # strip the seal: these tests isolate the recomputation
-                continue
-            w.add_metadata(m.name, m.metadata)
-        for a in r.iter_attachments():
-            w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
-        for _, ch, msg in r.iter_messages(log_time_order=False):
-            data = msg.data
-            if ch.topic == topics.PLAN:
-                obj = json.loads(data)
-                if obj["index"] == index:
-                    edit(obj)
-                    data = json.dumps(obj).encode()
-            w.add_message(cmap[ch.id], msg.log_time, data, msg.publish_time, msg.sequence)
-        w.finish()
+    def one(topic: str, o: dict) -> dict:
+        if topic == topics.PLAN and o.get("index") == index:
+            edit(o)
+        return o
+
+    rewrite(src, dst, msg=one)
 
 
 def test_verify_plumbing_with_oracle_engine(tmp_path, monkeypatch, capsys):

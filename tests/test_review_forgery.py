@@ -8,7 +8,6 @@ engine) is rewritten record by record as a forger would; each forged log must ma
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -17,14 +16,10 @@ from typing import Any
 import mujoco
 import numpy as np
 import pytest
-from mcap.reader import make_reader
-from mcap.writer import CompressionType, Writer
+from mcap_rewrite import rewrite
 
 from monitor.cli import main
 from monitor.log import MonitorLog, topics
-from monitor.log.digest import METADATA_DIGEST
-from monitor.log.reader import _decode_metadata
-from monitor.log.writer import encode_metadata
 
 REPO = Path(__file__).resolve().parents[1]
 ARM = REPO / "models" / "arm" / "scene.xml"
@@ -59,48 +54,6 @@ def genuine(tmp_path_factory) -> dict[str, Any]:
     bad = [k for k, v in enumerate(verdicts) if v != "certified"]
     assert len(bad) >= 2 and "certified" in verdicts
     return {"path": path, "verdicts": verdicts, "bad": bad, "model": model}
-
-
-def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = None,
-            metadata: Callable[[str, dict], dict] | None = None,
-            attachments: Callable[[str, bytes], bytes | None] | None = None,
-            chunked: bool = False) -> None:
-    """Copy a log record by record as a forger's tool would.
-
-    ``msg(topic, payload)`` returns the payload (edited in place or new; raw bytes are
-    written as they are), None to drop it, or a list of payloads to write several;
-    ``metadata(name, values)`` edits decoded metadata values; ``attachments(name, data)``
-    returns new bytes or None to drop.
-    """
-    with open(src, "rb") as fi, open(dst, "wb") as fo:
-        r = make_reader(fi)
-        w = Writer(fo, use_chunking=chunked,
-                   compression=CompressionType.ZSTD if chunked else CompressionType.NONE)
-        w.start(library=r.get_header().library)
-        s = r.get_summary()
-        smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
-        cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
-                for cid, c in s.channels.items()}
-        for m in r.iter_metadata():
-            if m.name == METADATA_DIGEST:  # a forger strips the seal (the log then reads "unsealed")
-                continue
-            values = _decode_metadata(dict(m.metadata))
-            if metadata is not None:
-                values = metadata(m.name, values)
-            w.add_metadata(m.name, encode_metadata(values))
-        for a in r.iter_attachments():
-            data = a.data if attachments is None else attachments(a.name, a.data)
-            if data is not None:
-                w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, data)
-        for _, ch, m in r.iter_messages(log_time_order=False):
-            outs: Any = [m.data]
-            if ch.message_encoding == "json" and msg is not None:
-                res = msg(ch.topic, json.loads(m.data))
-                res = [] if res is None else (res if isinstance(res, list) else [res])
-                outs = [o if isinstance(o, bytes) else json.dumps(o).encode() for o in res]
-            for data in outs:
-                w.add_message(cmap[ch.id], m.log_time, data, m.publish_time, m.sequence)
-        w.finish()
 
 
 def flip(bad: list[int], extra: Callable[[str, dict], Any] | None = None) -> Callable[[str, dict], Any]:

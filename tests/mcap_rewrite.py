@@ -1,0 +1,65 @@
+"""Test helper: copy a monitor log record by record, as a forger's or a repair tool would.
+
+Shared by the review, forgery and hostile-reader tests (one copy of the MCAP plumbing).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from mcap.reader import make_reader
+from mcap.writer import CompressionType, Writer
+
+from monitor.log.digest import METADATA_DIGEST
+from monitor.log.reader import _decode_metadata
+from monitor.log.writer import encode_metadata
+
+
+def _compact(obj: Any) -> bytes:
+    """JSON bytes in the writer's compact form (byte patterns stay comparable with genuine logs)."""
+    return json.dumps(obj, separators=(",", ":")).encode()
+
+
+def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = None,
+            metadata: Callable[[str, dict], dict] | None = None,
+            attachments: Callable[[str, bytes], bytes | None] | None = None,
+            chunked: bool = False) -> None:
+    """Copy ``src`` to ``dst`` record by record; the digest seal is stripped (as a forger would).
+
+    ``msg(topic, payload)`` (JSON channels) returns the payload (edited in place or new; raw bytes
+    are written as they are), None to drop it, or a list of payloads to write several;
+    ``metadata(name, values)`` edits decoded metadata values (without it the stored strings are
+    copied unchanged); ``attachments(name, data)`` returns new bytes or None to drop.
+    """
+    with open(src, "rb") as fi, open(dst, "wb") as fo:
+        r = make_reader(fi)
+        w = Writer(fo, use_chunking=chunked,
+                   compression=CompressionType.ZSTD if chunked else CompressionType.NONE)
+        w.start(library=r.get_header().library)
+        s = r.get_summary()
+        smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
+        cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
+                for cid, c in s.channels.items()}
+        for m in r.iter_metadata():
+            if m.name == METADATA_DIGEST:
+                continue
+            if metadata is None:
+                w.add_metadata(m.name, dict(m.metadata))
+            else:
+                w.add_metadata(m.name, encode_metadata(metadata(m.name, _decode_metadata(dict(m.metadata)))))
+        for a in r.iter_attachments():
+            data = a.data if attachments is None else attachments(a.name, a.data)
+            if data is not None:
+                w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, data)
+        for _, ch, m in r.iter_messages(log_time_order=False):
+            outs: Any = [m.data]
+            if ch.message_encoding == "json" and msg is not None:
+                res = msg(ch.topic, json.loads(m.data))
+                res = [] if res is None else (res if isinstance(res, list) else [res])
+                outs = [o if isinstance(o, bytes) else _compact(o) for o in res]
+            for data in outs:
+                w.add_message(cmap[ch.id], m.log_time, data, m.publish_time, m.sequence)
+        w.finish()
