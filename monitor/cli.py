@@ -1,4 +1,6 @@
-"""Command line: ``monitor {demo,review,bench,certify,acm,pairs} ...`` (also ``python -m monitor ...``).
+"""Command line: ``monitor {demo,review,bench,certify,acm,pairs,warmup} ...``.
+
+Also ``python -m monitor ...``.
 
 Each subcommand lives in ``monitor/commands/<name>.py`` and exposes
 ``add_parser(subparsers)`` and ``run(args) -> int``. They are imported lazily so
@@ -21,6 +23,7 @@ SUBCOMMANDS = {
     "certify": "Certify a library of plans from an .npz file.",
     "acm": "Compute a model's allowed-contact matrix (JSON file).",
     "pairs": "Print the pairs a gate will check, and the allowed ones with reasons.",
+    "warmup": "Compile the certification kernels once (run after installing).",
 }
 
 _ROLE = re.compile(r":(?:func|class|meth|mod|data|attr|obj|exc|ref):`~?([^`]+)`")

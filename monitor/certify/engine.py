@@ -144,8 +144,16 @@ def _stage_budget(bud: Budget, npairs: int) -> Budget:
 
 
 def _make_budget(budget: Any) -> Budget:
-    """The call's budget: ``None`` -> :data:`DEFAULT_BUDGET_SECONDS`; a dict is validated."""
+    """The call's budget: ``None`` -> :data:`DEFAULT_BUDGET_SECONDS`; a dict is validated.
+
+    Before the default budget's clock starts, the kernels are compiled once per process
+    (:func:`monitor.warmup.ensure_warm`): compilation is not certification work and would
+    otherwise make the first windows of a fresh process "uncertain".
+    """
     if budget is None:
+        from monitor.warmup import ensure_warm  # lazy: monitor.certify stays free of mujoco at import
+
+        ensure_warm()
         return Budget(seconds=DEFAULT_BUDGET_SECONDS)
     if isinstance(budget, Budget):
         return budget
