@@ -268,11 +268,13 @@ STRESS_XML = """
 """
 
 
-@pytest.mark.parametrize("step", [1e-11, 1e-8, 1e-4])
-def test_rounding_stress_large_coordinates_tiny_motions(step):
-    """Coordinates ~1e4 m, joint values ~1e3, motions down to 1e-11: pads must cover rounding."""
+def stress_plan(step: float, rng: np.random.Generator) -> tuple[mujoco.MjModel, Plan, np.ndarray]:
+    """The STRESS_XML plan: coordinates ~1e4 m, joint values ~1e3, waypoint steps of ``step``, times ~1e4 s.
+
+    Returns:
+        (model, plan, times (3,)).
+    """
     m = mujoco.MjModel.from_xml_string(STRESS_XML)
-    rng = np.random.default_rng(int(-np.log10(step)))
     K = 3
     q0 = np.array([1234.5, -876.0, *_rand_quat(rng), 9000.0, -7000.0, 5000.0, *_rand_quat(rng)])
     qpos = np.tile(q0, (K, 1))
@@ -283,7 +285,14 @@ def test_rounding_stress_large_coordinates_tiny_motions(step):
             qpos[k, a:a + 4] = qq / np.linalg.norm(qq)
         qpos[k, 6:9] += step * rng.normal(size=3) * 1e3
     times = np.array([0.0, 0.5, 1.5]) + 1e4  # large times as well
-    plan = Plan(times, qpos, model=m)
+    return m, Plan(times, qpos, model=m), times
+
+
+@pytest.mark.parametrize("step", [1e-11, 1e-8, 1e-4])
+def test_rounding_stress_large_coordinates_tiny_motions(step):
+    """Coordinates ~1e4 m, joint values ~1e3, motions down to 1e-11: pads must cover rounding."""
+    rng = np.random.default_rng(int(-np.log10(step)))
+    m, plan, times = stress_plan(step, rng)
     edges = np.linspace(times[0], times[-1], 65)
     mb = plan.motion_bounds(edges[:-1], edges[1:])
     for i in range(0, 64, 3):

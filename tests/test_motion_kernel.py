@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, Slerp
 from test_motion_bounds import (
-    STRESS_XML,
     _oracle_poses,
     _oracle_qpos,
     _rand_quat,
     _random_chain_xml,
     _random_qpos,
+    stress_plan,
 )
 
 from monitor.errors import InvalidInputError
@@ -200,19 +200,8 @@ def test_deep_subdivision(seed):
 @pytest.mark.parametrize("step", [1e-11, 1e-8, 1e-4])
 def test_large_coordinates_tiny_motions(step):
     """1e4 m offsets, joint values ~1e3, motions down to 1e-11: the pads cover rounding."""
-    m = mujoco.MjModel.from_xml_string(STRESS_XML)
     rng = np.random.default_rng(int(-np.log10(step)) + 100)
-    K = 3
-    q0 = np.array([1234.5, -876.0, *_rand_quat(rng), 9000.0, -7000.0, 5000.0, *_rand_quat(rng)])
-    qpos = np.tile(q0, (K, 1))
-    for k in range(1, K):
-        qpos[k, :2] += step * rng.normal(size=2) * 1e3
-        for a in (2, 9):
-            qq = qpos[0, a:a + 4] + step * rng.normal(size=4)
-            qpos[k, a:a + 4] = qq / np.linalg.norm(qq)
-        qpos[k, 6:9] += step * rng.normal(size=3) * 1e3
-    times = np.array([0.0, 0.5, 1.5]) + 1e4
-    plan = Plan(times, qpos, model=m)
+    m, plan, times = stress_plan(step, rng)
     mp = pack_trajectory(plan)
     edges = np.linspace(times[0], times[-1], 65)
     _, _, mb = poses_and_bounds(mp, edges[:-1], edges[1:])
