@@ -187,25 +187,15 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     for (k, s), r in zip(meta, sub.pairs):
         tol_txt = f"{penetration_tol:g} m"
         clear = r.clearance - s if math.isfinite(r.clearance) else r.clearance
-        if s < 0:  # inflated: the floor is a clearance, not a penetration
-            floor_txt = f"{-s:.3g} m"
-            if r.verdict == "certified":
-                note = f"ongoing (within margin): clearance > {floor_txt} certified"
-            elif r.verdict == "violation":
-                note = f"ongoing (within margin): clearance falls below {floor_txt}"
+        if s < 0 or s >= full:  # inflated (floor is a clearance) or fully shrunk (penetration < tol)
+            if s < 0:
+                head, bound = "ongoing (within margin): clearance", f"{-s:.3g} m"
+                texts = ("> {b} certified", "falls below {b}", "> {b} not proven")
             else:
-                note = f"ongoing (within margin): clearance > {floor_txt} not proven"
-            w = r.witness
-            if w is not None:
-                w = Witness(w.time, w.geoms, w.point, float(w.distance) - s)
-            pairs[k] = replace(r, clearance=clear, witness=w, note=note)
-        elif s >= full:
-            if r.verdict == "certified":
-                note = f"ongoing contact: penetration < {tol_txt} certified"
-            elif r.verdict == "violation":
-                note = f"ongoing contact: penetration exceeds {tol_txt}"
-            else:
-                note = f"ongoing contact: penetration < {tol_txt} not proven"
+                head, bound = "ongoing contact: penetration", tol_txt
+                texts = ("< {b} certified", "exceeds {b}", "< {b} not proven")
+            which = {"certified": 0, "violation": 1}.get(str(r.verdict), 2)
+            note = f"{head} {texts[which].format(b=bound)}"
             w = r.witness
             if w is not None:
                 w = Witness(w.time, w.geoms, w.point, float(w.distance) - s)
