@@ -461,6 +461,277 @@ def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
     return cases
 
 
+# --------------------------------------------------------------------------- translating cross-check cases
+XCHECK_KINDS_A = ("box", "hull", "sphere", "capsule")
+XCHECK_KINDS_B = ("box", "hull", "sphere", "capsule", "plane")
+XCHECK_INTENTS = ("clear", "graze", "collide", "tunnel", "start-inside")
+_XCHECK_INTENT_P = (0.28, 0.32, 0.14, 0.14, 0.12)
+
+
+@dataclass(eq=False)
+class TranslatingCase:
+    """Two convex geoms on bodies that translate with piecewise-constant velocity.
+
+    The cross-check of the two certifiers (issue 14) runs both ``method="toleranced"``
+    and ``method="extrusion"`` of :func:`monitor.certify` on such cases. Every body keeps
+    a constant (random) orientation; origins are linear between the waypoints.
+
+    Attributes:
+        name: unique case name (``xc-<seed>-<kind A>-<kind B>-<intent>``).
+        intent: one of :data:`XCHECK_INTENTS` (how it was built, not a label).
+        kinds: (kind A, kind B), from :data:`XCHECK_KINDS_A` / :data:`XCHECK_KINDS_B`.
+        margin: clearance (m) the certificate must prove.
+        shapes: (A, B) :class:`monitor.geometry.shapes.ConvexShape` in their body frames.
+        rotations: (2, 3, 3) constant world rotations R_WB of A and B.
+        times: (K,) waypoint times (s), K >= 2.
+        origins: (K, 2, 3) body origins (m, world) of A and B at the waypoints.
+        b_static: B is welded to the world (its geom is placed on the world body).
+    """
+
+    name: str
+    intent: str
+    kinds: tuple[str, str]
+    margin: float
+    shapes: tuple
+    rotations: np.ndarray
+    times: np.ndarray
+    origins: np.ndarray
+    b_static: bool
+
+    def velocities(self) -> np.ndarray:
+        """(K-1, 2, 3) constant origin velocities (m/s) per segment."""
+        return np.diff(self.origins, axis=0) / np.diff(self.times)[:, None, None]
+
+    def relative_speeds(self) -> np.ndarray:
+        """(K-1,) |v_A - v_B| (m/s) per segment: the Lipschitz constant of the pair's distance.
+
+        For translations the signed distance of A and B is 1-Lipschitz in the relative
+        offset, so on segment k it changes at most at this rate. Padded by 1e-12 relative.
+        """
+        v = self.velocities()
+        return np.linalg.norm(v[:, 0] - v[:, 1], axis=1) * (1 + 1e-12) + 1e-15
+
+    def origins_at(self, times: np.ndarray) -> np.ndarray:
+        """(N, 2, 3) body origins (m, world) at ``times`` (N,) s (linear between waypoints)."""
+        t = np.clip(np.asarray(times, float).reshape(-1), self.times[0], self.times[-1])
+        out = np.empty((len(t), 2, 3))
+        for b in range(2):
+            for c in range(3):
+                out[:, b, c] = np.interp(t, self.times, self.origins[:, b, c])
+        return out
+
+    def distance_bounds(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rigorous (lower (N,), upper (N,)) bounds (m) on the signed distance at ``times`` (N,)."""
+        from monitor.geometry.distance import shape_distance_batch
+
+        P = self.origins_at(times)
+        R = self.rotations
+        return shape_distance_batch(self.shapes[0], (np.broadcast_to(R[0], (len(P), 3, 3)), P[:, 0]),
+                                    self.shapes[1], (np.broadcast_to(R[1], (len(P), 3, 3)), P[:, 1]))
+
+    def scene(self):
+        """Hand-built :class:`monitor.Scene` (no MuJoCo model): bodies (world, A, B), geoms A, B.
+
+        A static B is placed on the world body with its pose baked into the shape.
+        """
+        from monitor.scene import GeomInfo, Scene
+        from monitor.tolerances import DEFAULT
+
+        sa, sb = self.shapes
+        if self.b_static:
+            sb = sb.transformed(self.rotations[1], self.origins[0, 1])
+        geoms = (
+            GeomInfo("A", 0, "A", 1, sa.kind, sa, 0.0, False, False),
+            GeomInfo("B", 1, "world" if self.b_static else "B", 0 if self.b_static else 2, sb.kind, sb,
+                     0.0, self.b_static, False),
+        )
+        return Scene(None, geoms, np.array([[0, 1]], np.int64), ("world", "A", "B"),
+                     np.array([True, False, self.b_static]), 16, DEFAULT)
+
+    def body_motion(self):
+        """The exact motion as a :class:`monitor.BodyMotion` over (world, A, B)."""
+        from monitor.motion.bodymotion import BodyMotion
+
+        K = len(self.times)
+        pos = np.zeros((K, 3, 3))
+        quat = np.zeros((K, 3, 4))
+        quat[:, :, 0] = 1.0
+        for b in range(2):
+            if b == 1 and self.b_static:
+                continue
+            pos[:, b + 1] = self.origins[:, b]
+            quat[:, b + 1] = Rotation.from_matrix(self.rotations[b]).as_quat(scalar_first=True)
+        return BodyMotion(self.times.copy(), pos, quat)
+
+    def to_dict(self) -> dict:
+        """JSON form (for results.json)."""
+        return {"name": self.name, "intent": self.intent, "kinds": list(self.kinds), "margin": self.margin,
+                "times": self.times.tolist(), "origins": self.origins.tolist(), "b_static": self.b_static}
+
+
+def _xc_shape(rng: np.random.Generator, kind: str, thin: bool = False):
+    from monitor.geometry import polytope
+
+    if kind == "box":
+        h = rng.uniform(0.04, 0.2, 3)
+        if thin:
+            h[rng.integers(3)] = rng.uniform(0.002, 0.01)
+        return polytope.box_polytope(h)
+    if kind == "hull":
+        pts = rng.normal(size=(int(rng.integers(6, 12)), 3)) * rng.uniform(0.05, 0.15)
+        if thin:
+            pts[:, rng.integers(3)] *= 0.05
+        return polytope.polytope_from_points(pts)
+    if kind == "sphere":
+        return polytope.sphere_shape(float(rng.uniform(0.01 if thin else 0.03, 0.15)))
+    if kind == "capsule":
+        return polytope.capsule_shape(float(rng.uniform(0.01 if thin else 0.02, 0.08)),
+                                      float(rng.uniform(0.03, 0.15)))
+    return polytope.halfspace_shape()
+
+
+def _closest_translating(case: TranslatingCase, samples: int = 17, levels: int = 3
+                         ) -> tuple[float, float]:
+    """(approximate minimum signed distance (m), its time (s)) over the window.
+
+    For translations the signed distance is convex in time on every segment (it is the
+    signed distance of the origin to the Minkowski difference, which moves linearly), so
+    zooming on the best sample's neighbours keeps the minimiser in the bracket.
+    """
+    best, t_best = np.inf, float(case.times[0])
+    for a0, b0 in zip(case.times[:-1], case.times[1:]):
+        a, b = float(a0), float(b0)
+        for _ in range(levels):
+            ts = np.linspace(a, b, samples)
+            _, up = case.distance_bounds(ts)
+            k = int(np.argmin(up))
+            a, b = float(ts[max(k - 1, 0)]), float(ts[min(k + 1, samples - 1)])
+        if up[k] < best:
+            best, t_best = float(up[k]), float(ts[k])
+    return best, t_best
+
+
+def _normal_at(case: TranslatingCase, t: float) -> np.ndarray:
+    """Unit world direction from B towards A at time ``t`` (the plane normal for a plane B)."""
+    from monitor.geometry.distance import shape_distance
+
+    if case.kinds[1] == "plane":
+        return case.rotations[1] @ np.array([0.0, 0.0, 1.0])
+    P = case.origins_at(np.array([t]))[0]
+    r = shape_distance(case.shapes[0], (case.rotations[0], P[0]), case.shapes[1], (case.rotations[1], P[1]))
+    n = r.p_a - r.p_b
+    nn = float(np.linalg.norm(n))
+    if nn < 1e-12:
+        return _unit(np.random.default_rng(int(1e6 * t) % 2**32))
+    return n / nn
+
+
+def _shift_b(case: TranslatingCase, d: np.ndarray) -> TranslatingCase:
+    origins = case.origins.copy()
+    origins[:, 1] += d
+    return TranslatingCase(case.name, case.intent, case.kinds, case.margin, case.shapes, case.rotations,
+                           case.times, origins, case.b_static)
+
+
+def make_translating_case(seed: int) -> TranslatingCase:
+    """One seeded translating case (a pure function of ``seed``).
+
+    Kinds: A in :data:`XCHECK_KINDS_A`, B in :data:`XCHECK_KINDS_B` (a plane is a
+    static half-space). Margin 0 (70 %) or 1 cm. 2-4 waypoints over a 1 s window; B is
+    static or moves slowly. Intents (the oracle labels the case afterwards):
+
+    * ``clear``: minimum distance margin + 2..30 cm;
+    * ``graze``: margin + 1e-6..1e-2 m (60 %), exactly the margin (10 %), or a shallow
+      penetration of the margin band by 1e-5..1e-3 m (30 %);
+    * ``collide``: penetration of the band by 1 mm..5 cm;
+    * ``tunnel``: one fast straight segment whose start and end poses are clear but
+      which takes A's inner point (vertex mean) through B's (thin plates and small
+      shapes: what endpoint or coarse time sampling misses); always a collision;
+    * ``start-inside``: A's inner point starts at B's (or below the plane) and moves
+      away; always a violation at t0.
+    """
+    rng = np.random.default_rng(seed)
+    ka = XCHECK_KINDS_A[int(rng.integers(len(XCHECK_KINDS_A)))]
+    kb = XCHECK_KINDS_B[int(rng.integers(len(XCHECK_KINDS_B)))]
+    intent = XCHECK_INTENTS[int(rng.choice(len(XCHECK_INTENTS), p=_XCHECK_INTENT_P))]
+    margin = 0.0 if rng.uniform() < 0.7 else 0.01
+    thin = intent == "tunnel"
+    sa, sb = _xc_shape(rng, ka, thin), _xc_shape(rng, kb, thin)
+    rot = np.stack([Rotation.random(random_state=rng).as_matrix() for _ in range(2)])
+    b_static = kb == "plane" or rng.uniform() < 0.5
+    K = 2 if intent == "tunnel" else int(rng.integers(2, 5))
+    times = np.linspace(0.0, 1.0, K)
+    origins = np.zeros((K, 2, 3))
+    u = _unit(rng)
+    n_plane = rot[1] @ np.array([0.0, 0.0, 1.0])
+    if not b_static:  # B first: the tunnel aims at where B is when A passes
+        vb = 0.15 * rng.normal(size=(K - 1, 3)) * rng.uniform(0, 1)
+        origins[1:, 1] = np.cumsum(vb * np.diff(times)[:, None], axis=0)
+    # inner points (the vertex mean lies in the convex core), world offsets from the origins
+    ca = rot[0] @ sa.points.mean(axis=0)
+    cb = rot[1] @ sb.points.mean(axis=0)
+    ra = sa.bounding_radius
+    rb = 0.0 if kb == "plane" else sb.bounding_radius
+    if intent == "tunnel":
+        # straight (one segment) through B's inner point at time tm, so the cores meet at tm;
+        # both ends clear of B unless B's own motion brings it back
+        reach = ra + rb + margin + rng.uniform(0.05, 0.3)
+        if kb == "plane":
+            u = -n_plane  # from above through the plane (ends inside the half-space)
+        tm = float(rng.uniform(0.3, 0.7))
+        b_tm = origins[0, 1] + tm * (origins[1, 1] - origins[0, 1])
+        origins[:, 0] = b_tm + cb - ca + (times[:, None] - tm) * (reach / max(tm, 1 - tm)) * u
+    elif intent == "start-inside":
+        # A's inner point starts at B's inner point (or below the plane) and moves away
+        away = n_plane if kb == "plane" else u
+        start = cb - ca - rng.uniform(0.0, 0.03) * n_plane if kb == "plane" else cb - ca
+        step = rng.uniform(0.1, 0.4) * (times[:, None] / times[-1])
+        origins[:, 0] = start + step * (away + 0.3 * _unit(rng))
+    else:
+        seg = rng.uniform(0.15, 0.5, K - 1)
+        dirs = [u]
+        for _ in range(K - 2):
+            d = dirs[-1] + 0.8 * _unit(rng)
+            dirs.append(d / np.linalg.norm(d))
+        pts = [np.zeros(3)]
+        for L, d in zip(seg, dirs):
+            pts.append(pts[-1] + L * d)
+        pts = np.array(pts)
+        origins[:, 0] = pts - pts.mean(axis=0)
+        if kb == "plane":
+            origins[:, 0] += (0.3 + ra) * n_plane
+    name = f"xc-{seed}-{ka}-{kb}-{intent}"
+    case = TranslatingCase(name, intent, (ka, kb), margin, (sa, sb), rot, times, origins, b_static)
+    if intent in ("tunnel", "start-inside"):
+        return case
+    u_t = rng.uniform()
+    if intent == "clear":
+        target = margin + rng.uniform(0.02, 0.3)
+    elif intent == "collide":
+        target = margin - rng.uniform(1e-3, 0.05)
+    elif u_t < 0.6:
+        target = margin + 10 ** rng.uniform(-6, -2)
+    elif u_t < 0.7:
+        target = margin
+    else:
+        target = margin - 10 ** rng.uniform(-5, -3)
+    # push B away from A's path until clearly apart, then move it along the closest-point
+    # normal so that the minimum over the window is (about) the target
+    away = -n_plane if kb == "plane" else _unit(rng)
+    for _ in range(30):
+        d, t = _closest_translating(case)
+        if d > 0.02:
+            break
+        case = _shift_b(case, (0.1 - min(d, 0.0)) * away)
+    d, t = _closest_translating(case)
+    return _shift_b(case, (d - target) * _normal_at(case, t))
+
+
+def make_translating_cases(n: int, seed0: int = 0) -> list[TranslatingCase]:
+    """``n`` seeded translating cases, seeds ``seed0 .. seed0 + n - 1``."""
+    return [make_translating_case(seed0 + i) for i in range(n)]
+
+
 __all__ = [
     "ShapeSpec",
     "PairCase",
@@ -469,4 +740,10 @@ __all__ = [
     "NEAR_CLEARANCES_FULL",
     "NEAR_CLEARANCES_QUICK",
     "CLEAR_DISTANCE",
+    "TranslatingCase",
+    "make_translating_case",
+    "make_translating_cases",
+    "XCHECK_KINDS_A",
+    "XCHECK_KINDS_B",
+    "XCHECK_INTENTS",
 ]
