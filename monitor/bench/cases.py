@@ -11,8 +11,11 @@ Each geom sits at its body origin with identity orientation, so body-frame and
 geom-frame coordinates coincide for all consumers (MJCF, python-fcl, ipctk,
 ``monitor.geometry``).
 
-Cases come in two groups, ``"translating"`` (no rotation; the extrusion checker
-and the exact LP oracle apply) and ``"rotating"``, and four intents:
+Cases come in four groups, ``"translating"`` (no rotation; the extrusion checker
+and the exact LP oracle apply), ``"rotating"``, ``"screw"`` (the same two poses
+joined by the SE(3) geodesic: ``BodyMotion(interpolation="screw")``, python-fcl
+``CCDM_SCREW``) and ``"bezier"`` (a planar rational Bézier motion of A:
+``BezierMotion``), and four intents:
 ``"collide"`` (paths cross), ``"graze"`` (shallow, brief penetration of depth
 1e-3 / 1e-5 m: the case that time sampling misses), ``"near"`` (designed minimum
 clearance ``c``, from 1e-1 down to 1e-5 m) and ``"clear"`` (about 0.2 m). The intent is only how the
@@ -21,7 +24,9 @@ case was built; the label used for scoring comes from :mod:`monitor.bench.oracle
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -35,6 +40,7 @@ NEAR_CLEARANCES_QUICK = (1e-2, 1e-4)
 GRAZE_DEPTHS_FULL = (1e-3, 1e-5)
 GRAZE_DEPTHS_QUICK = (1e-3,)
 CLEAR_DISTANCE = 0.2
+INTERPOLATIONS = ("lerp_slerp", "screw", "bezier")
 """Designed minimum clearance (m) of the ``"clear"`` cases."""
 
 
@@ -171,6 +177,83 @@ def slerp_matrices(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(q, scalar_first=True).as_matrix().reshape(-1, 3, 3)
 
 
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def _screw_poses(p0: np.ndarray, q0: np.ndarray, twist: np.ndarray, s: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Poses exp(s xi) X0 of a world twist xi = (omega, v): origins (N, 3), rotations (N, 3, 3).
+
+    Closed form (Murray, Li & Sastry, Prop. 2.8) with k = omega / |omega|, v' = v / |omega|,
+    theta = s |omega|: R_s = exp(theta [k]), t_s = (I - R_s)(k x v') + k (k . v') theta.
+    """
+    w, v = twist[:3], twist[3:]
+    R0 = Rotation.from_quat(q0, scalar_first=True).as_matrix()
+    nw = float(np.linalg.norm(w))
+    if nw < 1e-15:
+        return p0[None] + s[:, None] * v[None], np.broadcast_to(R0, (len(s), 3, 3)).copy()
+    k, vp = w / nw, v / nw
+    th = (s * nw)[:, None, None]
+    Kx = _skew(k)
+    Rs = np.eye(3)[None] + np.sin(th) * Kx[None] + (1.0 - np.cos(th)) * (Kx @ Kx)[None]  # Rodrigues
+    t = (np.eye(3)[None] - Rs) @ np.cross(k, vp) + np.outer(s * nw, k * (k @ vp))
+    return np.einsum("nij,j->ni", Rs, p0) + t, Rs @ R0
+
+
+def _screw_speed(p0: np.ndarray, twist: np.ndarray, max_radius: float) -> float:
+    """Bound (m per unit parameter) on the speed of any shape point under the screw."""
+    w, v = twist[:3], twist[3:]
+    nw = float(np.linalg.norm(w))
+    if nw < 1e-15:
+        return float(np.linalg.norm(v))
+    k = w / nw
+    c = np.cross(k, v / nw)  # the axis point nearest the world origin
+    d = p0 - c
+    dist = float(np.linalg.norm(d - (d @ k) * k))
+    return nw * (dist + max_radius) + abs(float(k @ v))
+
+
+def _casteljau(P: np.ndarray, x: float) -> np.ndarray:
+    """Point at parameter x of the polynomial Bézier curve with control points P (n+1, d)."""
+    cur = np.asarray(P, float)
+    while len(cur) > 1:
+        cur = (1.0 - x) * cur[:-1] + x * cur[1:]
+    return cur[0]
+
+
+def _bezier_poses(Q: np.ndarray, T: np.ndarray, W: np.ndarray, s: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Origins (N, 3) and rotations (N, 3, 3) of the rational motion (Q, T) at parameters s (N,).
+
+    R(s) is the rotation of the unit quaternion Q(s) / |Q(s)|; the origin is the rational
+    curve with homogeneous control points (W_k, W_k T_k) (W: Bernstein coefficients of |Q|^2).
+    """
+    q = np.array([_casteljau(Q, x) for x in s])
+    H = np.concatenate([W[:, None], W[:, None] * T], axis=1)
+    h = np.array([_casteljau(H, x) for x in s])
+    return h[:, 1:] / h[:, :1], Rotation.from_quat(q, scalar_first=True).as_matrix()
+
+
+def _bezier_speed(Q: np.ndarray, T: np.ndarray, W: np.ndarray, max_radius: float) -> float:
+    """Bound (m per unit parameter) on the speed of any shape point of the rational motion.
+
+    Angular speed of q = Q/|Q|: 2 |q'| <= 2 |Q'| / |Q| <= 2 m max|Q_{k+1} - Q_k| / sqrt(min W)
+    (|Q|^2 = sum B_k W_k >= min W). Origin x = N~ / W + T_0 with N~ the curve of control
+    points W_k (T_k - T_0): |x'| <= (|N~'| W + |N~| |W'|) / W^2
+    <= n max|dN~_k| / min W + max|N~_k| n max|dW_k| / min W^2 (n = 2m; hodograph and
+    convex-hull bounds of Bernstein polynomials).
+    """
+    m = len(Q) - 1
+    n = 2 * m
+    wmin = float(W.min())
+    omega = 2.0 * m * float(np.linalg.norm(np.diff(Q, axis=0), axis=1).max()) / math.sqrt(wmin)
+    Nt = W[:, None] * (T - T[0])
+    dx = (n * float(np.linalg.norm(np.diff(Nt, axis=0), axis=1).max()) / wmin
+          + float(np.linalg.norm(Nt, axis=1).max()) * n * float(np.abs(np.diff(W)).max()) / wmin**2)
+    return omega * max_radius + dx
+
+
 @dataclass(eq=False)
 class PairCase:
     """Two bodies, one lerp/slerp segment each, window ``[0, duration]`` s.
@@ -185,6 +268,13 @@ class PairCase:
         quat: (2, 2, 4) body orientations (w, x, y, z) [body, waypoint].
         moving: (2,) bool; a non-moving body is welded to the world in the MJCF.
         duration: window length T (s).
+        interpolation: ``"lerp_slerp"`` (default; ``"lerp-slerp"`` accepted), ``"screw"``
+            (constant world twist between the two poses: the SE(3) geodesic, as
+            ``BodyMotion(interpolation="screw")`` and python-fcl's ``CCDM_SCREW``) or
+            ``"bezier"`` (body A follows the rational Bézier motion :attr:`bezier`; B is
+            fixed at its first pose; ``pos``/``quat`` hold A's start and end poses).
+        bezier: for ``"bezier"``: (quat_ctrl (m+1, 4), trans_ctrl (2m+1, 3)) of A, the
+            control points of :class:`monitor.motion.bezier.RigidBezier`; else None.
     """
 
     name: str
@@ -196,14 +286,62 @@ class PairCase:
     quat: np.ndarray
     moving: tuple[bool, bool]
     duration: float = 1.0
+    interpolation: str = "lerp_slerp"
+    bezier: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __post_init__(self) -> None:
+        if self.interpolation == "lerp-slerp":
+            self.interpolation = "lerp_slerp"
+        if self.interpolation not in INTERPOLATIONS:
+            raise ValueError(f"interpolation must be one of {INTERPOLATIONS}, got {self.interpolation!r}")
+        if (self.interpolation == "bezier") != (self.bezier is not None):
+            raise ValueError("bezier control points are given iff interpolation == 'bezier'")
 
     # ----------------------------------------------------------------- motion
     def poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Exact world poses at ``times`` (N,) s: positions (N, 2, 3), rotations (N, 2, 3, 3)."""
+        """Exact world poses at ``times`` (N,) s: positions (N, 2, 3), rotations (N, 2, 3, 3).
+
+        Computed independently of :mod:`monitor.motion` (oracle use): slerp for
+        ``lerp_slerp``; the closed-form exponential of the twist from ``scipy.linalg.logm``
+        for ``screw``; hand-written de Casteljau for ``bezier``.
+        """
         s = np.clip(np.asarray(times, float).reshape(-1) / self.duration, 0.0, 1.0)
+        if self.interpolation == "screw":
+            out = [_screw_poses(self.pos[b, 0], self.quat[b, 0], self._twists[b], s) for b in range(2)]
+            return np.stack([o[0] for o in out], axis=1), np.stack([o[1] for o in out], axis=1)
         P = self.pos[None, :, 0, :] + s[:, None, None] * (self.pos[None, :, 1, :] - self.pos[None, :, 0, :])
         R = np.stack([slerp_matrices(self.quat[b, 0], self.quat[b, 1], s) for b in range(2)], axis=1)
+        if self.interpolation == "bezier":
+            P[:, 0], R[:, 0] = _bezier_poses(self.bezier[0], self.bezier[1], self._bezier_weights, s)
+            P[:, 1], R[:, 1] = P[:1, 1], R[:1, 1]
         return P, R
+
+    @functools.cached_property
+    def _twists(self) -> np.ndarray:
+        """(2, 6) world twists (omega, v) per unit parameter of the two screw segments."""
+        from scipy.linalg import logm
+
+        out = np.zeros((2, 6))
+        for b in range(2):
+            X = [np.eye(4), np.eye(4)]
+            for k in range(2):
+                X[k][:3, :3] = Rotation.from_quat(self.quat[b, k], scalar_first=True).as_matrix()
+                X[k][:3, 3] = self.pos[b, k]
+            if np.array_equal(X[0], X[1]):
+                continue
+            L = np.real(logm(X[1] @ np.linalg.inv(X[0])))
+            out[b] = [L[2, 1], L[0, 2], L[1, 0], *L[:3, 3]]
+        return out
+
+    @functools.cached_property
+    def _bezier_weights(self) -> np.ndarray:
+        """(2m+1,) Bernstein coefficients of |Q(s)|^2, by interpolation at 2m+1 parameters."""
+        Q = self.bezier[0]
+        n = 2 * (len(Q) - 1)
+        s = np.linspace(0.0, 1.0, n + 1)
+        q = np.array([_casteljau(Q, x) for x in s])
+        B = np.array([[math.comb(n, k) * x**k * (1 - x) ** (n - k) for k in range(n + 1)] for x in s])
+        return np.linalg.solve(B, (q * q).sum(axis=1))
 
     def angles(self) -> np.ndarray:
         """(2,) rotation angle (rad) of each body over the window."""
@@ -216,13 +354,23 @@ class PairCase:
     def speed_bounds(self) -> np.ndarray:
         """(2,) bound (m/s) on the speed of any point of each body's shape.
 
-        A point p (body frame) moves with velocity v + omega x R p, so its speed is
-        at most |v| + |omega| max|p|, with v and omega constant over the segment.
-        Padded by 1e-12 relative for rounding.
+        lerp_slerp: a point p (body frame) moves with velocity v + omega x R p, so its
+        speed is at most |v| + |omega| max|p|, with v and omega constant over the segment.
+        screw: a point y moves with omega x y + v = omega x (y - c) + (k.v) k (c on the
+        axis, k its direction), so its speed is |omega| dist(y, axis) + |k.v|, and
+        dist(y, axis) <= dist(origin_0, axis) + max|p| is constant along the helix.
+        bezier: see :func:`_bezier_speed` (hodograph bounds of Q and of the origin curve).
+        Padded by 1e-12 relative for rounding (1e-9 for bezier).
         """
+        r = np.array([s.max_radius for s in self.shapes])
+        if self.interpolation == "screw":
+            return np.array([_screw_speed(self.pos[b, 0], self._twists[b], r[b]) for b in range(2)]) / (
+                self.duration) * (1 + 1e-12) + 1e-15
+        if self.interpolation == "bezier":
+            a = _bezier_speed(self.bezier[0], self.bezier[1], self._bezier_weights, r[0]) / self.duration
+            return np.array([a * (1 + 1e-9) + 1e-15, 0.0])
         v = np.linalg.norm(self.pos[:, 1] - self.pos[:, 0], axis=1) / self.duration
         w = self.angles() / self.duration
-        r = np.array([s.max_radius for s in self.shapes])
         return (v + w * r) * (1 + 1e-12) + 1e-15
 
     def velocities(self) -> np.ndarray:
@@ -262,7 +410,11 @@ class PairCase:
         return np.concatenate(cols, axis=1)
 
     def body_motion(self):
-        """The exact motion as a :class:`monitor.BodyMotion` over (world, A, B)."""
+        """The exact motion over (world, A, B).
+
+        A :class:`monitor.BodyMotion` (lerp_slerp or screw) or a
+        :class:`monitor.motion.bezier.BezierMotion` (bezier).
+        """
         from monitor import BodyMotion
 
         pos = np.zeros((2, 3, 3))
@@ -271,7 +423,12 @@ class PairCase:
         for b in range(2):
             pos[:, b + 1] = self.pos[b]
             quat[:, b + 1] = self.quat[b]
-        return BodyMotion(np.array([0.0, self.duration]), pos, quat)
+        if self.interpolation == "bezier":
+            from monitor.motion.bezier import BezierMotion, RigidBezier
+
+            return BezierMotion((0.0, self.duration), pos[0], quat[0],
+                                {1: RigidBezier(self.bezier[0], self.bezier[1])})
+        return BodyMotion(np.array([0.0, self.duration]), pos, quat, interpolation=self.interpolation)
 
     def scene(self, facets: int = 16):
         """``monitor.Scene`` of :attr:`model` with all pairs (one candidate pair)."""
@@ -289,6 +446,8 @@ class PairCase:
             "quat": self.quat.tolist(),
             "moving": list(self.moving),
             "duration": self.duration,
+            "interpolation": self.interpolation,
+            "bezier": None if self.bezier is None else [np.asarray(x).tolist() for x in self.bezier],
         }
 
 
@@ -343,18 +502,9 @@ def min_distance(case: PairCase, dist: Callable[[PairCase, float], float], sampl
 
 def _shifted(case: PairCase, w: np.ndarray, s: float) -> PairCase:
     pos = case.pos.copy()
-    pos[0] += s * w
-    out = PairCase(
-        case.name,
-        case.group,
-        case.intent,
-        case.nominal,
-        case.shapes,
-        pos,
-        case.quat,
-        case.moving,
-        case.duration,
-    )
+    pos[0] += s * w  # a constant shift of both poses shifts the lerp, the screw and the Bézier
+    bez = None if case.bezier is None else (case.bezier[0], case.bezier[1] + s * w)
+    out = dataclasses.replace(case, pos=pos, bezier=bez)
     if "model" in case.__dict__:  # A always moves (free joint), so the compiled model is shared
         out.__dict__["model"] = case.__dict__["model"]
     return out
@@ -368,6 +518,10 @@ def _place(case: PairCase, w: np.ndarray, target: float, dist) -> PairCase:
     lo, hi = 0.0, case.shapes[0].max_radius + case.shapes[1].max_radius + target + 0.05
     f_lo = min_distance(_shifted(case, w, lo), dist) - target
     f_hi = min_distance(_shifted(case, w, hi), dist) - target
+    while f_hi < 0 and hi < 20.0:  # a curved path (screw, Bézier) can sweep wider than the bracket
+        lo, f_lo = hi, f_hi
+        hi *= 2.0
+        f_hi = min_distance(_shifted(case, w, hi), dist) - target
     side = 0
     s = hi
     for _ in range(60):  # regula falsi (Illinois) on the bracket [lo, hi]
@@ -458,7 +612,93 @@ def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
                 else:
                     case.nominal = min_distance(case, dist)
                 cases.append(case)
+    cases += _motion_cases(rng, quick, dist)
     return cases
+
+
+MOTION_INTENTS_FULL = (
+    ("collide", -1.0), ("graze", -1e-3), ("near", 1e-2), ("near", 1e-4), ("clear", CLEAR_DISTANCE))
+MOTION_INTENTS_QUICK = (("collide", -1.0), ("graze", -1e-3), ("near", 1e-2))
+
+
+def planar_bezier(rng: np.random.Generator, travel: float, u: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """A smooth planar rational Bézier motion of degree 4: (quat_ctrl (3, 4), trans_ctrl (5, 3)).
+
+    The rotation turns about the plane normal n by 0 .. a (a in [0.5, 2] rad) through a
+    quadratic quaternion polynomial with control points q_n(0), q_n(a/2), q_n(a) (times a
+    random base orientation); the origin's control polygon is a cubic S-curve from
+    -travel u to +travel u in the plane (through lateral offsets), degree-elevated to 4.
+    The weights (Bernstein coefficients of |Q|^2) are positive for a <= 2.
+    """
+    n = np.cross(u, _unit(rng))
+    n /= np.linalg.norm(n)
+    e = np.cross(n, u)
+    a = rng.uniform(0.5, 2.0)
+    base = Rotation.random(random_state=rng)
+    Q = np.array([(Rotation.from_rotvec(phi * n) * base).as_quat(scalar_first=True) for phi in (0, a / 2, a)])
+    for k in range(1, 3):  # one sign branch: consecutive control quaternions within 90 degrees
+        if Q[k] @ Q[k - 1] < 0:
+            Q[k] *= -1
+    b1, b2 = rng.uniform(-0.3, 0.3, 2)
+    C = np.array([-travel * u, -travel / 3 * u + b1 * e, travel / 3 * u + b2 * e, travel * u])
+    E = np.array([C[0]] + [(k / 4) * C[k - 1] + (1 - k / 4) * C[k] for k in (1, 2, 3)] + [C[3]])
+    return Q, E
+
+
+def _motion_cases(rng: np.random.Generator, quick: bool, dist) -> list[PairCase]:
+    """Screw cases (constant twist between two poses) and planar Bézier cases (issue 14).
+
+    Screw: A turns by 0.5..2.5 rad about a random axis while its origin goes from
+    -travel u to +travel u, interpolated as the SE(3) geodesic (a helix, not the lerp
+    line); every other case B screws too (0.6 rad, 15 cm). Bézier: A follows
+    :func:`planar_bezier`, B is fixed. Quick: 3 + 3 cases (box-box screw, hull-box Bézier).
+    """
+    combos = [("box", "box"), ("hull", "box"), ("hull", "hull"), ("capsule", "box"), ("sphere", "hull")]
+    intents = MOTION_INTENTS_QUICK if quick else MOTION_INTENTS_FULL
+    out: list[PairCase] = []
+    for interp in ("screw", "bezier"):
+        for ka, kb in ([combos[0]] if interp == "screw" else [combos[1]]) if quick else combos:
+            for k, (intent, c) in enumerate(intents):
+                both = interp == "screw" and bool(k % 2)
+                shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
+                u = _unit(rng)
+                w = np.cross(u, _unit(rng))
+                w /= np.linalg.norm(w)
+                travel = rng.uniform(0.5, 0.9)
+                pos = np.zeros((2, 2, 3))
+                quat = np.zeros((2, 2, 4))
+                qa, qb = _random_quat(rng), _random_quat(rng)
+                quat[0, :], quat[1, :] = qa, qb
+                bez = None
+                if interp == "screw":
+                    pos[0, 0], pos[0, 1] = -travel * u, travel * u
+                    ra = Rotation.from_rotvec(rng.uniform(0.5, 2.5) * _unit(rng)) * Rotation.from_quat(
+                        qa, scalar_first=True)
+                    quat[0, 1] = ra.as_quat(scalar_first=True)
+                    if both:
+                        pos[1, 1] = 0.15 * _unit(rng)
+                        rb = Rotation.from_rotvec(0.6 * _unit(rng)) * Rotation.from_quat(
+                            qb, scalar_first=True)
+                        quat[1, 1] = rb.as_quat(scalar_first=True)
+                    for b in range(2):
+                        if quat[b, 0] @ quat[b, 1] < 0:
+                            quat[b, 1] *= -1
+                else:
+                    bez = planar_bezier(rng, travel, u)
+                    pos[0, 0], pos[0, 1] = bez[1][0], bez[1][-1]
+                    quat[0, 0] = bez[0][0] / np.linalg.norm(bez[0][0])
+                    quat[0, 1] = bez[0][-1] / np.linalg.norm(bez[0][-1])
+                name = f"{interp[:3]}-{ka}-{kb}-{intent}" + (
+                    f"-{abs(c):.0e}" if intent in ("near", "graze") else "")
+                case = PairCase(name, interp, intent, c, shapes, pos, quat, (True, both),
+                                interpolation=interp, bezier=bez)
+                if intent != "collide":
+                    case = _place(case, w, c, dist)
+                else:
+                    case.nominal = min_distance(case, dist)
+                out.append(case)
+    return out
 
 
 # --------------------------------------------------------------------------- translating cross-check cases
@@ -740,6 +980,8 @@ __all__ = [
     "NEAR_CLEARANCES_FULL",
     "NEAR_CLEARANCES_QUICK",
     "CLEAR_DISTANCE",
+    "INTERPOLATIONS",
+    "planar_bezier",
     "TranslatingCase",
     "make_translating_case",
     "make_translating_cases",
