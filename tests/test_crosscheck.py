@@ -135,3 +135,22 @@ def test_translating_cases_are_seeded():
     assert np.array_equal(a.shapes[0].points, b.shapes[0].points)
     assert make_translating_case(18).name != a.name or not np.array_equal(
         make_translating_case(18).origins, a.origins)
+
+
+def test_crosscheck_bench_row(tmp_path):
+    """The bench row (smoke size): counts, reasons and the markdown table; 0 contradictions."""
+    from monitor.bench.suites import BenchConfig, _same_case_crosscheck, suite_crosscheck
+
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
+    res = suite_crosscheck(cfg)
+    summ = res["summary"]
+    assert summ["n"] == 12 and summ["contradictions"] == 0 and summ["false_negatives"] == 0
+    assert sum(summ["verdict_pairs"].values()) == 12
+    assert "| n | contradictions |" in "\n".join(res["markdown"])
+    # the same-case comparison inside suite_accuracy counts a contradiction when there is one
+    per_case = [{"case": "a", "checker": "extrusion", "epsilon": None, "verdict": "violation"},
+                {"case": "a", "checker": "toleranced", "epsilon": 1e-3, "verdict": "certified"},
+                {"case": "b", "checker": "extrusion", "epsilon": None, "verdict": "certified"},
+                {"case": "b", "checker": "toleranced", "epsilon": 1e-3, "verdict": "uncertain"}]
+    (row,) = _same_case_crosscheck(per_case)
+    assert row["contradictions"] == 1 and row["ext_cert_tol_uncertain"] == 1 and row["agree"] == 0

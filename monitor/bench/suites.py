@@ -345,6 +345,27 @@ def crosscheck_summary(entries: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def _same_case_crosscheck(per_case: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Toleranced (per epsilon) against extrusion verdicts on the accuracy suite's translating cases."""
+    ext = {e["case"]: e["verdict"] for e in per_case if e["checker"] == "extrusion"}
+    rows = []
+    for eps in sorted({e["epsilon"] for e in per_case if e["checker"] == "toleranced"}, reverse=True):
+        vv = [(e["verdict"], ext[e["case"]]) for e in per_case
+              if e["checker"] == "toleranced" and e["epsilon"] == eps and e["case"] in ext]
+        if not vv:
+            continue
+        rows.append({
+            "epsilon": eps,
+            "n": len(vv),
+            "contradictions": sum({a, b} == {"certified", "violation"} for a, b in vv),
+            "agree": sum(a == b for a, b in vv),
+            "ext_cert_tol_uncertain": sum((a, b) == ("uncertain", "certified") for a, b in vv),
+            "tol_cert_ext_uncertain": sum((a, b) == ("certified", "uncertain") for a, b in vv),
+            "other_disagreements": sum(a != b and "certified" not in (a, b) for a, b in vv),
+        })
+    return rows
+
+
 def suite_crosscheck(cfg: BenchConfig) -> dict[str, Any]:
     """The two certifiers on seeded translating cases: contradictions (must be 0) and why they differ.
 
@@ -366,7 +387,6 @@ def suite_crosscheck(cfg: BenchConfig) -> dict[str, Any]:
     cfg.log(f"[bench] cross-check: {n} cases built in {t1 - t:.1f} s, both certifiers in {t2 - t1:.1f} s, "
             f"{summ['contradictions']} contradictions")
     row = {k: v for k, v in summ.items() if not isinstance(v, dict)}
-    row["us_median_pair_of_calls"] = None
     cols = ["n", "contradictions", "false_negatives", "agree", "tol_cert_ext_uncertain",
             "ext_cert_tol_uncertain", "tol_viol_ext_uncertain", "ext_viol_tol_uncertain"]
     md = [
@@ -426,6 +446,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
             if ee:
                 rows.append({"checker": method, "epsilon": eps, "group": group, **_score(ee)})
     facets = {"skipped": "smoke run"} if cfg.smoke or cfg.shared.get("skip_facets") else _facet_sweep(cfg)
+    xcheck = {"skipped": "skip_crosscheck"} if cfg.shared.get("skip_crosscheck") else suite_crosscheck(cfg)
     figs = []
     peer_lines = cfg.shared.get("peer_lines", {})
     _plot_time_vs_epsilon(cfg, rows, eps_list, peer_lines)
@@ -482,11 +503,20 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     ]
     if facets.get("rows"):
         md += [facets["note"], report.table(facets["rows"], facets["cols"])]
+    md += xcheck.get("markdown", [f"Cross-check skipped: {xcheck.get('skipped')}"])
+    same = _same_case_crosscheck(per_case)
+    if same:
+        md += ["The two certifiers on this suite's own translating cases (same case, toleranced at each "
+               "epsilon against extrusion; contradictions must be 0):",
+               report.table(same, ["epsilon", "n", "contradictions", "agree", "ext_cert_tol_uncertain",
+                                   "tol_cert_ext_uncertain", "other_disagreements"])]
     return {
         "rows": rows,
         "per_case": per_case,
         "warmup": warm,
         "facets": facets,
+        "crosscheck": {k: v for k, v in xcheck.items() if k != "markdown"},
+        "crosscheck_same_cases": same,
         "cases": [dict(c.to_dict(), oracle=lab.to_dict()) for c, lab in zip(cases, labels)],
         "oracle_backend": oracle.backend_name(),
         "markdown": md,
@@ -1529,6 +1559,9 @@ __all__ = [
     "BenchConfig",
     "SUITE_FUNCS",
     "suite_accuracy",
+    "suite_crosscheck",
+    "crosscheck_case",
+    "crosscheck_summary",
     "suite_peers",
     "suite_seeds",
     "suite_gate",
