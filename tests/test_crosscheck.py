@@ -154,3 +154,27 @@ def test_crosscheck_bench_row(tmp_path):
                 {"case": "b", "checker": "toleranced", "epsilon": 1e-3, "verdict": "uncertain"}]
     (row,) = _same_case_crosscheck(per_case)
     assert row["contradictions"] == 1 and row["ext_cert_tol_uncertain"] == 1 and row["agree"] == 0
+
+
+def test_crosscheck_detects_a_contradiction(monkeypatch):
+    """The harness can fail: an extrusion checker that certified everything would be caught."""
+    from types import SimpleNamespace
+
+    import monitor.certify.engine as engine
+
+    real = engine.certify
+
+    def lying(scene, plan, *args, method="auto", **kw):
+        cert = real(scene, plan, *args, method=method, **kw)
+        if method != "extrusion":
+            return cert
+        pair = SimpleNamespace(method="extrusion", note="", tests=0)
+        return SimpleNamespace(verdict="certified", pairs=(pair,), clearance=1.0)
+
+    monkeypatch.setattr(engine, "certify", lying)
+    case = next(c for c in (make_translating_case(s) for s in range(40)) if c.intent == "start-inside")
+    e = crosscheck_case(case)
+    assert e["toleranced"]["verdict"] == "violation" and e["extrusion"]["verdict"] == "certified"
+    assert e["contradiction"] and e["false_negative"] and e["reason"].startswith("CONTRADICTION")
+    with pytest.raises(AssertionError):
+        _check([e] * 10)
