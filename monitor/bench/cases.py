@@ -646,18 +646,20 @@ def planar_bezier(rng: np.random.Generator, travel: float, u: np.ndarray
     return Q, E
 
 
-def _motion_cases(rng: np.random.Generator, quick: bool, dist) -> list[PairCase]:
+def _motion_cases(rng: np.random.Generator, quick: bool, dist,
+                  groups: tuple[str, ...] = ("screw", "bezier")) -> list[PairCase]:
     """Screw cases (constant twist between two poses) and planar Bézier cases (issue 14).
 
     Screw: A turns by 0.5..2.5 rad about a random axis while its origin goes from
     -travel u to +travel u, interpolated as the SE(3) geodesic (a helix, not the lerp
     line); every other case B screws too (0.6 rad, 15 cm). Bézier: A follows
     :func:`planar_bezier`, B is fixed. Quick: 3 + 3 cases (box-box screw, hull-box Bézier).
+    ``groups`` selects the interpolations (the RNG stream then differs from the default).
     """
     combos = [("box", "box"), ("hull", "box"), ("hull", "hull"), ("capsule", "box"), ("sphere", "hull")]
     intents = MOTION_INTENTS_QUICK if quick else MOTION_INTENTS_FULL
     out: list[PairCase] = []
-    for interp in ("screw", "bezier"):
+    for interp in groups:
         for ka, kb in ([combos[0]] if interp == "screw" else [combos[1]]) if quick else combos:
             for k, (intent, c) in enumerate(intents):
                 both = interp == "screw" and bool(k % 2)
