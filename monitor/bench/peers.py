@@ -5,13 +5,15 @@ combination is unsupported for the case. Peers (all optional, import-guarded; th
 ``bench`` extra installs python-fcl and ipctk):
 
 * python-fcl ``continuousCollide`` with each ``CCDMotionType`` x ``CCDSolverType``
-  (the default ``CCDC_NAIVE`` takes 10 samples). Combinations are first probed in a
+  (the default ``CCDC_NAIVE`` takes 10 samples). Screw cases are run only with
+  ``CCDM_SCREW`` (the same interpolation); Bézier cases are unsupported
+  (:func:`peer_support`). Combinations are first probed in a
   subprocess (:func:`probe_fcl`), so a crash is recorded instead of killing the run;
   output printed by the C++ library ("Invalid continuous collision ...", "not
   supported") is captured at the file-descriptor level.
 * MuJoCo sampling: ``mj_geomDistance < 0`` at N evenly spaced samples of the true
-  motion (time order, stop at the first hit). Pose evaluation (lerp/slerp to qpos)
-  is precomputed outside the timed region, which favours the peer.
+  motion (time order, stop at the first hit; lerp/slerp, screw and Bézier cases). Pose
+  evaluation (poses to qpos) is precomputed outside the timed region, which favours the peer.
 * ipctk Tight-Inclusion CCD: ``is_step_collision_free`` on the hull triangle meshes
   with vertices linearly interpolated between the start and end poses (exact for
   translations; for rotations the chord motion is not the true motion). Boundary CCD
@@ -300,6 +302,34 @@ class IpctkPeer:
         return (not ipctk.is_step_collision_free(mesh, V0, V1)), None
 
 
+def peer_support(peer: object, case: PairCase, probe: dict[str, dict] | None = None) -> str | None:
+    """None if ``peer`` answers about the case's true motion, else why it is unsupported.
+
+    * python-fcl: lerp/slerp cases as before (every motion type is run; the probe decides
+      which combinations work per shape kind). Screw cases: only ``CCDM_SCREW``, whose
+      ``ScrewMotion`` is the same constant twist between the two poses (the SE(3)
+      geodesic); the other motion types interpolate differently. Bézier cases: none
+      (fcl has no rational Bézier motion; ``CCDM_SPLINE`` is a B-spline of its own).
+    * MuJoCo sampling: every case (samples of :meth:`PairCase.poses`).
+    * ipctk: lerp/slerp cases only (it interpolates vertices linearly).
+    """
+    interp = getattr(case, "interpolation", "lerp_slerp")
+    if isinstance(peer, FclPeer):
+        if interp == "bezier":
+            return "fcl has no rational Bézier motion"
+        if interp == "screw" and peer.motion != "CCDM_SCREW":
+            return f"fcl {peer.motion} is not the screw motion"
+        kinds = {s.kind for s in case.shapes}
+        bad = [k for k in sorted(kinds) if (probe or {}).get(f"{peer.motion}|{peer.solver}|{k}", {}).get(
+            "status") != "ok"]
+        if bad:
+            return f"probe failed for {', '.join(bad)}"
+        return None
+    if isinstance(peer, IpctkPeer) and interp != "lerp_slerp":
+        return f"ipctk interpolates vertices linearly, not the {interp} motion"
+    return None
+
+
 def timed(fn: Callable[[], object], reps: int) -> tuple[object, float]:
     """(last result, median seconds) of ``reps`` calls of ``fn``."""
     ts, out = [], None
@@ -320,6 +350,7 @@ __all__ = [
     "have_ipctk",
     "fcl_geometry",
     "timed",
+    "peer_support",
     "PeerAnswer",
     "FCL_MOTIONS",
     "FCL_SOLVERS",

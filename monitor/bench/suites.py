@@ -81,6 +81,12 @@ def _pct(xs: list[float], q: float) -> float | None:
 
 
 # ------------------------------------------------------------------------------ shared case set
+def _groups(cases: list[PairCase]) -> list[str]:
+    """Row groups of the tables: rotating, translating, then screw / bezier when present, then all."""
+    present = {c.group for c in cases}
+    return [g for g in ("rotating", "translating", "screw", "bezier") if g in present] + ["all"]
+
+
 def case_set(cfg: BenchConfig) -> tuple[list[PairCase], list[oracle.OracleLabel]]:
     """The seeded cases and their oracle labels (built once per run)."""
     if "cases" not in cfg.shared:
@@ -242,6 +248,162 @@ def jit_warmup(cfg: BenchConfig) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------------------ suite 1
+# ------------------------------------------------------------------------------ cross-check (issue 14)
+XCHECK_METHODS = ("toleranced", "extrusion")
+XCHECK_BUDGET_TESTS = 200_000
+"""Elementary-test budget per certify call in the cross-check (deterministic, unlike seconds)."""
+
+
+def _xc_band(gap: float, epsilon: float) -> str:
+    """Coarse band of a clearance gap (m) = oracle min distance - margin, for the "why" column."""
+    if not math.isfinite(gap):
+        return "unknown"
+    if gap < 0:  # the oracle's smallest sampled upper bound: a lower bound on the depth
+        depth = -gap
+        return ("enters the band by < 1e-5 m" if depth < 1e-5 else
+                "enters the band by 1e-5..1e-3 m" if depth < 1e-3 else "enters the band by >= 1e-3 m")
+    if gap <= 1e-9:
+        return "touching (gap <= 1e-9 m)"
+    if gap < epsilon:
+        return "gap < epsilon"
+    if gap < 10 * epsilon:
+        return "gap in [epsilon, 10 epsilon)"
+    return "gap >= 10 epsilon"
+
+
+def crosscheck_case(case: Any, epsilon: float = 1e-3, budget_tests: int | None = XCHECK_BUDGET_TESTS
+                    ) -> dict[str, Any]:
+    """Certify one :class:`monitor.bench.cases.TranslatingCase` with both certifiers.
+
+    Runs ``monitor.certify`` with ``method="toleranced"`` and ``method="extrusion"``
+    (budget: ``budget_tests`` elementary tests, no wall-clock limit, so the outcome is
+    deterministic). When the verdicts differ, the independent oracle
+    (:func:`monitor.bench.oracle.translating_label`: dense sampling with the exact
+    Lipschitz margin, plus the exact LP for polytope / half-space pairs) labels the case.
+
+    Returns:
+        dict with ``case``, ``intent``, ``kinds``, ``margin``, per method ``verdict`` /
+        ``pair_method`` / ``clearance`` / ``note`` (keys ``toleranced``, ``extrusion``),
+        ``contradiction`` (certified by one, violation by the other), ``disagreement``
+        (the verdicts differ), ``oracle`` (label dict or None), ``false_negative`` (a
+        checker certified an oracle-collide case) and ``reason`` (why they differ, or "").
+    """
+    from monitor.certify.common import Budget
+    from monitor.certify.engine import certify
+
+    scene, motion = case.scene(), case.body_motion()
+    out: dict[str, Any] = {"case": case.name, "intent": case.intent, "kinds": "-".join(case.kinds),
+                           "margin": case.margin}
+    for method in XCHECK_METHODS:
+        budget = Budget(tests=budget_tests) if budget_tests is not None else Budget()
+        cert = certify(scene, motion, margin=case.margin, epsilon=epsilon, method=method, budget=budget)
+        pr = cert.pairs[0] if cert.pairs else None
+        out[method] = {"verdict": cert.verdict, "pair_method": pr.method if pr else None,
+                       "clearance": cert.clearance, "note": pr.note if pr else "",
+                       "tests": pr.tests if pr else 0}
+    vt, ve = out["toleranced"]["verdict"], out["extrusion"]["verdict"]
+    out["contradiction"] = {vt, ve} == {"certified", "violation"}
+    out["disagreement"] = vt != ve
+    out["oracle"], out["false_negative"], out["reason"] = None, False, ""
+    if out["disagreement"]:
+        from monitor.bench.oracle import translating_label
+
+        lab = translating_label(case)
+        out["oracle"] = lab.to_dict()
+        out["false_negative"] = lab.label == "collide" and "certified" in (vt, ve)
+        if out["contradiction"]:
+            out["reason"] = f"CONTRADICTION (oracle {lab.label})"
+        else:
+            other = "toleranced" if vt != "uncertain" else "extrusion"
+            unsure = "extrusion" if other == "toleranced" else "toleranced"
+            gap = lab.distance_upper - case.margin
+            pm = out[unsure]["pair_method"]
+            via = f" ({pm})" if pm not in (None, unsure) else ""
+            out["reason"] = (f"{out[other]['verdict']} by {other}, {unsure} uncertain{via}; "
+                             f"oracle {lab.label}, {_xc_band(gap, epsilon)}")
+    return out
+
+
+def crosscheck_summary(entries: list[dict[str, Any]]) -> dict[str, Any]:
+    """Counts over :func:`crosscheck_case` results: contradictions, one-sided verdicts, reasons."""
+    from collections import Counter
+
+    pairs = Counter((e["toleranced"]["verdict"], e["extrusion"]["verdict"]) for e in entries)
+    reasons = Counter(e["reason"] for e in entries if e["reason"])
+    return {
+        "n": len(entries),
+        "contradictions": sum(e["contradiction"] for e in entries),
+        "false_negatives": sum(e["false_negative"] for e in entries),
+        "agree": sum(not e["disagreement"] for e in entries),
+        "tol_cert_ext_uncertain": pairs[("certified", "uncertain")],
+        "ext_cert_tol_uncertain": pairs[("uncertain", "certified")],
+        "tol_viol_ext_uncertain": pairs[("violation", "uncertain")],
+        "ext_viol_tol_uncertain": pairs[("uncertain", "violation")],
+        "verdict_pairs": {f"{a}/{b}": n for (a, b), n in sorted(pairs.items())},
+        "reasons": dict(reasons.most_common()),
+        "intents": dict(Counter(e["intent"] for e in entries)),
+    }
+
+
+def _same_case_crosscheck(per_case: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Toleranced (per epsilon) against extrusion verdicts on the accuracy suite's translating cases."""
+    ext = {e["case"]: e["verdict"] for e in per_case if e["checker"] == "extrusion"}
+    rows = []
+    for eps in sorted({e["epsilon"] for e in per_case if e["checker"] == "toleranced"}, reverse=True):
+        vv = [(e["verdict"], ext[e["case"]]) for e in per_case
+              if e["checker"] == "toleranced" and e["epsilon"] == eps and e["case"] in ext]
+        if not vv:
+            continue
+        rows.append({
+            "epsilon": eps,
+            "n": len(vv),
+            "contradictions": sum({a, b} == {"certified", "violation"} for a, b in vv),
+            "agree": sum(a == b for a, b in vv),
+            "ext_cert_tol_uncertain": sum((a, b) == ("uncertain", "certified") for a, b in vv),
+            "tol_cert_ext_uncertain": sum((a, b) == ("certified", "uncertain") for a, b in vv),
+            "other_disagreements": sum(a != b and "certified" not in (a, b) for a, b in vv),
+        })
+    return rows
+
+
+def suite_crosscheck(cfg: BenchConfig) -> dict[str, Any]:
+    """The two certifiers on seeded translating cases: contradictions (must be 0) and why they differ.
+
+    Cases: :func:`monitor.bench.cases.make_translating_cases` (seed ``cfg.seed``; 1000 cases,
+    200 with ``--quick``, 12 in smoke runs). Also run inside :func:`suite_accuracy`.
+    """
+    miss = _missing("monitor.certify.engine", "monitor.scene", "monitor.motion.bodymotion")
+    if miss:
+        return {"skipped": miss}
+    from monitor.bench.cases import make_translating_cases
+
+    n = 12 if cfg.smoke else 200 if cfg.quick else 1000
+    t = time.perf_counter()
+    cases = make_translating_cases(n, seed0=1000 * cfg.seed)
+    t1 = time.perf_counter()
+    entries = [crosscheck_case(c) for c in cases]
+    t2 = time.perf_counter()
+    summ = crosscheck_summary(entries)
+    cfg.log(f"[bench] cross-check: {n} cases built in {t1 - t:.1f} s, both certifiers in {t2 - t1:.1f} s, "
+            f"{summ['contradictions']} contradictions")
+    row = {k: v for k, v in summ.items() if not isinstance(v, dict)}
+    cols = ["n", "contradictions", "false_negatives", "agree", "tol_cert_ext_uncertain",
+            "ext_cert_tol_uncertain", "tol_viol_ext_uncertain", "ext_viol_tol_uncertain"]
+    md = [
+        f"Cross-check of the two certifiers (issue 14) on {n} seeded translating pair-windows "
+        f"(intents {summ['intents']}; kinds box/hull/sphere/capsule vs box/hull/sphere/capsule/plane; "
+        "margin 0 or 1 cm; epsilon 1e-3; budget "
+        f"{XCHECK_BUDGET_TESTS} tests per call). contradictions = certified by one, violation by the "
+        "other (must be 0); false_negatives = certified although the independent oracle (Lipschitz "
+        "sampling + exact LP) finds a collision (must be 0). Every disagreement is labelled by the oracle.",
+        report.table([row], cols),
+        "Why they differ (count per reason):",
+        report.table([{"reason": k, "count": v} for k, v in summ["reasons"].items()], ["reason", "count"]),
+    ]
+    return {"summary": summ, "entries": entries, "seconds_build": t1 - t, "seconds_check": t2 - t1,
+            "markdown": md, "figures": []}
+
+
 def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     """Run time against error: epsilon and facet sweeps, scored against the oracle."""
     miss = _missing("monitor.certify.engine", "monitor.scene", "monitor.motion.bodymotion")
@@ -275,7 +437,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
         cfg.log(f"[bench] accuracy: {method} eps={eps} done")
     rows = []
     for method, eps in plans:
-        for group in ("rotating", "translating", "all"):
+        for group in _groups(cases):
             ee = [
                 e
                 for e in per_case
@@ -284,6 +446,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
             if ee:
                 rows.append({"checker": method, "epsilon": eps, "group": group, **_score(ee)})
     facets = {"skipped": "smoke run"} if cfg.smoke or cfg.shared.get("skip_facets") else _facet_sweep(cfg)
+    xcheck = {"skipped": "skip_crosscheck"} if cfg.shared.get("skip_crosscheck") else suite_crosscheck(cfg)
     figs = []
     peer_lines = cfg.shared.get("peer_lines", {})
     _plot_time_vs_epsilon(cfg, rows, eps_list, peer_lines)
@@ -340,11 +503,20 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     ]
     if facets.get("rows"):
         md += [facets["note"], report.table(facets["rows"], facets["cols"])]
+    md += xcheck.get("markdown", [f"Cross-check skipped: {xcheck.get('skipped')}"])
+    same = _same_case_crosscheck(per_case)
+    if same:
+        md += ["The two certifiers on this suite's own translating cases (same case, toleranced at each "
+               "epsilon against extrusion; contradictions must be 0):",
+               report.table(same, ["epsilon", "n", "contradictions", "agree", "ext_cert_tol_uncertain",
+                                   "tol_cert_ext_uncertain", "other_disagreements"])]
     return {
         "rows": rows,
         "per_case": per_case,
         "warmup": warm,
         "facets": facets,
+        "crosscheck": {k: v for k, v in xcheck.items() if k != "markdown"},
+        "crosscheck_same_cases": same,
         "cases": [dict(c.to_dict(), oracle=lab.to_dict()) for c, lab in zip(cases, labels)],
         "oracle_backend": oracle.backend_name(),
         "markdown": md,
@@ -485,20 +657,20 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
     for case, lab in zip(cases, labels):
         prepared = {}
         for c in checkers:
-            if isinstance(c, P.FclPeer):
-                kinds = {s.kind for s in case.shapes}
-                if any(probe.get(f"{c.motion}|{c.solver}|{k}", {}).get("status") != "ok" for k in kinds):
-                    entries[c.name].append(
-                        {
-                            "case": case.name,
-                            "group": case.group,
-                            "label": lab.label,
-                            "verdict": "unsupported",
-                            "us": None,
-                        }
-                    )
-                    continue
             if isinstance(c, P.IpctkPeer) and not c.applies(case):
+                continue
+            why = P.peer_support(c, case, probe)
+            if why is not None:
+                entries[c.name].append(
+                    {
+                        "case": case.name,
+                        "group": case.group,
+                        "label": lab.label,
+                        "verdict": "unsupported",
+                        "us": None,
+                        "output": why,
+                    }
+                )
                 continue
             prepared[c.name] = c.prepare(case)
         times: dict[str, list[float]] = {k: [] for k in entries}
@@ -556,7 +728,7 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
                 }
             )
     rows = []
-    for group in ("rotating", "translating", "all"):
+    for group in _groups(cases):
         base = None
         for name, ee in entries.items():
             ee = [e for e in ee if group == "all" or e["group"] == group]
@@ -594,7 +766,11 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
         "Same cases, same run; per case the repetitions interleave ours and every peer. misses = "
         "oracle-collide cases reported collision-free (ours: certified); false_alarms = oracle-clear cases "
         "reported colliding (ours: confirmed violation); ours also lists `uncertain` on clear cases. "
-        "ratio_to_ours = peer median µs / ours (toleranced, eps=1e-3) median µs in the same group.",
+        "ratio_to_ours = peer median µs / ours (toleranced, eps=1e-3) median µs in the same group. "
+        "Groups `screw` (constant twist between the two poses: `BodyMotion(interpolation=\"screw\")`; "
+        "fcl only with its CCDM_SCREW motion, which interpolates the same way) and `bezier` (a planar "
+        "rational Bézier motion, `BezierMotion`; no fcl motion type and no ipctk mode represents it: "
+        "`unsupported`) are rows of their own.",
         report.table(
             rows,
             [
@@ -1383,6 +1559,9 @@ __all__ = [
     "BenchConfig",
     "SUITE_FUNCS",
     "suite_accuracy",
+    "suite_crosscheck",
+    "crosscheck_case",
+    "crosscheck_summary",
     "suite_peers",
     "suite_seeds",
     "suite_gate",
