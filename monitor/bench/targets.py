@@ -507,13 +507,25 @@ def plain_gate(
     return out
 
 
+def _scene_file(name: str) -> Path:
+    """``models/<name>/scene.xml`` of this source tree when run from a checkout, else the installed one.
+
+    (``monitor._paths.models_dir`` prefers an installed ``monitor.models``, which for an editable
+    install of another checkout is that checkout's folder: the bench measures this tree's scenes.)
+    """
+    here = Path(__file__).resolve().parents[2] / "models" / name / "scene.xml"
+    if here.is_file():
+        return here
+    from monitor._paths import scene_path
+
+    return scene_path(name)
+
+
 def tunnel_gate(cfg: Any) -> dict[str, Any]:
     """``Gate.step`` on ``models/tunnel`` with ``examples/plain_mujoco.py``'s controller (one 10 ms step)."""
     import mujoco
 
-    from monitor._paths import scene_path
-
-    model = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    model = mujoco.MjModel.from_xml_path(str(_scene_file("tunnel")))
     half = 25 if cfg.quick else 100  # the target side switches every `half` windows
 
     def reset(d: Any) -> None:
@@ -540,9 +552,7 @@ def hand30_gate(cfg: Any) -> dict[str, Any]:
     """``Gate.step`` on ``models/hand30``: random joint targets (new every 10 windows of 5 x 2 ms)."""
     import mujoco
 
-    from monitor._paths import models_dir
-
-    model = mujoco.MjModel.from_xml_path(str(models_dir() / "hand30" / "scene.xml"))
+    model = mujoco.MjModel.from_xml_path(str(_scene_file("hand30")))
     lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
     targets = np.random.default_rng(cfg.seed).uniform(lo, hi, size=(64, model.nu))
 
