@@ -260,3 +260,23 @@ def test_cli_lists_the_targets_suite():
     from monitor.commands.bench import SUITES
 
     assert SUITES[-1] == "targets"
+
+
+def test_targets_take_ours_from_the_peers_suite_of_the_run(small_set, tmp_path):
+    """Ours' per-case µs and verdicts come from the peers suite's entries, earliest times from run_ours."""
+    from monitor.bench.suites import BenchConfig
+    from monitor.bench.targets import _ours_per_case
+
+    cases, labels = small_set
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
+    entries = [
+        {"case": c.name, "verdict": "violation" if lab.label == "collide" else "certified", "us": 100.0 + i}
+        for i, (c, lab) in enumerate(zip(cases, labels))
+    ]
+    cfg.shared["suite_results"] = {"peers": {"entries": {"ours/toleranced eps=1e-3": entries}}}
+    cfg.shared["ours"] = {(c.name, "toleranced", 1e-3): {"verdict": "x", "us": 1.0, "earliest_time": 0.25}
+                          for c in cases}
+    got, source = _ours_per_case(cfg, cases, labels)
+    assert source == f"{len(cases)} from the peers suite"
+    for i, c in enumerate(cases):
+        assert got[c.name]["us"] == 100.0 + i and got[c.name]["earliest_time"] == 0.25

@@ -53,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
     reps = args.reps if args.reps is not None else (3 if args.quick else 5)
     cfg = BenchConfig(quick=bool(args.quick), out=out, seed=int(args.seed), reps=reps)
     names = [s for s in SUITES if not args.suite or s in args.suite]
+    cfg.shared["planned_suites"] = tuple(names)
     command = (
         "python -m monitor bench " + " ".join(shlex.quote(a) for a in sys.argv[2:])
         if len(sys.argv) > 1 and sys.argv[1] == "bench"
