@@ -403,6 +403,7 @@ def gym_gate(
         gate = envs["gated"].gate
         npairs = gate.npairs
         candidates = len(gate.scene.candidate_pairs)
+        names = [f"{a}:{b}" for a, b in gate.scene.candidate_pairs] if npairs <= 8 else None
     finally:
         for env in envs.values():
             env.close()
@@ -411,6 +412,7 @@ def gym_gate(
         "env": env_id,
         "pairs": pairs,
         "monitored_pairs": npairs,
+        "pair_names": names,
         "candidate_pairs": candidates,
         "ungated_s": u,
         "gated_s": g,
@@ -689,8 +691,9 @@ def _gate_note(r: dict[str, Any], what: str) -> str:
     return (
         f"{what}; medians of {r['reps']} interleaved blocks ({r['steps_gated']} gated / {r['steps_ungated']} "
         f"ungated steps): gated {_f(1e3 * r['gated_s'])} ms, ungated {_f(1e6 * r['ungated_s'])} µs per step; "
-        f"monitored pairs {r['monitored_pairs']} of {r['candidate_pairs']} candidates; "
-        f"verdicts {r['verdicts']}"
+        f"{r['monitored_pairs']} monitored pairs"
+        + (f" ({', '.join(r['pair_names'])})" if r.get("pair_names") else "")
+        + f"; verdicts {r['verdicts']}"
     )
 
 
