@@ -180,3 +180,103 @@ def test_cli_writes_results(tmp_path):
     assert rc == 0  # 1 means a suite raised
     assert "seeds" in res["suites"] and res["machine"]["cpu"]
     assert (tmp_path / "results.md").exists()
+
+
+def test_targets_suite_on_small_set(small_set, tmp_path):
+    """The targets section (issue 12): one row per target, statuses consistent, in json, md and stdout.
+
+    Smoke sizes only; nothing about the timings is asserted.
+    """
+    from monitor.bench import targets
+    from monitor.bench.suites import SUITE_FUNCS, BenchConfig
+
+    cases, labels = small_set
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
+    cfg.shared["cases"], cfg.shared["labels"] = cases, labels
+    res = SUITE_FUNCS["targets"](cfg)
+    rows = {r["key"]: r for r in res["rows"]}
+    assert list(rows) == [s.key for s in targets.TARGETS]  # every issue-12 target, in order
+    assert res["errors"] == {}, res["errors"]
+    for r in rows.values():
+        for bound, status in (("target", "target_status"), ("floor", "floor_status")):
+            if r[bound] is None:
+                assert r[status] is None
+            elif r["value"] is None:
+                assert r[status] == "NOT MEASURED"
+            elif r["value"] > r[bound]:
+                assert r[status] == "MISSED"
+            else:  # within the bound; MISSED only when an extra condition (e.g. 0 misses) failed
+                assert r[status] in ("MET", "MISSED")
+    # the issue's targets and floors
+    assert (rows["pair_windows"]["target"], rows["pair_windows"]["floor"]) == (3.0, 10.0)
+    assert (rows["pusher"]["target"], rows["pusher"]["floor"]) == (3.0, 5.0)
+    assert (rows["arm"]["target"], rows["arm"]["floor"]) == (5.0, 10.0)
+    assert (rows["tunnel"]["target"], rows["tunnel"]["floor"]) == (3.0, 5.0)
+    assert (rows["hand30"]["target"], rows["hand30"]["floor"]) == (10.0, 25.0)
+    assert (rows["cold_start"]["target"], rows["cold_start"]["floor"]) == (10.0, 15.0)
+    assert rows["sparse_seconds"]["target"] == 0.05 and rows["sparse_exponent"]["target"] == 1.2
+    # measured in a smoke run: the tunnel gate against its mj_step loop, ours against fcl when installed
+    tun = rows["tunnel"]
+    assert tun["value"] is not None and tun["value"] == pytest.approx(tun["ours"] / tun["ref"])
+    verdicts = res["tunnel"]["verdicts"]
+    assert verdicts and sum(verdicts.values()) == res["tunnel"]["steps_gated"]
+    pw = res["pair_windows"]
+    from monitor.bench import peers
+
+    if peers.have_fcl():
+        assert pw["rows"][-1]["group"] == "all" and pw["rows"][-1]["n"] == len(cases)
+        assert pw["rows"][-1]["ours_misses"] == 0  # oracle-collide cases never certified
+        assert rows["pair_windows"]["value"] is not None
+    else:
+        assert rows["pair_windows"]["target_status"] == "NOT MEASURED"
+    # report: summary table at the top of results.md, rows in results.json, stdout lines
+    results = {"command": "x", "quick": True, "wall_seconds": 1.0, "machine": report.machine_info(),
+               "suites": {"targets": res}, "targets": res["rows"]}
+    report.write_json(tmp_path / "r.json", results)
+    report.write_markdown(tmp_path / "r.md", results)
+    md = (tmp_path / "r.md").read_text()
+    assert md.index("## Targets (issue 12)") < md.index("## targets")
+    assert "Gate.step on models/tunnel" in md and "≤ 3x:" in md
+    back = json.loads((tmp_path / "r.json").read_text())
+    assert [r["key"] for r in back["targets"]] == list(rows)
+    lines = targets.summary_lines(res["rows"])
+    assert len(lines) == len(rows) and any("floor <= 5x" in s for s in lines)
+
+
+def test_target_status_rules():
+    from monitor.bench.targets import SPECS, target_row
+
+    spec = SPECS["pair_windows"]
+    assert target_row(spec, 2.0)["target_status"] == "MET"
+    five = target_row(spec, 5.0)
+    assert five["target_status"] == "MISSED" and five["floor_status"] == "MET"
+    assert target_row(spec, 2.0, ok=False)["floor_status"] == "MISSED"  # e.g. a miss: never MET
+    assert target_row(spec, None)["floor_status"] == "NOT MEASURED"
+    assert target_row(spec, float("nan"))["target_status"] == "NOT MEASURED"
+    assert target_row(SPECS["sparse_seconds"], 0.01)["floor_status"] is None  # the issue sets no floor
+
+
+def test_cli_lists_the_targets_suite():
+    from monitor.commands.bench import SUITES
+
+    assert SUITES[-1] == "targets"
+
+
+def test_targets_take_ours_from_the_peers_suite_of_the_run(small_set, tmp_path):
+    """Ours' per-case µs and verdicts come from the peers suite's entries, earliest times from run_ours."""
+    from monitor.bench.suites import BenchConfig
+    from monitor.bench.targets import _ours_per_case
+
+    cases, labels = small_set
+    cfg = BenchConfig(quick=True, out=tmp_path, reps=1, log=lambda s: None, smoke=True)
+    entries = [
+        {"case": c.name, "verdict": "violation" if lab.label == "collide" else "certified", "us": 100.0 + i}
+        for i, (c, lab) in enumerate(zip(cases, labels))
+    ]
+    cfg.shared["suite_results"] = {"peers": {"entries": {"ours/toleranced eps=1e-3": entries}}}
+    cfg.shared["ours"] = {(c.name, "toleranced", 1e-3): {"verdict": "x", "us": 1.0, "earliest_time": 0.25}
+                          for c in cases}
+    got, source = _ours_per_case(cfg, cases, labels)
+    assert source == f"{len(cases)} from the peers suite"
+    for i, c in enumerate(cases):
+        assert got[c.name]["us"] == 100.0 + i and got[c.name]["earliest_time"] == 0.25

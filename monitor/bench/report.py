@@ -91,6 +91,30 @@ def table(rows: list[dict[str, Any]], cols: list[str], headers: list[str] | None
     return "\n".join(out)
 
 
+def targets_table(rows: list[dict[str, Any]]) -> str:
+    """The issue-12 summary table: target, reference, measured value, target / floor and their status."""
+    from monitor.bench.targets import bound_text, value_text
+
+    out = []
+    for r in rows:
+        unit = r.get("unit") or ""
+        goal, floor = r.get("target"), r.get("floor")
+        out.append(
+            {
+                "target": r["target_name"],
+                "reference": r.get("reference") or "–",
+                "measured": value_text(r.get("value"), unit),
+                "goal": "–" if goal is None else f"≤ {bound_text(goal, unit)}: {r['target_status']}",
+                "floor": "–" if floor is None else f"≤ {bound_text(floor, unit)}: {r['floor_status']}",
+            }
+        )
+    return table(
+        out,
+        ["target", "reference", "measured", "goal", "floor"],
+        ["target", "reference (same run)", "measured", "issue target", "floor"],
+    )
+
+
 def write_markdown(path: Path, results: dict[str, Any]) -> None:
     """Write the human-readable report: machine, command, one section per suite."""
     m = results["machine"]
@@ -108,6 +132,17 @@ def write_markdown(path: Path, results: dict[str, Any]) -> None:
         "not absolute times.",
         "",
     ]
+    if results.get("targets"):
+        lines += [
+            "## Targets (issue 12)",
+            "",
+            "Each ratio is ours / its reference, both measured in this run; MET / MISSED against the "
+            "issue's target and against its floor (the minimum for resolving the issue; '–' = none set). "
+            "Details per target: the `targets` section below.",
+            "",
+            targets_table(results["targets"]),
+            "",
+        ]
     for name, suite in results["suites"].items():
         lines += [f"## {name}", ""]
         if suite.get("skipped"):
@@ -259,6 +294,7 @@ def plot_scaling(path: Path, rows: list[dict]) -> None:
 
 __all__ = [
     "machine_info",
+    "targets_table",
     "write_json",
     "write_markdown",
     "table",

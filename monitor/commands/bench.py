@@ -3,7 +3,11 @@
 Writes ``results.json``, ``results.md`` and the PNG plots to ``--out``. Suites:
 accuracy (run time against error), peers (python-fcl, MuJoCo sampling, ipctk),
 seeds (paper reproductions), gate (overhead on gymnasium envs), scaling,
-review (per-window cost of read_log + analyze + render_text on an N-window log).
+review (per-window cost of read_log + analyze + render_text on an N-window log),
+targets (issue 12: every target as a ratio against its reference in the same run, MET / MISSED
+against the issue's target and floor; it reuses the accuracy, peers and scaling results of the
+same run when they ran). The targets are also printed to stdout, summarised at the top of
+results.md and stored under ``targets`` in results.json.
 A suite whose dependency is missing is recorded as skipped, never silently dropped;
 an exception inside a suite is recorded in the results and the exit code is 1.
 """
@@ -17,7 +21,10 @@ import time
 import traceback
 from pathlib import Path
 
-from monitor.bench import SUITES
+from monitor.bench import SUITES as _BASE_SUITES
+
+SUITES = tuple(_BASE_SUITES) + tuple(s for s in ("targets",) if s not in _BASE_SUITES)
+"""Suite names in run order; ``targets`` last (it reads the other suites' results)."""
 
 
 def add_parser(p: argparse.ArgumentParser) -> None:
@@ -46,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
     reps = args.reps if args.reps is not None else (3 if args.quick else 5)
     cfg = BenchConfig(quick=bool(args.quick), out=out, seed=int(args.seed), reps=reps)
     names = [s for s in SUITES if not args.suite or s in args.suite]
+    cfg.shared["planned_suites"] = tuple(names)
     command = (
         "python -m monitor bench " + " ".join(shlex.quote(a) for a in sys.argv[2:])
         if len(sys.argv) > 1 and sys.argv[1] == "bench"
@@ -75,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
             }
         res["suite_seconds"] = time.perf_counter() - t
         results["suites"][name] = res
+        cfg.shared.setdefault("suite_results", {})[name] = res
         cfg.log(
             f"[bench] suite {name}: {res['suite_seconds']:.1f} s"
             + (f" (skipped: {res['skipped']})" if res.get("skipped") else "")
@@ -83,6 +92,13 @@ def run(args: argparse.Namespace) -> int:
     results["wall_seconds"] = time.perf_counter() - t0
     report.write_json(out / "results.json", results)
     report.write_markdown(out / "results.md", results)
+    if results.get("targets"):
+        from monitor.bench.targets import summary_lines
+
+        print("issue 12 targets (ratios against references measured in this run):")
+        for line in summary_lines(results["targets"]):
+            print(f"  {line}")
+        sys.stdout.flush()
     cfg.log(
         f"[bench] wrote {out / 'results.json'} and {out / 'results.md'} in {results['wall_seconds']:.1f} s"
     )
