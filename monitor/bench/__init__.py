@@ -19,7 +19,7 @@ never one absolute time.
 
 from __future__ import annotations
 
-SUITES = ("accuracy", "peers", "seeds", "gate", "scaling", "review")
+SUITES = ("accuracy", "peers", "seeds", "gate", "scaling", "review", "targets")
 """Suite names accepted by ``--suite`` (in run order)."""
 
 __all__ = ["SUITES"]

@@ -794,7 +794,7 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
                 "ratio_to_ours",
             ],
         ),
-        f"Target (median µs per pair-window below fcl continuousCollide NAIVE on the rotating set): {target}",
+        f"Target (issue 12: ours / fcl LINEAR conservative advancement, all cases): {target}",
         "python-fcl probe (colliding probe case per shape kind, run in a subprocess; "
         "output captured at fd level):",
         report.table(fcl_table, ["combination", "status", "collide", "output"]),

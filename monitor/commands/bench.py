@@ -23,7 +23,7 @@ from pathlib import Path
 
 from monitor.bench import SUITES as _BASE_SUITES
 
-SUITES = tuple(_BASE_SUITES) + tuple(s for s in ("targets",) if s not in _BASE_SUITES)
+SUITES = tuple(_BASE_SUITES)
 """Suite names in run order; ``targets`` last (it reads the other suites' results)."""
 
 
