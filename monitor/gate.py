@@ -78,6 +78,27 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 class Rollout:
     """Exact one-window prediction by integrating a scratch copy of the state.
 
+    Cost. Per window everything is preallocated or cached: the integration-state
+    buffers, the views of the scratch ``MjData`` arrays read per substep, and a
+    second scratch ``MjData`` for the braking tail. After :meth:`states` the window
+    scratch holds the complete ``MjData`` at the window's end, together with the key
+    it was computed from (the caller's integration state, the control, ``nstep``):
+
+    * :meth:`brake_tail` continues from that snapshot instead of integrating the
+      window a second time, when the key matches;
+    * :meth:`commit` copies it into the caller's ``MjData`` instead of stepping it
+      again (used by :meth:`Gate.step`), when the key matches.
+
+    Both are exact, not approximations: ``mj_step`` is a deterministic function of
+    the integration state (``mjSTATE_INTEGRATION``: time, qpos, qvel, act, warm
+    start, ctrl, applied forces, mocap, eq_active, userdata, plugin state,
+    history), so the scratch's end state is bit for bit what ``mj_step`` on the
+    caller's data would produce (tested against an independent ``MjData`` on every
+    array field over 500 tunnel steps). The key is compared bit for bit. The model
+    is the one object both run on; an in-place model edit between a prediction and
+    its commit is not detected here (:meth:`Gate.step` predicts and commits within
+    one call, with only the certifier in between, which does not edit the model).
+
     Args:
         model: the ``MjModel``.
     """
@@ -85,7 +106,29 @@ class Rollout:
     def __init__(self, model: mujoco.MjModel) -> None:
         self.model = model
         self.scratch = mujoco.MjData(model)
-        self._state = np.empty(mujoco.mj_stateSize(model, _INTEGRATION))
+        self._tail_data: mujoco.MjData | None = None  # created on the first braking tail
+        size = mujoco.mj_stateSize(model, _INTEGRATION)
+        self._state = np.empty(size)
+        self._key_state = np.empty(size)  # integration state the scratch window started from
+        self._end_state = np.empty(size)
+        self._key_ctrl = np.empty(model.nu)
+        self._key_nstep = 0  # 0: the scratch holds no complete window
+        self._s_qpos = self.scratch.qpos  # views (an MjData's buffers never move)
+        self._s_ctrl = self.scratch.ctrl
+
+    def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
+        """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
+
+        Compares ``data``'s integration state and the control with the last :meth:`states`
+        call bit for bit (``ctrl=None``: ``data.ctrl``).
+        """
+        if nstep < 1 or self._key_nstep != nstep:
+            return False
+        c = data.ctrl if ctrl is None else np.asarray(ctrl, dtype=np.float64)
+        if c.shape != self._key_ctrl.shape or not np.array_equal(c, self._key_ctrl):
+            return False
+        mujoco.mj_getState(self.model, data, self._state, _INTEGRATION)
+        return bool(np.array_equal(self._state, self._key_state))
 
     def states(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -99,23 +142,50 @@ class Rollout:
         Returns:
             times (nstep + 1,) seconds and qpos (nstep + 1, nq): the current state
             (quaternions normalised, as MuJoCo uses them) followed by the state
-            after each substep.
+            after each substep. Fresh arrays: the caller may keep them.
         """
         m, s = self.model, self.scratch
-        mujoco.mj_getState(m, data, self._state, _INTEGRATION)
-        mujoco.mj_setState(m, s, self._state, _INTEGRATION)
+        self._key_nstep = 0  # no complete window until the loop below is done
+        mujoco.mj_getState(m, data, self._key_state, _INTEGRATION)
+        # A full copy, not only the integration state: then the scratch also carries
+        # data's diagnostics (warning counters, solver statistics, fields a substep
+        # does not rewrite), so :meth:`commit` gives exactly what stepping data gives.
+        mujoco.mj_copyData(s, m, data)
         if ctrl is not None:
-            s.ctrl[:] = ctrl
+            self._s_ctrl[:] = ctrl
+        self._key_ctrl[:] = self._s_ctrl
         times = np.empty(nstep + 1)
         qpos = np.empty((nstep + 1, m.nq))
         times[0], qpos[0] = data.time, data.qpos
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
-        for k in range(nstep):
+        sq = self._s_qpos
+        for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
-            times[k + 1], qpos[k + 1] = s.time, s.qpos
+            times[k] = s.time
+            qpos[k] = sq
+        self._key_nstep = int(nstep)
         return times, qpos
+
+    def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
+        """Advance ``data`` by the predicted window if the scratch holds it (else do nothing).
+
+        Same result as ``data.ctrl[:] = ctrl; mj_step(model, data, nstep=nstep)``: the
+        scratch started as a full copy of ``data`` (``mj_copyData``, diagnostics included)
+        and ran exactly those substeps, and it is copied back. Bit for bit in every array
+        of ``MjData``, the warning counters, solver statistics and memory high-water marks
+        (tested); the wall-clock ``timer`` durations are the scratch run's.
+
+        Returns:
+            True if ``data`` was advanced; False if the scratch does not hold this window
+            (the caller steps ``data`` itself).
+        """
+        if not self.window_matches(data, ctrl, nstep):
+            return False
+        mujoco.mj_copyData(data, self.model, self.scratch)
+        self._key_nstep = 0  # used up: data has moved on
+        return True
 
     def plan(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> Any:
         """The :class:`monitor.Plan` of the next ``nstep`` substeps (mocap poses held)."""
@@ -134,27 +204,47 @@ class Rollout:
         brake control ``brake_fn(state at the window's end)`` until every
         ``|qvel| <= vel_tol`` or ``max_steps`` substeps.
 
+        The window is not integrated again when the scratch already holds it (the
+        gate predicted it just before): the tail starts from the scratch's end state
+        (``mj_setState`` of its integration state into a second scratch ``MjData``,
+        which determines every later ``mj_step`` bit for bit). ``brake_fn`` receives
+        that ``MjData``: its integration state (qpos, qvel, act, ctrl, ...) is the
+        window's end; quantities derived from it (``xpos``, contacts, ...) are not
+        recomputed (the gate's brake functions read ``qpos`` only).
+
         Returns:
             (plan of the tail from the window's end, brake control (nu,),
             qvel (K, nv) at the tail's waypoints).
         """
         from monitor.motion.plan import Plan
 
-        self.states(data, ctrl, nstep)
-        m, s = self.model, self.scratch
+        m = self.model
+        if not self.window_matches(data, ctrl, nstep):
+            self.states(data, ctrl, nstep)
+        s = self._tail_data
+        if s is None:
+            s = self._tail_data = mujoco.MjData(m)
+        mujoco.mj_getState(m, self.scratch, self._end_state, _INTEGRATION)
+        mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
-        times, qpos, qvel = [s.time], [s.qpos.copy()], [s.qvel.copy()]
-        for _ in range(max(int(max_steps), 1)):
+        n = max(int(max_steps), 1)
+        times = np.empty(n + 1)
+        qpos = np.empty((n + 1, m.nq))
+        qvel = np.empty((n + 1, m.nv))
+        sq, sv = s.qpos, s.qvel
+        times[0], qpos[0], qvel[0] = s.time, sq, sv
+        k = 0
+        while k < n:
             mujoco.mj_step(m, s)
-            times.append(s.time)
-            qpos.append(s.qpos.copy())
-            qvel.append(s.qvel.copy())
-            if m.nv == 0 or float(np.max(np.abs(s.qvel))) <= vel_tol:
+            k += 1
+            times[k], qpos[k], qvel[k] = s.time, sq, sv
+            if m.nv == 0 or float(np.abs(qvel[k]).max()) <= vel_tol:
                 break
-        plan = Plan._trusted(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
+        k += 1
+        plan = Plan._trusted(times[:k].copy(), qpos[:k].copy(), model=m, mocap_pos=np.array(data.mocap_pos),
                              mocap_quat=np.array(data.mocap_quat))
-        return plan, brake, np.array(qvel)
+        return plan, brake, qvel[:k].copy()
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -541,7 +631,7 @@ class Gate:
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0}
+                      "reused_pairs": 0, "pairs": 0, "committed": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -875,7 +965,9 @@ class Gate:
 
         ``data.ctrl`` is set to the applied control (the proposal, or the fallback
         when blocked) and ``mj_step`` runs ``nstep`` times, as gymnasium's
-        ``MujocoEnv.do_simulation`` does.
+        ``MujocoEnv.do_simulation`` does. When the gate's scratch already integrated
+        exactly that window (the usual case), its end state is copied instead
+        (:meth:`Rollout.commit`; bit-identical, the simulation runs once per window).
 
         Args:
             data: the caller's ``MjData`` (advanced in place).
@@ -896,8 +988,14 @@ class Gate:
         if not np.all(np.isfinite(ctrl)):
             raise InvalidInputError("ctrl contains NaN or inf")
         report = self.decide(data, ctrl, nstep=n)
-        data.ctrl[:] = report.applied_ctrl
-        mujoco.mj_step(self.model, data, nstep=n)
+        # The scratch usually holds the applied window already (the proposal's, or the
+        # fallback's when it was predicted): copy it instead of integrating again (exact,
+        # see Rollout.commit). Otherwise (a window inside the committed tail) step.
+        if self._rollout.commit(data, report.applied_ctrl, n):
+            self.stats["committed"] += 1
+        else:
+            data.ctrl[:] = report.applied_ctrl
+            mujoco.mj_step(self.model, data, nstep=n)
         report = replace(report, stepped=True)
         self.last_report = report
         return report
