@@ -247,6 +247,12 @@ class Rollout:
         return plan, brake, qvel[:k].copy()
 
 
+_AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
+_FIXED = int(mujoco.mjtGain.mjGAIN_FIXED)
+_TRN_JOINT = int(mujoco.mjtTrn.mjTRN_JOINT)
+_HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+
+
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     """A control that holds the current position where the actuators allow it.
 
@@ -257,23 +263,30 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     servo then brakes, a motor coasts). The result is clipped to ``ctrlrange``
     where the control is limited.
 
+    Vectorised over the actuators and read from the live model on every call (a model
+    edited in place, e.g. a randomised gain, is used as it is now); the same
+    operations per actuator as the scalar formula, so the same floats.
+
     Returns:
         (nu,) float64 control.
     """
-    ctrl = np.zeros(model.nu)
-    hinge_slide = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
-    for a in range(model.nu):
-        if (int(model.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT)
-                or int(model.actuator_biastype[a]) != int(mujoco.mjtBias.mjBIAS_AFFINE)
-                or int(model.actuator_gaintype[a]) != int(mujoco.mjtGain.mjGAIN_FIXED)):
-            continue
-        gain = model.actuator_gainprm[a, 0]
-        b0, b1 = model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
-        j = model.actuator_trnid[a, 0]
-        if gain == 0.0 or b1 == 0.0 or int(model.jnt_type[j]) not in hinge_slide:
-            continue
-        length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j]]
-        ctrl[a] = -(b0 + b1 * length) / gain
+    nu = model.nu
+    ctrl = np.zeros(nu)
+    if nu == 0:
+        return ctrl
+    gain = model.actuator_gainprm[:, 0]
+    b0, b1 = model.actuator_biasprm[:, 0], model.actuator_biasprm[:, 1]
+    j = model.actuator_trnid[:, 0]
+    ok = ((model.actuator_trntype == _TRN_JOINT) & (model.actuator_biastype == _AFFINE)
+          & (model.actuator_gaintype == _FIXED) & (gain != 0.0) & (b1 != 0.0))
+    if ok.any():
+        a = np.flatnonzero(ok)
+        ja = j[a]
+        jt = model.jnt_type[ja]
+        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+        if a.size:
+            length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j[a]]]
+            ctrl[a] = -(b0[a] + b1[a] * length) / gain[a]
     limited = model.actuator_ctrllimited.astype(bool)
     lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
     ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
@@ -596,6 +609,7 @@ class Gate:
         _check_log(log)
         self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._cache_context: tuple[Any, ...] | None = None
+        self._pair_bodies_cache: tuple[Any, ...] | None = None
         self._scene_builds = 0
         self.penetration_tol = check_rule(ongoing, penetration_tol)
         self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
@@ -753,24 +767,42 @@ class Gate:
             self._cache.clear()
             self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
-        pair_bodies = [(scene.geoms[a].body_id, scene.geoms[b].body_id) for a, b in scene.pair_ids]
-        fixed = [i for i, (ba, bb) in enumerate(pair_bodies) if not moving[ba] and not moving[bb]]
-        if not fixed:
+        body_a, body_b = self._pair_bodies(scene)
+        fixed = np.flatnonzero(~(moving[body_a] | moving[body_b]))
+        if not fixed.size:
             return None, {}, {}
         pos, rot = plan.body_poses(np.array([plan.t0]))
+        ba, bb = body_a[fixed], body_b[fixed]
+        # key of pair i: the bytes of (p_a (3,), R_a (9,), p_b (3,), R_b (9,)) at t0
+        rows = np.concatenate([pos[0, ba], rot[0, ba].reshape(-1, 9), pos[0, bb], rot[0, bb].reshape(-1, 9)],
+                              axis=1)
         keys, reused = {}, {}
-        for i in fixed:
-            ba, bb = pair_bodies[i]
-            key = (pos[0, ba].tobytes() + rot[0, ba].tobytes() + pos[0, bb].tobytes()
-                   + rot[0, bb].tobytes())
+        cache = self._cache
+        for i, row in zip(fixed.tolist(), rows):
+            key = row.tobytes()
             keys[i] = key
-            hit = self._cache.get(i)
+            hit = cache.get(i)
             if hit is not None and hit[0] == key:
                 reused[i] = hit[1]
         if not reused:
             return None, {}, keys
-        todo = [i for i in range(len(pair_bodies)) if i not in reused]
+        todo = [i for i in range(len(body_a)) if i not in reused]
         return todo, reused, keys
+
+    def _pair_bodies(self, scene: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(P,) body ids of each candidate pair's two geoms, cached per scene geometry.
+
+        Keyed on the scene object and its current ``geoms`` / ``pair_ids`` objects, which
+        ``Scene.sync()`` replaces on a rebuild.
+        """
+        hit = self._pair_bodies_cache
+        if hit is not None and hit[0] is scene and hit[1] is scene.geoms and hit[2] is scene.pair_ids:
+            return hit[3], hit[4]
+        ids = np.asarray(scene.pair_ids, dtype=np.int64).reshape(-1, 2)
+        body_of = np.array([g.body_id for g in scene.geoms], dtype=np.int64)
+        body_a, body_b = body_of[ids[:, 0]], body_of[ids[:, 1]]
+        self._pair_bodies_cache = (scene, scene.geoms, scene.pair_ids, body_a, body_b)
+        return body_a, body_b
 
     def _certify_subset(self, certify: Callable[..., Certificate], scene: Any, plan: Any,
                         todo: list[int], reused: dict[int, PairResult]) -> Certificate:
