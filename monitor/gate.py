@@ -72,6 +72,9 @@ ON_VIOLATION = ("block", "terminate", "warn")
 UNSAFE = ("uncertain", "violation")
 PREDICTORS = ("rollout",)
 _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
+_TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
+             | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
+_TAIL_CHUNK = 8  # braking-tail substeps between two (vectorised) stop tests
 
 
 # --------------------------------------------------------------------------- predictors
@@ -229,22 +232,32 @@ class Rollout:
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
         n = max(int(max_steps), 1)
-        times = np.empty(n + 1)
-        qpos = np.empty((n + 1, m.nq))
-        qvel = np.empty((n + 1, m.nv))
-        sq, sv = s.qpos, s.qvel
-        times[0], qpos[0], qvel[0] = s.time, sq, sv
+        nq = m.nq
+        # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
+        # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps; the tail
+        # ends at the first substep that passes it, exactly as a per-substep test would
+        # (substeps simulated beyond it in the same chunk only touch the private scratch).
+        rows = np.empty((n + 1, 1 + nq + m.nv))
+        mujoco.mj_getState(m, s, rows[0], _TAIL_ROW)
+        end = n
         k = 0
         while k < n:
-            mujoco.mj_step(m, s)
-            k += 1
-            times[k], qpos[k], qvel[k] = s.time, sq, sv
-            if m.nv == 0 or float(np.abs(qvel[k]).max()) <= vel_tol:
+            hi = min(k + _TAIL_CHUNK, n)
+            for j in range(k + 1, hi + 1):
+                mujoco.mj_step(m, s)
+                mujoco.mj_getState(m, s, rows[j], _TAIL_ROW)
+            if m.nv == 0:
+                end = k + 1
                 break
-        k += 1
-        plan = Plan._trusted(times[:k].copy(), qpos[:k].copy(), model=m, mocap_pos=np.array(data.mocap_pos),
-                             mocap_quat=np.array(data.mocap_quat))
-        return plan, brake, qvel[:k].copy()
+            stop = np.flatnonzero(np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol)
+            if stop.size:
+                end = k + 1 + int(stop[0])
+                break
+            k = hi
+        rows = rows[:end + 1]
+        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=m,
+                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
+        return plan, brake, rows[:, 1 + nq:].copy()
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)

@@ -107,21 +107,25 @@ def test_commit_refuses_a_window_the_scratch_does_not_hold():
     assert not ro.commit(d, np.array([2.0]), 2)  # used up
 
 
+@pytest.mark.parametrize("vel_tol", [1e-3, 0.05, 0.5, 1e3])
 @pytest.mark.parametrize("scene", ["tunnel", "arm"])
-def test_brake_tail_from_the_snapshot_equals_a_fresh_simulation(scene):
-    """The tail continued from the predicted window equals the tail of a fresh rollout."""
+def test_brake_tail_from_the_snapshot_equals_a_fresh_simulation(scene, vel_tol):
+    """The tail continued from the predicted window equals the tail of a fresh rollout and an
+    independent hand-stepped oracle, including where it stops (first substep with every
+    |qvel| <= vel_tol, else max_steps)."""
     m = mujoco.MjModel.from_xml_path(str(scene_path(scene)))
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, 0)
     rng = np.random.default_rng(7)
     lo, hi = m.actuator_ctrlrange[:, 0], m.actuator_ctrlrange[:, 1]
     gate = Gate(m)
-    for _ in range(3):
+    lengths = set()
+    for _ in range(4):
         ctrl = rng.uniform(lo, hi)
         warm = Rollout(m)
         warm.plan(d, ctrl, 4)  # the gate's order: predict the window, then the tail
-        got = warm.brake_tail(d, ctrl, 4, gate._brake_ctrl, 40, 1e-3)
-        fresh = Rollout(m).brake_tail(d, ctrl, 4, gate._brake_ctrl, 40, 1e-3)
+        got = warm.brake_tail(d, ctrl, 4, gate._brake_ctrl, 40, vel_tol)
+        fresh = Rollout(m).brake_tail(d, ctrl, 4, gate._brake_ctrl, 40, vel_tol)
         # the oracle: the window and the brake integrated by hand on an independent MjData
         o = mujoco.MjData(m)
         mujoco.mj_resetDataKeyframe(m, o, 0)
@@ -131,14 +135,21 @@ def test_brake_tail_from_the_snapshot_equals_a_fresh_simulation(scene):
         mujoco.mj_step(m, o, nstep=4)
         brake_oracle = gate._brake_ctrl(o)  # at the window's end
         o.ctrl[:] = brake_oracle
-        qpos = [np.array(o.qpos)]
-        for _ in range(len(got[0].times) - 1):
+        times, qpos, qvel = [o.time], [np.array(o.qpos)], [np.array(o.qvel)]
+        for _ in range(40):
             mujoco.mj_step(m, o)
+            times.append(o.time)
             qpos.append(np.array(o.qpos))
-        for plan, brake, qvel in (got, fresh):
+            qvel.append(np.array(o.qvel))
+            if np.max(np.abs(o.qvel)) <= vel_tol:
+                break
+        lengths.add(len(times))
+        for plan, brake, qv in (got, fresh):
+            assert np.array_equal(plan.times, np.array(times))
             assert np.array_equal(plan.qpos, np.array(qpos))
+            assert np.array_equal(qv, np.array(qvel))
             assert np.array_equal(brake, brake_oracle)
-            assert np.array_equal(qvel[-1], o.qvel)
-        assert np.array_equal(got[0].times, fresh[0].times)
         d.ctrl[:] = ctrl
         mujoco.mj_step(m, d, nstep=4)
+    if vel_tol == 1e3:
+        assert lengths == {2}  # stops after the first substep

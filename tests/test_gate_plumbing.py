@@ -161,3 +161,30 @@ def test_plan_moving_and_rotating_bodies_match_the_chain_walk(name):
             moving, rotating = _moving_scalar(m, changes)
             assert np.array_equal(plan.moving_bodies(), moving), (trial, ctor)
             assert np.array_equal(plan._rotating, rotating), (trial, ctor)
+
+
+def _null_unknown_reference(x):
+    """The log's rule, written out: floats that are not < 1e308 in magnitude (stand-ins, NaN) -> None."""
+    if isinstance(x, dict):
+        return {k: _null_unknown_reference(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_null_unknown_reference(v) for v in x]
+    if isinstance(x, float) and not abs(x) < 1e308:
+        return None
+    return x
+
+
+def test_log_null_unknown_fast_path_matches_the_rule():
+    from collections import OrderedDict
+
+    from monitor.log.writer import _null_unknown
+
+    value = {"a": 1e308, "b": -1e308, "c": 1.5, "d": float("nan"), "e": [1, (2.0, 1e308), None, "x", True],
+             "f": {"g": np.float64(1e308), "h": np.float64(0.25), "i": np.int64(3)},
+             "j": OrderedDict(k=-1e308, m=[np.float32(2.0)]), "n": float("inf"), "o": 1.7976931348623157e308,
+             "p": 9.999999999999999e307}
+    got, want = _null_unknown(value), _null_unknown_reference(value)
+    assert got == want
+    assert [type(v) for v in got.values()] == [type(v) for v in want.values()]
+    assert got["a"] is None and got["o"] is None and got["p"] == 9.999999999999999e307
+    assert got["f"]["g"] is None and got["j"]["k"] is None and got["e"][1] == [2.0, None]
