@@ -74,6 +74,7 @@ PREDICTORS = ("rollout",)
 _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
+_WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
 _TAIL_CHUNK = 8  # braking-tail substeps between two (vectorised) stop tests
 
 
@@ -116,8 +117,7 @@ class Rollout:
         self._end_state = np.empty(size)
         self._key_ctrl = np.empty(model.nu)
         self._key_nstep = 0  # 0: the scratch holds no complete window
-        self._s_qpos = self.scratch.qpos  # views (an MjData's buffers never move)
-        self._s_ctrl = self.scratch.ctrl
+        self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
@@ -157,18 +157,16 @@ class Rollout:
         if ctrl is not None:
             self._s_ctrl[:] = ctrl
         self._key_ctrl[:] = self._s_ctrl
-        times = np.empty(nstep + 1)
-        qpos = np.empty((nstep + 1, m.nq))
-        times[0], qpos[0] = data.time, data.qpos
+        rows = np.empty((nstep + 1, 1 + m.nq))  # (time, qpos) per state, by mj_getState
+        mujoco.mj_getState(m, data, rows[0], _WINDOW_ROW)
+        for k in range(1, nstep + 1):
+            mujoco.mj_step(m, s)
+            mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
+        self._key_nstep = int(nstep)
+        times, qpos = rows[:, 0].copy(), rows[:, 1:].copy()
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
-        sq = self._s_qpos
-        for k in range(1, nstep + 1):
-            mujoco.mj_step(m, s)
-            times[k] = s.time
-            qpos[k] = sq
-        self._key_nstep = int(nstep)
         return times, qpos
 
     def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
