@@ -261,6 +261,7 @@ class _ModelStructure:
         # matrix-vector product with the (nq,) changed-columns mask.
         self.chain_cols: np.ndarray | None = None
         self.chain_rot_cols: np.ndarray | None = None
+        self.chain_both_cols: np.ndarray | None = None
         if nbody * model.nq <= 1 << 16:
             cc = np.zeros((nbody, model.nq), dtype=np.int64)
             cr = np.zeros((nbody, model.nq), dtype=np.int64)
@@ -269,6 +270,7 @@ class _ModelStructure:
                     cc[b] = self.own_cols[b] | (cc[self.parent[b]] > 0)
                     cr[b] = self.own_rot_cols[b] | (cr[self.parent[b]] > 0)
             self.chain_cols, self.chain_rot_cols = cc, cr
+            self.chain_both_cols = np.concatenate([cc, cr])  # (2 nbody, nq): one product for both
         # Chains (virtual joints root -> body over the moving bodies) per moving pattern.
         self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
         self.ref = _ref_points(model)
@@ -465,15 +467,15 @@ class Plan(WindowTimes):
         # (rotates) when one of its own joints or of its ancestors' (up to the world or a
         # mocap body, which is a fixed frame) changes. Propagated one tree depth at a
         # time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
-        changes = np.any(q != q[0], axis=0)  # (nq,)
+        changes = (q != q[0]).any(axis=0)  # (nq,)
         nbody = st.nbody
         parent = st.parent
         moving = np.zeros(nbody, dtype=bool)
         rotating = np.zeros(nbody, dtype=bool)
         if changes.any():
             if st.chain_cols is not None:  # small trees: one product each
-                moving = (st.chain_cols @ changes.view(np.uint8)) > 0
-                rotating = (st.chain_rot_cols @ changes.view(np.uint8)) > 0
+                both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
+                moving, rotating = both[:nbody], both[nbody:]
             else:
                 own_moving = (st.own_cols & changes).any(axis=1)
                 own_rot = (st.own_rot_cols & changes).any(axis=1)
@@ -512,7 +514,7 @@ class Plan(WindowTimes):
         self._chain_v, self._own_count = chains
 
         self._magnitude = {
-            "q": float(np.max(np.abs(q), initial=0.0)) + st.qpos0_mag,
+            "q": float(np.abs(q).max(initial=0.0)) + st.qpos0_mag,
             "path": max((float(tr.cum[-1]) for tr in self._quat_tracks.values()), default=0.0),
         }
         # Waypoint poses (for translation segments and the rounding scale) and the
