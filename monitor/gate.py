@@ -232,15 +232,19 @@ class Rollout:
         n = max(int(max_steps), 1)
         nq = m.nq
         # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
-        # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps; the tail
-        # ends at the first substep that passes it, exactly as a per-substep test would
-        # (substeps simulated beyond it in the same chunk only touch the private scratch).
+        # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
+        # 1, 2, 4, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
+        # tail ends at the first substep that passes it, exactly as a per-substep test
+        # would (substeps simulated beyond it in the same chunk only touch the private
+        # scratch).
         rows = np.empty((n + 1, 1 + nq + m.nv))
         mujoco.mj_getState(m, s, rows[0], _TAIL_ROW)
         end = n
         k = 0
+        chunk = 1
         while k < n:
-            hi = min(k + _TAIL_CHUNK, n)
+            hi = min(k + chunk, n)
+            chunk = min(2 * chunk, _TAIL_CHUNK)
             for j in range(k + 1, hi + 1):
                 mujoco.mj_step(m, s)
                 mujoco.mj_getState(m, s, rows[j], _TAIL_ROW)
