@@ -72,11 +72,36 @@ ON_VIOLATION = ("block", "terminate", "warn")
 UNSAFE = ("uncertain", "violation")
 PREDICTORS = ("rollout",)
 _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
+_TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
+             | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
+_WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
+_TAIL_CHUNK = 8  # braking-tail substeps between two (vectorised) stop tests
 
 
 # --------------------------------------------------------------------------- predictors
 class Rollout:
     """Exact one-window prediction by integrating a scratch copy of the state.
+
+    Cost. Per window everything is preallocated or cached: the integration-state
+    buffers, the views of the scratch ``MjData`` arrays read per substep, and a
+    second scratch ``MjData`` for the braking tail. After :meth:`states` the window
+    scratch holds the complete ``MjData`` at the window's end, together with the key
+    it was computed from (the caller's integration state, the control, ``nstep``):
+
+    * :meth:`brake_tail` continues from that snapshot instead of integrating the
+      window a second time, when the key matches;
+    * :meth:`commit` copies it into the caller's ``MjData`` instead of stepping it
+      again (used by :meth:`Gate.step`), when the key matches.
+
+    Both are exact, not approximations: ``mj_step`` is a deterministic function of
+    the integration state (``mjSTATE_INTEGRATION``: time, qpos, qvel, act, warm
+    start, ctrl, applied forces, mocap, eq_active, userdata, plugin state,
+    history), so the scratch's end state is bit for bit what ``mj_step`` on the
+    caller's data would produce (tested against an independent ``MjData`` on every
+    array field over 500 tunnel steps). The key is compared bit for bit. The model
+    is the one object both run on; an in-place model edit between a prediction and
+    its commit is not detected here (:meth:`Gate.step` predicts and commits within
+    one call, with only the certifier in between, which does not edit the model).
 
     Args:
         model: the ``MjModel``.
@@ -85,7 +110,28 @@ class Rollout:
     def __init__(self, model: mujoco.MjModel) -> None:
         self.model = model
         self.scratch = mujoco.MjData(model)
-        self._state = np.empty(mujoco.mj_stateSize(model, _INTEGRATION))
+        self._tail_data: mujoco.MjData | None = None  # created on the first braking tail
+        size = mujoco.mj_stateSize(model, _INTEGRATION)
+        self._state = np.empty(size)
+        self._key_state = np.empty(size)  # integration state the scratch window started from
+        self._end_state = np.empty(size)
+        self._key_ctrl = np.empty(model.nu)
+        self._key_nstep = 0  # 0: the scratch holds no complete window
+        self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
+
+    def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
+        """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
+
+        Compares ``data``'s integration state and the control with the last :meth:`states`
+        call bit for bit (``ctrl=None``: ``data.ctrl``).
+        """
+        if nstep < 1 or self._key_nstep != nstep:
+            return False
+        c = data.ctrl if ctrl is None else np.asarray(ctrl, dtype=np.float64)
+        if c.shape != self._key_ctrl.shape or not np.array_equal(c, self._key_ctrl):
+            return False
+        mujoco.mj_getState(self.model, data, self._state, _INTEGRATION)
+        return bool(np.array_equal(self._state, self._key_state))
 
     def states(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -99,23 +145,48 @@ class Rollout:
         Returns:
             times (nstep + 1,) seconds and qpos (nstep + 1, nq): the current state
             (quaternions normalised, as MuJoCo uses them) followed by the state
-            after each substep.
+            after each substep. Fresh arrays: the caller may keep them.
         """
         m, s = self.model, self.scratch
-        mujoco.mj_getState(m, data, self._state, _INTEGRATION)
-        mujoco.mj_setState(m, s, self._state, _INTEGRATION)
+        self._key_nstep = 0  # no complete window until the loop below is done
+        mujoco.mj_getState(m, data, self._key_state, _INTEGRATION)
+        # A full copy, not only the integration state: then the scratch also carries
+        # data's diagnostics (warning counters, solver statistics, fields a substep
+        # does not rewrite), so :meth:`commit` gives exactly what stepping data gives.
+        mujoco.mj_copyData(s, m, data)
         if ctrl is not None:
-            s.ctrl[:] = ctrl
-        times = np.empty(nstep + 1)
-        qpos = np.empty((nstep + 1, m.nq))
-        times[0], qpos[0] = data.time, data.qpos
+            self._s_ctrl[:] = ctrl
+        self._key_ctrl[:] = self._s_ctrl
+        rows = np.empty((nstep + 1, 1 + m.nq))  # (time, qpos) per state, by mj_getState
+        mujoco.mj_getState(m, data, rows[0], _WINDOW_ROW)
+        for k in range(1, nstep + 1):
+            mujoco.mj_step(m, s)
+            mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
+        self._key_nstep = int(nstep)
+        times, qpos = rows[:, 0].copy(), rows[:, 1:].copy()
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
-        for k in range(nstep):
-            mujoco.mj_step(m, s)
-            times[k + 1], qpos[k + 1] = s.time, s.qpos
         return times, qpos
+
+    def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
+        """Advance ``data`` by the predicted window if the scratch holds it (else do nothing).
+
+        Same result as ``data.ctrl[:] = ctrl; mj_step(model, data, nstep=nstep)``: the
+        scratch started as a full copy of ``data`` (``mj_copyData``, diagnostics included)
+        and ran exactly those substeps, and it is copied back. Bit for bit in every array
+        of ``MjData``, the warning counters, solver statistics and memory high-water marks
+        (tested); the wall-clock ``timer`` durations are the scratch run's.
+
+        Returns:
+            True if ``data`` was advanced; False if the scratch does not hold this window
+            (the caller steps ``data`` itself).
+        """
+        if not self.window_matches(data, ctrl, nstep):
+            return False
+        mujoco.mj_copyData(data, self.model, self.scratch)
+        self._key_nstep = 0  # used up: data has moved on
+        return True
 
     def plan(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> Any:
         """The :class:`monitor.Plan` of the next ``nstep`` substeps (mocap poses held)."""
@@ -134,27 +205,67 @@ class Rollout:
         brake control ``brake_fn(state at the window's end)`` until every
         ``|qvel| <= vel_tol`` or ``max_steps`` substeps.
 
+        The window is not integrated again when the scratch already holds it (the
+        gate predicted it just before): the tail starts from the scratch's end state
+        (``mj_setState`` of its integration state into a second scratch ``MjData``,
+        which determines every later ``mj_step`` bit for bit). ``brake_fn`` receives
+        that ``MjData``: its integration state (qpos, qvel, act, ctrl, ...) is the
+        window's end; quantities derived from it (``xpos``, contacts, ...) are not
+        recomputed (the gate's brake functions read ``qpos`` only).
+
         Returns:
             (plan of the tail from the window's end, brake control (nu,),
             qvel (K, nv) at the tail's waypoints).
         """
         from monitor.motion.plan import Plan
 
-        self.states(data, ctrl, nstep)
-        m, s = self.model, self.scratch
+        m = self.model
+        if not self.window_matches(data, ctrl, nstep):
+            self.states(data, ctrl, nstep)
+        s = self._tail_data
+        if s is None:
+            s = self._tail_data = mujoco.MjData(m)
+        mujoco.mj_getState(m, self.scratch, self._end_state, _INTEGRATION)
+        mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
-        times, qpos, qvel = [s.time], [s.qpos.copy()], [s.qvel.copy()]
-        for _ in range(max(int(max_steps), 1)):
-            mujoco.mj_step(m, s)
-            times.append(s.time)
-            qpos.append(s.qpos.copy())
-            qvel.append(s.qvel.copy())
-            if m.nv == 0 or float(np.max(np.abs(s.qvel))) <= vel_tol:
+        n = max(int(max_steps), 1)
+        nq = m.nq
+        # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
+        # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
+        # 1, 2, 4, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
+        # tail ends at the first substep that passes it, exactly as a per-substep test
+        # would (substeps simulated beyond it in the same chunk only touch the private
+        # scratch).
+        rows = np.empty((n + 1, 1 + nq + m.nv))
+        mujoco.mj_getState(m, s, rows[0], _TAIL_ROW)
+        end = n
+        k = 0
+        chunk = 1
+        while k < n:
+            hi = min(k + chunk, n)
+            chunk = min(2 * chunk, _TAIL_CHUNK)
+            for j in range(k + 1, hi + 1):
+                mujoco.mj_step(m, s)
+                mujoco.mj_getState(m, s, rows[j], _TAIL_ROW)
+            if m.nv == 0:
+                end = k + 1
                 break
-        plan = Plan._trusted(np.array(times), np.array(qpos), model=m, mocap_pos=np.array(data.mocap_pos),
-                             mocap_quat=np.array(data.mocap_quat))
-        return plan, brake, np.array(qvel)
+            stop = np.flatnonzero(np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol)
+            if stop.size:
+                end = k + 1 + int(stop[0])
+                break
+            k = hi
+        rows = rows[:end + 1]
+        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=m,
+                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
+        return plan, brake, rows[:, 1 + nq:].copy()
+
+
+_AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
+_FIXED = int(mujoco.mjtGain.mjGAIN_FIXED)
+_TRN_JOINT = int(mujoco.mjtTrn.mjTRN_JOINT)
+_HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -167,23 +278,30 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     servo then brakes, a motor coasts). The result is clipped to ``ctrlrange``
     where the control is limited.
 
+    Vectorised over the actuators and read from the live model on every call (a model
+    edited in place, e.g. a randomised gain, is used as it is now); the same
+    operations per actuator as the scalar formula, so the same floats.
+
     Returns:
         (nu,) float64 control.
     """
-    ctrl = np.zeros(model.nu)
-    hinge_slide = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
-    for a in range(model.nu):
-        if (int(model.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT)
-                or int(model.actuator_biastype[a]) != int(mujoco.mjtBias.mjBIAS_AFFINE)
-                or int(model.actuator_gaintype[a]) != int(mujoco.mjtGain.mjGAIN_FIXED)):
-            continue
-        gain = model.actuator_gainprm[a, 0]
-        b0, b1 = model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
-        j = model.actuator_trnid[a, 0]
-        if gain == 0.0 or b1 == 0.0 or int(model.jnt_type[j]) not in hinge_slide:
-            continue
-        length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j]]
-        ctrl[a] = -(b0 + b1 * length) / gain
+    nu = model.nu
+    ctrl = np.zeros(nu)
+    if nu == 0:
+        return ctrl
+    gain = model.actuator_gainprm[:, 0]
+    b0, b1 = model.actuator_biasprm[:, 0], model.actuator_biasprm[:, 1]
+    j = model.actuator_trnid[:, 0]
+    ok = ((model.actuator_trntype == _TRN_JOINT) & (model.actuator_biastype == _AFFINE)
+          & (model.actuator_gaintype == _FIXED) & (gain != 0.0) & (b1 != 0.0))
+    if ok.any():
+        a = np.flatnonzero(ok)
+        ja = j[a]
+        jt = model.jnt_type[ja]
+        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+        if a.size:
+            length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j[a]]]
+            ctrl[a] = -(b0[a] + b1[a] * length) / gain[a]
     limited = model.actuator_ctrllimited.astype(bool)
     lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
     ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
@@ -506,6 +624,7 @@ class Gate:
         _check_log(log)
         self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._cache_context: tuple[Any, ...] | None = None
+        self._pair_bodies_cache: tuple[Any, ...] | None = None
         self._scene_builds = 0
         self.penetration_tol = check_rule(ongoing, penetration_tol)
         self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
@@ -541,7 +660,7 @@ class Gate:
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0}
+                      "reused_pairs": 0, "pairs": 0, "committed": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -663,24 +782,42 @@ class Gate:
             self._cache.clear()
             self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
-        pair_bodies = [(scene.geoms[a].body_id, scene.geoms[b].body_id) for a, b in scene.pair_ids]
-        fixed = [i for i, (ba, bb) in enumerate(pair_bodies) if not moving[ba] and not moving[bb]]
-        if not fixed:
+        body_a, body_b = self._pair_bodies(scene)
+        fixed = np.flatnonzero(~(moving[body_a] | moving[body_b]))
+        if not fixed.size:
             return None, {}, {}
         pos, rot = plan.body_poses(np.array([plan.t0]))
+        ba, bb = body_a[fixed], body_b[fixed]
+        # key of pair i: the bytes of (p_a (3,), R_a (9,), p_b (3,), R_b (9,)) at t0
+        rows = np.concatenate([pos[0, ba], rot[0, ba].reshape(-1, 9), pos[0, bb], rot[0, bb].reshape(-1, 9)],
+                              axis=1)
         keys, reused = {}, {}
-        for i in fixed:
-            ba, bb = pair_bodies[i]
-            key = (pos[0, ba].tobytes() + rot[0, ba].tobytes() + pos[0, bb].tobytes()
-                   + rot[0, bb].tobytes())
+        cache = self._cache
+        for i, row in zip(fixed.tolist(), rows):
+            key = row.tobytes()
             keys[i] = key
-            hit = self._cache.get(i)
+            hit = cache.get(i)
             if hit is not None and hit[0] == key:
                 reused[i] = hit[1]
         if not reused:
             return None, {}, keys
-        todo = [i for i in range(len(pair_bodies)) if i not in reused]
+        todo = [i for i in range(len(body_a)) if i not in reused]
         return todo, reused, keys
+
+    def _pair_bodies(self, scene: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(P,) body ids of each candidate pair's two geoms, cached per scene geometry.
+
+        Keyed on the scene object and its current ``geoms`` / ``pair_ids`` objects, which
+        ``Scene.sync()`` replaces on a rebuild.
+        """
+        hit = self._pair_bodies_cache
+        if hit is not None and hit[0] is scene and hit[1] is scene.geoms and hit[2] is scene.pair_ids:
+            return hit[3], hit[4]
+        ids = np.asarray(scene.pair_ids, dtype=np.int64).reshape(-1, 2)
+        body_of = np.array([g.body_id for g in scene.geoms], dtype=np.int64)
+        body_a, body_b = body_of[ids[:, 0]], body_of[ids[:, 1]]
+        self._pair_bodies_cache = (scene, scene.geoms, scene.pair_ids, body_a, body_b)
+        return body_a, body_b
 
     def _certify_subset(self, certify: Callable[..., Certificate], scene: Any, plan: Any,
                         todo: list[int], reused: dict[int, PairResult]) -> Certificate:
@@ -875,7 +1012,9 @@ class Gate:
 
         ``data.ctrl`` is set to the applied control (the proposal, or the fallback
         when blocked) and ``mj_step`` runs ``nstep`` times, as gymnasium's
-        ``MujocoEnv.do_simulation`` does.
+        ``MujocoEnv.do_simulation`` does. When the gate's scratch already integrated
+        exactly that window (the usual case), its end state is copied instead
+        (:meth:`Rollout.commit`; bit-identical, the simulation runs once per window).
 
         Args:
             data: the caller's ``MjData`` (advanced in place).
@@ -896,8 +1035,14 @@ class Gate:
         if not np.all(np.isfinite(ctrl)):
             raise InvalidInputError("ctrl contains NaN or inf")
         report = self.decide(data, ctrl, nstep=n)
-        data.ctrl[:] = report.applied_ctrl
-        mujoco.mj_step(self.model, data, nstep=n)
+        # The scratch usually holds the applied window already (the proposal's, or the
+        # fallback's when it was predicted): copy it instead of integrating again (exact,
+        # see Rollout.commit). Otherwise (a window inside the committed tail) step.
+        if self._rollout.commit(data, report.applied_ctrl, n):
+            self.stats["committed"] += 1
+        else:
+            data.ctrl[:] = report.applied_ctrl
+            mujoco.mj_step(self.model, data, nstep=n)
         report = replace(report, stepped=True)
         self.last_report = report
         return report

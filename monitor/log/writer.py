@@ -116,7 +116,21 @@ def _dumps(obj: Any) -> bytes:
 
 
 def _null_unknown(x: Any) -> Any:
-    """Replace the +-1e308 stand-ins of ``Certificate.to_dict`` by None, recursively."""
+    """Replace the +-1e308 stand-ins of ``Certificate.to_dict`` by None, recursively.
+
+    Tuples become lists. Dispatches on the exact type first (the plain dict / list /
+    float / str / int / None that ``to_dict`` produces); subclasses (numpy floats, ...)
+    take the general ``isinstance`` path, with the same result.
+    """
+    t = type(x)
+    if t is float:
+        return x if abs(x) < UNKNOWN_ABS else None
+    if t is dict:
+        return {k: _null_unknown(v) for k, v in x.items()}
+    if t is list or t is tuple:
+        return [_null_unknown(v) for v in x]
+    if x is None or t is str or t is int or t is bool:
+        return x
     if isinstance(x, dict):
         return {k: _null_unknown(v) for k, v in x.items()}
     if isinstance(x, list | tuple):

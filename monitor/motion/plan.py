@@ -243,6 +243,34 @@ class _ModelStructure:
                 self.own_cols[b, whole] = True
                 if rot is not None:
                     self.own_rot_cols[b, rot] = True
+        # Bodies by tree depth (non-mocap, world excluded) with their parents: for the
+        # vectorised moving/rotating propagation in Plan._setup. Mocap bodies stay
+        # False (fixed frames), and so does the world.
+        depth = np.zeros(nbody, dtype=np.int64)
+        for b in range(1, nbody):
+            depth[b] = depth[self.parent[b]] + 1  # MuJoCo orders parents before children
+        par = np.asarray(self.parent, dtype=np.int64)
+        not_mocap = ~np.asarray(self.mocap, dtype=bool)
+        self.levels: list[tuple[np.ndarray, np.ndarray]] = []
+        for lev in range(1, int(depth.max(initial=0)) + 1):
+            bodies = np.flatnonzero((depth == lev) & not_mocap)
+            if bodies.size:
+                self.levels.append((bodies, par[bodies]))
+        # Small trees: (nbody, nq) counts of the qpos columns of each body's chain (its own
+        # joints and its ancestors' up to the world or a mocap body), so that "moves" is one
+        # matrix-vector product with the (nq,) changed-columns mask.
+        self.chain_cols: np.ndarray | None = None
+        self.chain_rot_cols: np.ndarray | None = None
+        self.chain_both_cols: np.ndarray | None = None
+        if nbody * model.nq <= 1 << 16:
+            cc = np.zeros((nbody, model.nq), dtype=np.int64)
+            cr = np.zeros((nbody, model.nq), dtype=np.int64)
+            for b in range(1, nbody):
+                if not self.mocap[b]:
+                    cc[b] = self.own_cols[b] | (cc[self.parent[b]] > 0)
+                    cr[b] = self.own_rot_cols[b] | (cr[self.parent[b]] > 0)
+            self.chain_cols, self.chain_rot_cols = cc, cr
+            self.chain_both_cols = np.concatenate([cc, cr])  # (2 nbody, nq): one product for both
         # Chains (virtual joints root -> body over the moving bodies) per moving pattern.
         self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
         self.ref = _ref_points(model)
@@ -278,10 +306,13 @@ def _fk_data(model: mujoco.MjModel) -> mujoco.MjData:
 
 
 def _structure_key(model: mujoco.MjModel) -> bytes:
-    """Bytes of every model array :class:`_ModelStructure` reads (its cache key)."""
-    return b"|".join([np.asarray([model.nq, model.nv, model.njnt, model.nbody, model.nmocap,
-                                  model.ngeom]).tobytes()]
-                     + [np.ascontiguousarray(getattr(model, f)).tobytes() for f in _STRUCT_FIELDS])
+    """Bytes of every model array :class:`_ModelStructure` reads (its cache key).
+
+    Read through the cached views of :func:`_field_views` (the same buffers as
+    ``getattr(model, field)``, without building 16 new views per plan).
+    """
+    sizes = (model.nq, model.nv, model.njnt, model.nbody, model.nmocap, model.ngeom)
+    return b"|".join([repr(sizes).encode()] + [v.tobytes() for v in _field_views(model)])
 
 
 _VIEWS: dict[int, tuple[mujoco.MjModel, list[np.ndarray]]] = {}
@@ -394,8 +425,9 @@ class Plan(WindowTimes):
         if not (np.isfinite(times).all() and (times[1:] > times[:-1]).all()):
             K.check_times(times)  # raises with the precise message
         K.check_finite("qpos", qpos)
-        K.check_finite("mocap_pos", mocap_pos)
-        K.check_finite("mocap_quat", mocap_quat)
+        if mocap_pos.size:
+            K.check_finite("mocap_pos", mocap_pos)
+            K.check_finite("mocap_quat", mocap_quat)
         self._setup(model, st, times, qpos, mocap_pos, mocap_quat, tolerances)
         return self
 
@@ -405,7 +437,8 @@ class Plan(WindowTimes):
         self._model = model
         self._tol = tolerances
         self._st = st
-        mq = K.normalize_quats("mocap_quat", mq, tolerances)
+        if mq.size:  # (0, 4) when the model has no mocap body: nothing to normalise
+            mq = K.normalize_quats("mocap_quat", mq, tolerances)
 
         # Joint structure.
         self._quat_tracks: dict[int, K.QuatTrack] = {}
@@ -430,25 +463,25 @@ class Plan(WindowTimes):
         self._body_mat = st.body_mat
         self._parent = st.parent
 
-        # Which qpos columns change anywhere in the window, per body chain.
-        changes = np.any(q != q[0], axis=0)  # (nq,)
+        # Which qpos columns change anywhere in the window, per body chain: a body moves
+        # (rotates) when one of its own joints or of its ancestors' (up to the world or a
+        # mocap body, which is a fixed frame) changes. Propagated one tree depth at a
+        # time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
+        changes = (q != q[0]).any(axis=0)  # (nq,)
         nbody = st.nbody
         parent = st.parent
         moving = np.zeros(nbody, dtype=bool)
         rotating = np.zeros(nbody, dtype=bool)
         if changes.any():
-            own_moving = (st.own_cols & changes).any(axis=1).tolist()
-            own_rot = (st.own_rot_cols & changes).any(axis=1).tolist()
-            mv = [False] * nbody
-            rt = [False] * nbody
-            for b in range(1, nbody):
-                if st.mocap[b]:
-                    continue
-                p = parent[b]
-                mv[b] = own_moving[b] or mv[p]
-                rt[b] = own_rot[b] or rt[p]
-            moving[:] = mv
-            rotating[:] = rt
+            if st.chain_cols is not None:  # small trees: one product each
+                both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
+                moving, rotating = both[:nbody], both[nbody:]
+            else:
+                own_moving = (st.own_cols & changes).any(axis=1)
+                own_rot = (st.own_rot_cols & changes).any(axis=1)
+                for bodies, parents in st.levels:
+                    moving[bodies] = own_moving[bodies] | moving[parents]
+                    rotating[bodies] = own_rot[bodies] | rotating[parents]
         self._moving = moving
         self._rotating = rotating
         self._moving.setflags(write=False)
@@ -481,7 +514,7 @@ class Plan(WindowTimes):
         self._chain_v, self._own_count = chains
 
         self._magnitude = {
-            "q": float(np.max(np.abs(q), initial=0.0)) + st.qpos0_mag,
+            "q": float(np.abs(q).max(initial=0.0)) + st.qpos0_mag,
             "path": max((float(tr.cum[-1]) for tr in self._quat_tracks.values()), default=0.0),
         }
         # Waypoint poses (for translation segments and the rounding scale) and the

@@ -1,0 +1,190 @@
+"""The gate's per-step plumbing, vectorised: same numbers as the scalar definitions (issue 12, item 5).
+
+Oracles are the scalar per-actuator / per-body definitions written out here (independent of
+the vectorised code): ``hold_ctrl``'s formula per actuator, and "a body moves when a joint of
+its chain (up to the world or a mocap body) changes" walked body by body.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from monitor._paths import scene_path
+from monitor.gate import hold_ctrl
+from monitor.motion.plan import Plan
+
+_HINGE, _SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+_FREE, _BALL = int(mujoco.mjtJoint.mjJNT_FREE), int(mujoco.mjtJoint.mjJNT_BALL)
+
+_MIXED = """
+<mujoco>
+  <worldbody>
+    <body name="mocap" mocap="true" pos="1 0 0">
+      <geom size="0.05"/>
+      <body name="under_mocap"><joint type="hinge" axis="0 0 1"/><geom size="0.05" pos="0.2 0 0"/></body>
+    </body>
+    <body name="free" pos="0 1 0"><freejoint/><geom size="0.05"/>
+      <body name="on_free"><joint type="ball"/><geom size="0.05" pos="0 0.2 0"/>
+        <body name="slider"><joint type="slide" axis="1 0 0"/><geom size="0.05" pos="0 0.4 0"/></body>
+      </body>
+    </body>
+    <body name="arm" pos="0 -1 0"><joint name="j0" type="hinge" axis="0 0 1"/><geom size="0.05"/>
+      <body name="fore" pos="0.3 0 0"><joint name="j1" type="hinge" axis="0 1 0"/><geom size="0.05"/>
+        <body name="tip" pos="0.3 0 0"><joint name="j2" type="slide" axis="1 0 0"/><geom size="0.05"/></body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <position joint="j0" kp="10" ctrlrange="-1 1"/>
+    <position joint="j1" kp="5" gear="2"/>
+    <velocity joint="j2" kv="3"/>
+    <motor joint="j1" ctrlrange="-2 2"/>
+    <general joint="j2" gaintype="fixed" biastype="affine" gainprm="4" biasprm="0.5 -2 0"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def _forest(chains: int = 60, depth: int = 5) -> str:
+    """chains x depth hinge bodies (nbody * nq > 2^16: the per-depth propagation path)."""
+    out = []
+    for c in range(chains):
+        body = ""
+        for k in reversed(range(depth)):
+            joint = '<joint type="hinge" axis="0 0 1"/>' if k else '<joint type="slide" axis="1 0 0"/>'
+            pos = "0.1 0 0" if k else f"{c} 0 0"
+            body = f'<body pos="{pos}">{joint}<geom size="0.01"/>{body}</body>'
+        out.append(body)
+    return f"<mujoco><worldbody>{''.join(out)}</worldbody></mujoco>"
+
+
+def _models():
+    return {"forest": mujoco.MjModel.from_xml_string(_forest()),
+            "mixed": mujoco.MjModel.from_xml_string(_MIXED),
+            "arm": mujoco.MjModel.from_xml_path(str(scene_path("arm"))),
+            "tunnel": mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))}
+
+
+def _hold_scalar(model, data):
+    """hold_ctrl's documented formula, one actuator at a time."""
+    ctrl = np.zeros(model.nu)
+    for a in range(model.nu):
+        if (model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT
+                or model.actuator_biastype[a] != mujoco.mjtBias.mjBIAS_AFFINE
+                or model.actuator_gaintype[a] != mujoco.mjtGain.mjGAIN_FIXED):
+            continue
+        gain = model.actuator_gainprm[a, 0]
+        b0, b1 = model.actuator_biasprm[a, 0], model.actuator_biasprm[a, 1]
+        j = model.actuator_trnid[a, 0]
+        if gain == 0.0 or b1 == 0.0 or model.jnt_type[j] not in (_HINGE, _SLIDE):
+            continue
+        ctrl[a] = -(b0 + b1 * (model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j]])) / gain
+        if model.actuator_ctrllimited[a]:
+            ctrl[a] = min(max(ctrl[a], model.actuator_ctrlrange[a, 0]), model.actuator_ctrlrange[a, 1])
+    for a in range(model.nu):
+        if model.actuator_ctrllimited[a]:
+            ctrl[a] = min(max(ctrl[a], model.actuator_ctrlrange[a, 0]), model.actuator_ctrlrange[a, 1])
+    return ctrl
+
+
+@pytest.mark.parametrize("name", ["mixed", "arm", "tunnel"])
+def test_hold_ctrl_matches_the_per_actuator_formula(name):
+    m = _models()[name]
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(0)
+    nonzero = 0
+    for _ in range(40):
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] += rng.normal(0.0, 0.7, m.nq)
+        got = hold_ctrl(m, d)
+        assert np.array_equal(got, _hold_scalar(m, d))
+        nonzero += int(np.count_nonzero(got))
+    if name != "tunnel":  # the tunnel has a velocity servo only: hold = 0
+        assert nonzero > 0
+
+
+def test_hold_ctrl_reads_an_edited_model():
+    m = mujoco.MjModel.from_xml_string(_MIXED)
+    d = mujoco.MjData(m)
+    d.qpos[m.jnt_qposadr[m.joint("j1").id]] = 0.3
+    before = hold_ctrl(m, d)
+    m.actuator_gear[1, 0] = 3.0  # domain randomisation of the gear, in place
+    after = hold_ctrl(m, d)
+    assert before[1] == pytest.approx(0.6) and after[1] == pytest.approx(0.9)
+    assert np.array_equal(after, _hold_scalar(m, d))
+
+
+def _moving_scalar(model, changes):
+    """(moving, rotating) body masks walked body by body from the changed qpos columns."""
+    width = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}
+    moving = np.zeros(model.nbody, bool)
+    rotating = np.zeros(model.nbody, bool)
+    for b in range(1, model.nbody):
+        if model.body_mocapid[b] >= 0:
+            continue
+        own_m = own_r = False
+        for j in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+            a, typ = model.jnt_qposadr[j], model.jnt_type[j]
+            cols = changes[a:a + width[typ]]
+            own_m |= bool(cols.any())
+            if typ in (_HINGE, _BALL):
+                own_r |= bool(cols.any())
+            elif typ == _FREE:
+                own_r |= bool(changes[a + 3:a + 7].any())
+        p = model.body_parentid[b]
+        moving[b] = own_m or moving[p]
+        rotating[b] = own_r or rotating[p]
+    return moving, rotating
+
+
+@pytest.mark.parametrize("name", ["mixed", "arm", "tunnel", "forest"])
+def test_plan_moving_and_rotating_bodies_match_the_chain_walk(name):
+    m = _models()[name]
+    d = mujoco.MjData(m)
+    mujoco.mj_resetData(m, d)
+    rng = np.random.default_rng(1)
+    for trial in range(30):
+        q0 = np.array(d.qpos)
+        q1 = q0.copy()
+        changes = rng.random(m.nq) < (0.3 if trial % 3 else 0.0)  # some windows move nothing
+        q1[changes] += rng.normal(0.0, 0.2, int(changes.sum()))
+        mujoco.mj_normalizeQuat(m, q1)
+        changes = q1 != q0
+        for ctor in ("public", "trusted"):
+            if ctor == "public":
+                plan = Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), m)
+            else:
+                plan = Plan._trusted(np.array([0.0, 0.1]), np.stack([q0, q1]), model=m,
+                                     mocap_pos=np.array(d.mocap_pos), mocap_quat=np.array(d.mocap_quat))
+            moving, rotating = _moving_scalar(m, changes)
+            assert np.array_equal(plan.moving_bodies(), moving), (trial, ctor)
+            assert np.array_equal(plan._rotating, rotating), (trial, ctor)
+
+
+def _null_unknown_reference(x):
+    """The log's rule, written out: floats that are not < 1e308 in magnitude (stand-ins, NaN) -> None."""
+    if isinstance(x, dict):
+        return {k: _null_unknown_reference(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_null_unknown_reference(v) for v in x]
+    if isinstance(x, float) and not abs(x) < 1e308:
+        return None
+    return x
+
+
+def test_log_null_unknown_fast_path_matches_the_rule():
+    from collections import OrderedDict
+
+    from monitor.log.writer import _null_unknown
+
+    value = {"a": 1e308, "b": -1e308, "c": 1.5, "d": float("nan"), "e": [1, (2.0, 1e308), None, "x", True],
+             "f": {"g": np.float64(1e308), "h": np.float64(0.25), "i": np.int64(3)},
+             "j": OrderedDict(k=-1e308, m=[np.float32(2.0)]), "n": float("inf"), "o": 1.7976931348623157e308,
+             "p": 9.999999999999999e307}
+    got, want = _null_unknown(value), _null_unknown_reference(value)
+    assert got == want
+    assert [type(v) for v in got.values()] == [type(v) for v in want.values()]
+    assert got["a"] is None and got["o"] is None and got["p"] == 9.999999999999999e307
+    assert got["f"]["g"] is None and got["j"]["k"] is None and got["e"][1] == [2.0, None]
