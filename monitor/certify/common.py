@@ -52,6 +52,67 @@ class PairOutcome:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+class _CompileClock:
+    """Seconds this process has spent compiling numba kernels (``numba:compile`` events).
+
+    A numba compile (or an on-disk cache load) of a kernel used for the first time runs
+    inside whatever call needs it. It is not certification work, so :class:`Budget` does
+    not charge it: a budget's clock is wall time minus the compile time since the budget
+    started. Nested compile events (a kernel compiling its callees) are counted once,
+    from the outermost start to its end. numba compiles under a process-wide lock, so
+    one compile runs at a time; a compile on another thread during a budget also pauses
+    that budget's clock (harmless: a budget is a work limit, never a soundness argument).
+    """
+
+    def __init__(self) -> None:
+        self.total = 0.0
+        self._depth = 0
+        self._t0 = 0.0
+
+    def on_start(self, event: Any) -> None:
+        if self._depth == 0:
+            self._t0 = time.perf_counter()
+        self._depth += 1
+
+    def on_end(self, event: Any) -> None:
+        self._depth = max(self._depth - 1, 0)
+        if self._depth == 0:
+            self.total += time.perf_counter() - self._t0
+
+    def seconds(self) -> float:
+        """Compile seconds so far (including a compile still running)."""
+        if self._depth > 0:
+            return self.total + (time.perf_counter() - self._t0)
+        return self.total
+
+
+def _install_compile_clock() -> _CompileClock:
+    clock = _CompileClock()
+    try:
+        from numba.core import event
+
+        class _Listener(event.Listener):
+            def on_start(self, ev: Any) -> None:
+                clock.on_start(ev)
+
+            def on_end(self, ev: Any) -> None:
+                clock.on_end(ev)
+
+        event.register("numba:compile", _Listener())
+    except Exception:  # noqa: BLE001 - no numba event API: compile time is charged (slower, never unsound)
+        pass
+    return clock
+
+
+COMPILE_CLOCK = _install_compile_clock()
+"""Process-wide numba compile time; see :class:`_CompileClock`."""
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent compiling numba kernels so far."""
+    return COMPILE_CLOCK.seconds()
+
+
 DEFAULT_BUDGET_SECONDS = 10.0
 """Wall-clock budget (s) of a ``certify`` call made with ``budget=None``.
 
@@ -75,7 +136,9 @@ class Budget:
 
     An exhausted budget turns every unfinished pair into "uncertain", never into
     "certified". ``None`` fields are unlimited. The clock starts when the Budget is
-    created (a dict budget or the default one is created when ``certify`` starts).
+    created (a dict budget or the default one is created when ``certify`` starts) and
+    does not count numba compile time (:func:`compile_seconds`): a kernel compiled on
+    first use inside a call does not spend that call's budget.
     ``monitor.certify`` checks it inside every stage (motion bounds, broad phase, start
     pose, checkers, witness search); the worst overrun measured is in
     ``docs/notes/issue-11-model.md``.
@@ -89,6 +152,7 @@ class Budget:
     tests: int | None = None
     _start: float = field(default_factory=time.perf_counter, repr=False)
     _used_tests: int = field(default=0, repr=False)
+    _compile0: float = field(default_factory=compile_seconds, repr=False)
 
     def __post_init__(self) -> None:
         from monitor.errors import InvalidInputError
@@ -117,7 +181,19 @@ class Budget:
         """True once either limit is reached."""
         if self.tests is not None and self._used_tests >= self.tests:
             return True
-        return self.seconds is not None and time.perf_counter() - self._start >= self.seconds
+        if self.seconds is None:
+            return False
+        return self.elapsed() >= self.seconds
+
+    def elapsed(self) -> float:
+        """Seconds since the budget started, minus the numba compile time in that span."""
+        return time.perf_counter() - self._start - (compile_seconds() - self._compile0)
+
+    def share_clock(self, other: Budget) -> None:
+        """Run on ``other``'s clock and test count (a budget derived from ``other``)."""
+        self._start = other._start
+        self._compile0 = other._compile0
+        self._used_tests = other._used_tests
 
     def check(self) -> None:
         """Raise :class:`BudgetExhausted` if the budget is exhausted."""
@@ -150,5 +226,5 @@ def check_active_budget() -> None:
         raise BudgetExhausted
 
 
-__all__ = ["PairOutcome", "Budget", "Outcome", "BudgetExhausted", "DEFAULT_BUDGET_SECONDS",
+__all__ = ["PairOutcome", "Budget", "Outcome", "BudgetExhausted", "DEFAULT_BUDGET_SECONDS", "compile_seconds",
            "active_budget", "check_active_budget"]
