@@ -354,7 +354,10 @@ class _Search:
     def __init__(self, bodies: Sequence[_Body], pairs: Sequence[tuple[int, int, int, int]],
                  window: tuple[float, float], margin: float, tol: Tolerances,
                  budget: Budget | None, earliest: bool, clearance: bool,
-                 divide: bool = True, offset: bool = True) -> None:
+                 divide: bool = True, offset: bool = True, division: str = "bisect") -> None:
+        if division not in ("bisect", "16way"):
+            raise InvalidInputError(f"division must be 'bisect' or '16way', got {division!r}")
+        self.division = division
         self.bodies = bodies
         self.window = window
         self.margin = margin
@@ -742,7 +745,8 @@ class _Search:
                 live_idx.append(k)
             if not live_idx:
                 continue
-            if not self.divide or len(live_idx) <= kappa(d) or d >= KAPPA_MAX_DEPTH:
+            max_d = KAPPA_MAX_DEPTH // 4 if self.division == "16way" else KAPPA_MAX_DEPTH
+            if not self.divide or len(live_idx) <= kappa(d) or d >= max_d:
                 # conquer: one LP per leaf pair and span, over its whole S-bound box (the
                 # regions prune, prove full collisions and order by time; re-testing a
                 # pair per region would only multiply LPs)
@@ -753,6 +757,15 @@ class _Search:
                     tested.add(k)
                     p.max_depth = max(p.max_depth, d)
                     self._lp_region(p, s0, s1, st, np.r_[x_lo, tl], np.r_[x_hi, th], tl, th, x_lo, x_hi)
+                continue
+            if self.division == "16way":  # the paper's rule: halve all four axes
+                mid4 = 0.5 * (rlo + rhi)
+                for code in range(16):
+                    bits = np.array([(code >> j) & 1 for j in range(4)], bool)
+                    nlo = np.where(bits, mid4, rlo)
+                    nhi = np.where(bits, rhi, mid4)
+                    counter += 1
+                    heapq.heappush(heap, (float(nlo[3]), counter, d + 1, nlo, nhi, live_idx))
                 continue
             # divide: bisect the longest axis (time in metres via the fastest speed)
             ext = rhi - rlo
@@ -1035,7 +1048,7 @@ def _resolve_pairs(bodies: list[_Body], allowed: Iterable[tuple[str, str]] | Non
 def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple[str, str]] | None,
                 window: tuple[float, float], margin: float = 0.0, tolerances: Tolerances = DEFAULT,
                 budget: Budget | None = None, earliest: bool = True, clearance: bool = True,
-                divide: bool = True, offset: bool = True) -> SearchResult:
+                divide: bool = True, offset: bool = True, division: str = "bisect") -> SearchResult:
     """The n-ary operator of §6 over all translating bodies in one search, with statistics.
 
     Args:
@@ -1046,6 +1059,9 @@ def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple
         divide: run the divide-and-conquer stage (False: conquer every region at once).
         offset: null-set LP on offset half-spaces for pairs with radii / margin (see
             :func:`check_pairs`).
+        division: ``"bisect"`` (longest axis, time in metres by the fastest speed; the
+            default, see docs/notes/issue-14-extrusion.md) or ``"16way"`` (the paper's
+            split of all four axes, at most 3 levels).
 
     Returns:
         :class:`SearchResult` with one outcome per pair (request order) and stats.
@@ -1053,7 +1069,7 @@ def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple
     w = _check_window(window, margin)
     bl = _bodies_many(bodies, w)
     idx = _resolve_pairs(bl, allowed_pairs)
-    s = _Search(bl, idx, w, float(margin), tolerances, budget, earliest, clearance, divide, offset)
+    s = _Search(bl, idx, w, float(margin), tolerances, budget, earliest, clearance, divide, offset, division)
     s.run()
     names = [(bl[i].geoms[ga], bl[j].geoms[gb]) for i, ga, j, gb in idx]
     return SearchResult(s.outcomes(), names, _compact_stats(s.stats))
