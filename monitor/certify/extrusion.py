@@ -37,13 +37,33 @@ Pipeline (per time span, spans in time order):
    its own co-moving frame (the first scheme of §6.3). Regions are measured in
    a frame moving with a per-axis body velocity (App. B, "optimal fitting");
    collision is Galilean invariant, so this only shifts velocities.
-4. **Exact null-set test** (§4.2), per remaining convex leaf pair, in
-   :mod:`monitor.certify.extrusion_null`: slack LP for polytope pairs at zero
-   margin (regularised semantics: touching is not a collision), exact
-   quadratic (swept least-distance) test when a radius or margin is involved,
-   closed form against half-spaces. Sphere and capsule geoms are exact here
-   (no circumscribed polytope), so ``approx_error`` is 0 for them.
-5. **Earliest witness** (§5). Spans are visited in time order, and a pair found
+   ``division="16way"`` splits all four axes as the paper does; the default
+   longest-axis bisection needed the same LPs with 3.7x fewer regions (measured,
+   docs/notes/issue-14-extrusion.md).
+4. **Null-set test** (§4.2), per remaining convex leaf pair, in
+   :mod:`monitor.certify.extrusion_null`: the slack LP with its float64-verified
+   dual bound (regularised semantics: touching is not a collision), first tried
+   with the 1- and 2-row duals (:func:`~monitor.certify.extrusion_null.dual_certificate`,
+   no solver call). With a radius or a margin (``r = r_a + r_b + margin > 0``)
+   each leaf's half-spaces are **offset** outward by its radius + margin/2 + delta
+   (sphere and capsule cores get a synthesised H-rep: 14 directions about a point,
+   an octagonal prism about a segment, :func:`core_hrep`). The offset polytope
+   contains the rounded shape, so an empty offset intersection (max slack <=
+   ``extrusion_slack`` < delta) certifies core distance > r. The offset
+   over-approximates the rounded shape by up to r(sqrt 3 - 1) at a box corner
+   (less with the 14 directions), so a region it leaves open (or a "full"
+   region of §4.1) goes to
+5. **the exact swept test** (not in the paper): the swept least-distance test
+   (Wolfe / NNLS min-norm point of the swept Minkowski difference), which decides
+   exactly; also ``offset=False`` sends every rounded pair straight there. Against
+   a plane the closed form is exact (counted as the null-set stage: a half-space
+   offset by r is exact). Sphere and capsule geoms are exact (no circumscribed
+   polytope), so ``approx_error`` is 0 for them.
+
+   ``PairOutcome.info["stage"]`` names the stage that decided the pair (the latest
+   stage any span needed): ``"sbounds"``, ``"divide_and_conquer"``, ``"null_set"`` or
+   ``"exact_swept"`` (:data:`STAGES`); :func:`search_summary` counts them.
+6. **Earliest witness** (§5). Spans are visited in time order, and a pair found
    colliding in a span gets the exact first-contact time in that span (LP
    ``min tau`` over the intersection polytope, or bisection of the convex core
    distance). ``witness_time`` is the earliest time at which the overlap reaches

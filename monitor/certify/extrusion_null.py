@@ -33,7 +33,18 @@ Three exact tests, chosen per pair by the *inflation* ``r = radius_a + radius_b 
     Overlaps of inscribed depth in ``(pad, extrusion_slack]`` may be reported
     either way; outside this band the verdict is exact.
 
-``quadratic`` (r > 0: spheres, capsules, or any pair with a margin)
+    :func:`dual_certificate` tries every 1- and 2-row dual ``y`` first (the
+    certificate of two antiparallel faces or of a face against the box): the same
+    weak-duality bound, no solver call.
+
+``lp`` on offset half-spaces (r > 0, the engine's path)
+    The caller moves each leaf's rows outward by its radius + margin/2 + delta
+    (``Leaf.h`` already offset). A certificate ``max s <= extrusion_slack < delta``
+    proves core distance > r; a positive slack proves nothing (the offset
+    polytope over-approximates the rounded shape, by up to r(sqrt 3 - 1) at a box
+    corner) and the caller falls back to the quadratic test below.
+
+``quadratic`` (r > 0: the exact swept fallback)
     The exact quadratic extrusion ``{(x, tau) : dist(x, core(tau)) <= radius}``.
     For translating convex cores the core distance ``d(tau)`` is the distance
     from the origin to ``K + w tau`` (``K`` = Minkowski difference of the cores at
@@ -56,6 +67,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy.optimize import linprog, nnls
 
 from monitor.tolerances import Tolerances
@@ -123,6 +135,117 @@ def _solve(c, A, b, bounds):
     return None
 
 
+@njit(cache=True)
+def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
+    """Compiled body of :func:`small_slack_lp`; status 0 = optimal, 1 = failed."""
+    m = h.shape[0]
+    n = m + 8
+    A = np.zeros((5, n))
+    c = np.zeros(n)
+    for i in range(m):
+        for k in range(4):
+            A[k, i] = G[i, k]
+        A[4, i] = 1.0
+        c[i] = h[i]
+    for k in range(4):
+        A[k, m + k] = 1.0
+        A[k, m + 4 + k] = -1.0
+        c[m + k] = hi[k]
+        c[m + 4 + k] = -lo[k]
+    b = np.zeros(5)
+    b[4] = 1.0
+    best, j = np.inf, 0
+    for i in range(m):
+        v = h[i]
+        for k in range(4):
+            v += max(-G[i, k] * lo[k], -G[i, k] * hi[k])
+        if v < best:
+            best, j = v, i
+    basis = np.zeros(5, np.int64)
+    basis[0] = j
+    for k in range(4):
+        basis[k + 1] = m + k if G[j, k] <= 0.0 else m + 4 + k
+    scale = np.abs(c).max() + np.abs(A).max()
+    tol = 1e-12 * scale
+    z = np.zeros(4)
+    y = np.zeros(m)
+    B = np.zeros((5, 5))
+    cB = np.zeros(5)
+    inb = np.zeros(n, np.bool_)
+    for it in range(max_iter):
+        inb[:] = False
+        for r in range(5):
+            B[:, r] = A[:, basis[r]]
+            cB[r] = c[basis[r]]
+            inb[basis[r]] = True
+        if abs(np.linalg.det(B)) < 1e-300:
+            return 1, z, 0.0, y
+        xB = np.linalg.solve(B, b)
+        pi = np.linalg.solve(B.T, cB)
+        e = -1
+        dmin = -tol
+        for q in range(n):
+            if inb[q]:
+                continue
+            d = c[q]
+            for k in range(5):
+                d -= A[k, q] * pi[k]
+            if d < -tol:
+                if it >= 50:  # Bland: first improving column
+                    e = q
+                    break
+                if d < dmin:
+                    dmin, e = d, q
+        if e < 0:
+            for r in range(5):
+                if basis[r] < m:
+                    y[basis[r]] = max(xB[r], 0.0)
+            z[:] = pi[:4]
+            return 0, z, pi[4], y
+        u = np.linalg.solve(B, A[:, e].copy())
+        leave = -1
+        rmin = np.inf
+        for r in range(5):
+            if u[r] > 1e-12:
+                ratio = max(xB[r], 0.0) / u[r]
+                if leave < 0 or ratio < rmin * (1.0 - 1e-15) - 1e-300:
+                    rmin, leave = ratio, r
+                elif ratio <= rmin * (1.0 + 1e-15) + 1e-300 and basis[r] < basis[leave]:
+                    leave = r  # Bland's tie-break
+        if leave < 0:
+            return 1, z, 0.0, y
+        basis[leave] = e
+    return 1, z, 0.0, y
+
+
+def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                   max_iter: int = 200) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The slack LP ``max s : G z + s <= h, lo <= z <= hi`` by a dense revised simplex on its dual.
+
+    Dual (standard form, 5 equality rows): ``min h.y + hi.p - lo.q`` subject to
+    ``G^T y + p - q = 0``, ``1.y = 1``, ``y, p, q >= 0``. The start basis is the best
+    single row ``y = e_j`` with ``p - q = -G_j`` (feasible, unit triangular), so no
+    phase 1 is needed; Dantzig pricing, Bland's rule after 50 pivots (no cycling).
+    The simplex multipliers are the primal ``(z, s)``. Compiled (numba).
+
+    Nothing here is trusted: the caller verifies ``z`` (slack in float64) and ``y``
+    (weak-duality bound) exactly as for the HiGHS answer, and falls back to HiGHS
+    when neither proves a verdict.
+
+    Returns:
+        ``(z (4,), s, y (m,))`` or None (non-finite box, iteration cap, singular basis).
+    """
+    if len(h) == 0 or not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        return None
+    f64 = np.float64
+    status, z, s, y = _dual_simplex_kernel(np.ascontiguousarray(G, f64), np.ascontiguousarray(h, f64),
+                                           np.ascontiguousarray(lo, f64), np.ascontiguousarray(hi, f64),
+                                           int(max_iter))
+    if status != 0 or not (np.all(np.isfinite(z)) and np.isfinite(s) and np.all(np.isfinite(y))):
+        return None
+    return z, float(s), y
+
+
 def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) -> float:
     """Rigorous lower bound on ``min_i h_i - G_i z`` evaluated in float64 (m)."""
     terms = h - G @ z
@@ -142,15 +265,26 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
     """
     G = np.vstack([a.G, b.G])
     h = np.concatenate([a.h, b.h])
+    fast = small_slack_lp(G, h, np.asarray(lo, float), np.asarray(hi, float))
+    if fast is not None:
+        res = _verify_slack(G, h, lo, hi, fast[0], fast[2], tol, data_pad)
+        if res.verdict != "unresolved":
+            return res
     A = np.hstack([G, np.ones((len(h), 1))])
     bounds = [(float(lo[k]), float(hi[k])) for k in range(4)] + [(None, None)]
-    res = _solve(np.array([0, 0, 0, 0, -1.0]), A, h, bounds)
-    if res is None:
+    sol = _solve(np.array([0, 0, 0, 0, -1.0]), A, h, bounds)
+    if sol is None:
         return NullResult("unresolved", -np.inf, np.inf, float(lo[3]), 0.5 * (lo[:3] + hi[:3]))
-    z = np.clip(res.x[:4], lo, hi)
+    return _verify_slack(G, h, lo, hi, sol.x[:4], -sol.ineqlin.marginals, tol, data_pad)
+
+
+def _verify_slack(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray, z: np.ndarray,
+                  y: np.ndarray, tol: Tolerances, data_pad: float) -> NullResult:
+    """Float64 verification of a slack-LP answer: primal point ``z`` (4,) and dual ``y`` (m,)."""
+    z = np.clip(z, lo, hi)
     s_lo = slack_lower(G, h, z, tol) - data_pad
     # dual certificate: s <= y.h - (G^T y).z for every feasible (z, s) when y >= 0, sum y = 1
-    y = np.clip(-res.ineqlin.marginals, 0.0, None)
+    y = np.clip(y, 0.0, None)
     ub = np.inf
     if y.sum() > 0:
         y = y / y.sum()
@@ -439,6 +573,6 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
     return res, float(first.min())
 
 
-__all__ = ["Leaf", "NullResult", "slack_lower", "lp_null_test", "dual_certificate", "lp_earliest", "min_norm",
-           "static_distance",
-           "quadratic_null_test", "quadratic_first_time", "halfspace_null_test"]
+__all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "lp_null_test", "dual_certificate",
+           "lp_earliest", "min_norm", "static_distance", "quadratic_null_test", "quadratic_first_time",
+           "halfspace_null_test"]
