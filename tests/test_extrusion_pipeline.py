@@ -287,3 +287,83 @@ def test_second_pass_only_for_pairs_that_need_it():
     assert cert.stats["extrusion"]["searches"] == 2
     second = _agv_trays_sbounds(cert)[1:]
     assert second and all(b["leaves_in"] <= 4 for b in second)
+
+
+# ----------------------------------------------------------------------------- the LP and its shortcuts
+
+def _random_lp(rng):
+    m = int(rng.integers(8, 40))
+    G = rng.normal(size=(m, 4))
+    G[:, :3] /= np.linalg.norm(G[:, :3], axis=1, keepdims=True)
+    h = rng.uniform(-0.5, 1.0, m)
+    lo, hi = -rng.uniform(0.1, 2.0, 4), rng.uniform(0.1, 2.0, 4)
+    return G, h, lo, hi
+
+
+def test_small_simplex_matches_highs_and_dual_shortcut_is_an_upper_bound():
+    from scipy.optimize import linprog
+
+    from monitor.certify.extrusion_null import Leaf, dual_certificate, small_slack_lp
+
+    rng = np.random.default_rng(5)
+    for _ in range(150):
+        G, h, lo, hi = _random_lp(rng)
+        ref = linprog(np.array([0, 0, 0, 0, -1.0]), A_ub=np.hstack([G, np.ones((len(h), 1))]), b_ub=h,
+                      bounds=[(lo[k], hi[k]) for k in range(4)] + [(None, None)], method="highs-ds")
+        smax = -ref.fun
+        fast = small_slack_lp(G, h, lo, hi)
+        assert fast is not None
+        z, s, y = fast
+        assert s == pytest.approx(smax, abs=1e-9 * (1 + abs(smax)))
+        assert np.all(lo - 1e-12 <= z) and np.all(z <= hi + 1e-12)
+        # split the rows into two "leaves" (velocity 0: G's time column is carried by N @ v = 0 only
+        # when it is zero, so build leaves with N = G[:, :3] and v chosen to reproduce G[:, 3])
+        k = len(h) // 2
+        leaves = []
+        for rows in (slice(0, k), slice(k, len(h))):
+            N, g4 = G[rows, :3], G[rows, 3]
+            v = np.linalg.lstsq(N, -g4, rcond=None)[0]
+            leaves.append(Leaf("polytope", N, h[rows], np.zeros((1, 3)), v, 0.0))
+        Gl = np.vstack([leaves[0].G, leaves[1].G])
+        ref2 = linprog(np.array([0, 0, 0, 0, -1.0]), A_ub=np.hstack([Gl, np.ones((len(h), 1))]), b_ub=h,
+                       bounds=[(lo[k], hi[k]) for k in range(4)] + [(None, None)], method="highs-ds")
+        assert dual_certificate(leaves[0], leaves[1], lo, hi, DEFAULT) >= -ref2.fun - 1e-12
+
+
+def test_a_wrong_simplex_answer_is_never_trusted():
+    """_verify_slack proves verdicts from the numbers it is given: garbage gives 'unresolved'."""
+    from monitor.certify.extrusion_null import _verify_slack
+
+    rng = np.random.default_rng(6)
+    n_checked = 0
+    for _ in range(100):
+        G, h, lo, hi = _random_lp(rng)
+        z = rng.uniform(lo, hi)
+        y = rng.uniform(0, 1, len(h))
+        res = _verify_slack(G, h, lo, hi, z, y, DEFAULT, 0.0)
+        smax = float(np.min(h - G @ np.clip(z, lo, hi)))
+        if res.verdict == "violation":
+            assert smax > 0  # the point really has positive slack
+        if res.verdict == "certified":  # the random dual really bounds the LP below the band
+            from scipy.optimize import linprog
+
+            ref = linprog(np.array([0, 0, 0, 0, -1.0]), A_ub=np.hstack([G, np.ones((len(h), 1))]), b_ub=h,
+                          bounds=[(lo[k], hi[k]) for k in range(4)] + [(None, None)], method="highs-ds")
+            assert -ref.fun <= DEFAULT.extrusion_slack
+        n_checked += 1
+    assert n_checked == 100
+
+
+def test_division_16way_gives_the_same_verdicts_and_bad_value_raises():
+    from monitor.bench.extrusion_scenes import WINDOW, agv_translating_bodies
+    from monitor.certify.extrusion import search_many
+    from monitor.errors import InvalidInputError
+
+    bodies = agv_translating_bodies("straight", True)
+    a = search_many(bodies, None, WINDOW, 0.01)
+    b = search_many(bodies, None, WINDOW, 0.01, division="16way")
+    assert [o.verdict for o in a.outcomes] == [o.verdict for o in b.outcomes]
+    assert any(o.verdict == "violation" for o in a.outcomes)
+    assert b.stats["regions"] >= a.stats["regions"]
+    with pytest.raises(InvalidInputError, match="division"):
+        search_many(bodies, None, WINDOW, division="octree")
