@@ -567,6 +567,14 @@ def extrusion_stats(outs: list[PairOutcome]) -> dict[str, Any]:
         return {}
     from monitor.certify.extrusion import search_summary
     summ = search_summary(outs)
+    # bounded size (certificates are logged): at most 64 span/body-pair entries, 32 names each
+    sb = summ["sbounds"]
+    if len(sb) > 64:
+        summ["sbounds_left_off"] = len(sb) - 64
+        summ["sbounds"] = sb = sb[:64]
+    for e in sb:
+        if len(e.get("survivors", ())) > 32:
+            e["survivors"] = e["survivors"][:32] + ["..."]
     return {"extrusion_stages": summ.pop("stages"), "extrusion": summ}
 
 
