@@ -22,6 +22,14 @@ from monitor.tolerances import DEFAULT
 PAPER_PATH = ("sbounds", "divide_and_conquer", "null_set")
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _warm_simplex():
+    """The compiled slack-LP simplex is used once warm (monitor.warmup's job); warm it here."""
+    from monitor.certify.extrusion_null import warm_small_lp
+
+    warm_small_lp()
+
+
 def _lin_pair(sa, pa, va, sb, pb, vb, Ra=None, Rb=None, t1=1.0, name=("a", "b")):
     Ra = np.eye(3) if Ra is None else Ra
     Rb = np.eye(3) if Rb is None else Rb

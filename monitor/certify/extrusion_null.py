@@ -136,6 +136,37 @@ def _solve(c, A, b, bounds):
 
 
 @njit(cache=True)
+def _solve_small(M, rhs, out):  # pragma: no cover - compiled
+    """Gaussian elimination with partial pivoting on a copy of (n, n) ``M``; False if singular."""
+    n = M.shape[0]
+    A = M.copy()
+    x = rhs.copy()
+    for col in range(n):
+        piv = col
+        for r in range(col + 1, n):
+            if abs(A[r, col]) > abs(A[piv, col]):
+                piv = r
+        if abs(A[piv, col]) < 1e-14:
+            return False
+        if piv != col:
+            for k in range(n):
+                A[col, k], A[piv, k] = A[piv, k], A[col, k]
+            x[col], x[piv] = x[piv], x[col]
+        for r in range(col + 1, n):
+            f = A[r, col] / A[col, col]
+            if f != 0.0:
+                for k in range(col, n):
+                    A[r, k] -= f * A[col, k]
+                x[r] -= f * x[col]
+    for r in range(n - 1, -1, -1):
+        acc = x[r]
+        for k in range(r + 1, n):
+            acc -= A[r, k] * out[k]
+        out[r] = acc / A[r, r]
+    return True
+
+
+@njit(cache=True)
 def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
     """Compiled body of :func:`small_slack_lp`; status 0 = optimal, 1 = failed."""
     m = h.shape[0]
@@ -171,6 +202,9 @@ def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
     y = np.zeros(m)
     B = np.zeros((5, 5))
     cB = np.zeros(5)
+    xB = np.zeros(5)
+    pi = np.zeros(5)
+    u = np.zeros(5)
     inb = np.zeros(n, np.bool_)
     for it in range(max_iter):
         inb[:] = False
@@ -178,10 +212,11 @@ def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
             B[:, r] = A[:, basis[r]]
             cB[r] = c[basis[r]]
             inb[basis[r]] = True
-        if abs(np.linalg.det(B)) < 1e-300:
+        if not _solve_small(B, b, xB):
             return 1, z, 0.0, y
-        xB = np.linalg.solve(B, b)
-        pi = np.linalg.solve(B.T, cB)
+        Bt = B.T.copy()
+        if not _solve_small(Bt, cB, pi):
+            return 1, z, 0.0, y
         e = -1
         dmin = -tol
         for q in range(n):
@@ -202,7 +237,8 @@ def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
                     y[basis[r]] = max(xB[r], 0.0)
             z[:] = pi[:4]
             return 0, z, pi[4], y
-        u = np.linalg.solve(B, A[:, e].copy())
+        if not _solve_small(B, A[:, e].copy(), u):
+            return 1, z, 0.0, y
         leave = -1
         rmin = np.inf
         for r in range(5):
@@ -232,9 +268,15 @@ def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     (weak-duality bound) exactly as for the HiGHS answer, and falls back to HiGHS
     when neither proves a verdict.
 
+    The kernel is never compiled here (seconds, inside a caller's budget): until
+    :func:`warm_small_lp` has compiled or loaded it in this process (``monitor.warmup``),
+    this returns None and the caller uses HiGHS.
+
     Returns:
-        ``(z (4,), s, y (m,))`` or None (non-finite box, iteration cap, singular basis).
+        ``(z (4,), s, y (m,))`` or None (not warm, non-finite box, iteration cap, singular basis).
     """
+    if not _dual_simplex_kernel.signatures:
+        return None
     if len(h) == 0 or not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         return None
     f64 = np.float64
@@ -244,6 +286,12 @@ def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     if status != 0 or not (np.all(np.isfinite(z)) and np.isfinite(s) and np.all(np.isfinite(y))):
         return None
     return z, float(s), y
+
+
+def warm_small_lp() -> None:
+    """Compile (or load from the numba cache) :func:`small_slack_lp`'s kernel: for ``monitor.warmup``."""
+    G = np.array([[1.0, 0, 0, 0], [-1.0, 0, 0, 0], [0, 1.0, 0, 0]])
+    _dual_simplex_kernel(G, np.ones(3), -np.ones(4), np.ones(4), 10)
 
 
 def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) -> float:
@@ -573,6 +621,6 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
     return res, float(first.min())
 
 
-__all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "lp_null_test", "dual_certificate",
-           "lp_earliest", "min_norm", "static_distance", "quadratic_null_test", "quadratic_first_time",
-           "halfspace_null_test"]
+__all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "warm_small_lp", "lp_null_test",
+           "dual_certificate", "lp_earliest", "min_norm", "static_distance", "quadratic_null_test",
+           "quadratic_first_time", "halfspace_null_test"]

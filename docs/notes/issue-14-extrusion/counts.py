@@ -1,4 +1,5 @@
 import sys
+from monitor.certify.extrusion_null import warm_small_lp; warm_small_lp()  # what monitor.warmup should do
 sys.path.insert(0, "tests")
 from test_extrusion_pipeline import seeded_translating_pairs
 from monitor.certify.extrusion import check_pairs, search_summary

@@ -1,4 +1,5 @@
 import time, numpy as np
+from monitor.certify.extrusion_null import warm_small_lp; warm_small_lp()  # what monitor.warmup should do
 from scipy.spatial.transform import Rotation
 from monitor.certify.extrusion import TranslatingBody, search_many
 from monitor.bench.extrusion_scenes import agv_translating_bodies, WINDOW

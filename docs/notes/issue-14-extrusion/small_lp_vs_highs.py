@@ -3,7 +3,8 @@ from scipy.optimize import linprog
 from monitor.certify.extrusion_null import small_slack_lp
 rng = np.random.default_rng(1)
 bad = none = 0; tf = ts = 0.0
-small_slack_lp(np.eye(4)[:3].repeat(1,0) if False else np.ones((3,4)), np.ones(3), -np.ones(4), np.ones(4))
+from monitor.certify.extrusion_null import warm_small_lp
+warm_small_lp()
 for trial in range(400):
     m = int(rng.integers(8, 40))
     G = rng.normal(size=(m, 4)); G[:, :3] /= np.linalg.norm(G[:, :3], axis=1, keepdims=True)

@@ -1,4 +1,5 @@
 import sys, time, numpy as np
+from monitor.certify.extrusion_null import warm_small_lp; warm_small_lp()  # what monitor.warmup should do
 from monitor.bench.cases import make_cases
 from monitor.certify.engine import certify
 quick = "quick" in sys.argv
