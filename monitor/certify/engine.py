@@ -348,9 +348,11 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
         unfinished(checked)
         checked, ext_items, tol_items = [], [], []
     outcomes: dict[int, tuple[str, PairOutcome]] = {}
+    ext_stats: dict[str, Any] = {}
     if ext_items:
         try:
             outs = _run_extrusion(plan, ext_items, margin, tol, bud, t0, t1)
+            ext_stats = extrusion_stats(outs)
         except BudgetExhausted:
             outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in ext_items]
         for (i, _ga, _gb, _), o in zip(ext_items, outs):
@@ -469,7 +471,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     stats = {"pairs": len(ordered), "pairs_culled": n_culled,
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        ordered, stats, allowed)
     if len(ordered) >= 10_000:  # learn the assembly cost on big scenes (small ones are noise)
@@ -509,7 +511,14 @@ def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: floa
 
 def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, bud: Budget,
                    t0: float, t1: float) -> list[PairOutcome]:
-    """Extrusion checker on the translating pairs (see the comment inside)."""
+    """Extrusion checker on the translating pairs, in one n-ary search (Cameron §6).
+
+    Per pair the checker runs S-bounds (§4.3, App. B; shared per body, §6.3), divide
+    and conquer (§4.1) and the null-set LP on the half-spaces offset by the pair's
+    radii + margin + pad (§4.2); only what that leaves open goes to the exact swept
+    test. ``PairOutcome.info["stage"]`` names the deciding stage;
+    :func:`extrusion_stats` summarises a list of outcomes for ``cert.stats``.
+    """
     from monitor.certify import extrusion
     posr, rotr = plan.body_poses(np.array([t0]))
     eps_pairs = []
@@ -517,24 +526,25 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
         eps_pairs.append(extrusion.TranslatingPair(
             ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
             gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
-            name=(ga.name, gb.name)))
+            name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
     # The extrusion checker is exact up to Tolerances.extrusion_slack with Cameron's
     # regularised semantics (touching is not a collision). The engine's contract is
     # stricter (certified => clearance > margin, rounding included), so it asks the
     # checker the stronger question: a certificate at margin + slack + pad implies
     # clearance > margin. Exact touching (or a sub-slack shortfall) then ends as
     # "uncertain" (never "certified", and "violation" only if a witness confirms it).
-    # Pairs that fail the stronger question are re-run at the true margin for a
-    # witness deep enough to confirm (with margin > 0 the checker caps its depth at
-    # the margin it is given); "certified" there means the sub-slack band: unresolved.
+    # Pairs that fail the stronger question (only those) are re-run at the true margin
+    # for a witness deep enough to confirm (with margin > 0 the checker caps its depth
+    # at the margin it is given); "certified" there means the sub-slack band: unresolved.
     ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
-    outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud)
+    outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud, nary=True)
     redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
     if redo and not bud.exhausted:
-        again = extrusion.check_pairs([eps_pairs[k] for k in redo], (t0, t1), margin, tol, bud)
+        again = extrusion.check_pairs([eps_pairs[k] for k in redo], (t0, t1), margin, tol, bud, nary=True)
         for k, o2 in zip(redo, again):
             if o2.verdict == "violation":
                 o2.tests += outs[k].tests
+                o2.info["first_pass_stats"] = outs[k].info.get("stats")
                 outs[k] = o2
             elif outs[k].verdict == "violation":  # band case: never a confirmed witness time
                 o1 = outs[k]
@@ -544,6 +554,28 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
             if outs[k].verdict == "violation":  # not re-run: never a confirmed witness time
                 outs[k].verdict, outs[k].witness_time = "unresolved", None
     return outs
+
+
+def extrusion_stats(outs: list[PairOutcome]) -> dict[str, Any]:
+    """``cert.stats`` entries for extrusion outcomes (empty without outcomes).
+
+    ``extrusion_stages``: {deciding stage: pairs}; ``extrusion``: LP / offset / exact-swept
+    counts and S-bound survivors per span and body pair
+    (:func:`monitor.certify.extrusion.search_summary`).
+    """
+    if not outs:
+        return {}
+    from monitor.certify.extrusion import search_summary
+    summ = search_summary(outs)
+    # bounded size (certificates are logged): at most 64 span/body-pair entries, 32 names each
+    sb = summ["sbounds"]
+    if len(sb) > 64:
+        summ["sbounds_left_off"] = len(sb) - 64
+        summ["sbounds"] = sb = sb[:64]
+    for e in sb:
+        if len(e.get("survivors", ())) > 32:
+            e["survivors"] = e["survivors"][:32] + ["..."]
+    return {"extrusion_stages": summ.pop("stages"), "extrusion": summ}
 
 
 def _build_ordered(sel: list[int], cull_clear: list[float], unfin: list[bool], window: tuple[float, float],

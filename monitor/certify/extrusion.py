@@ -37,13 +37,33 @@ Pipeline (per time span, spans in time order):
    its own co-moving frame (the first scheme of §6.3). Regions are measured in
    a frame moving with a per-axis body velocity (App. B, "optimal fitting");
    collision is Galilean invariant, so this only shifts velocities.
-4. **Exact null-set test** (§4.2), per remaining convex leaf pair, in
-   :mod:`monitor.certify.extrusion_null`: slack LP for polytope pairs at zero
-   margin (regularised semantics: touching is not a collision), exact
-   quadratic (swept least-distance) test when a radius or margin is involved,
-   closed form against half-spaces. Sphere and capsule geoms are exact here
-   (no circumscribed polytope), so ``approx_error`` is 0 for them.
-5. **Earliest witness** (§5). Spans are visited in time order, and a pair found
+   ``division="16way"`` splits all four axes as the paper does; the default
+   longest-axis bisection needed the same LPs with 3.7x fewer regions (measured,
+   docs/notes/issue-14-extrusion.md).
+4. **Null-set test** (§4.2), per remaining convex leaf pair, in
+   :mod:`monitor.certify.extrusion_null`: the slack LP with its float64-verified
+   dual bound (regularised semantics: touching is not a collision), first tried
+   with the 1- and 2-row duals (:func:`~monitor.certify.extrusion_null.dual_certificate`,
+   no solver call). With a radius or a margin (``r = r_a + r_b + margin > 0``)
+   each leaf's half-spaces are **offset** outward by its radius + margin/2 + delta
+   (sphere and capsule cores get a synthesised H-rep: 14 directions about a point,
+   an octagonal prism about a segment, :func:`core_hrep`). The offset polytope
+   contains the rounded shape, so an empty offset intersection (max slack <=
+   ``extrusion_slack`` < delta) certifies core distance > r. The offset
+   over-approximates the rounded shape by up to r(sqrt 3 - 1) at a box corner
+   (less with the 14 directions), so a region it leaves open (or a "full"
+   region of §4.1) goes to
+5. **the exact swept test** (not in the paper): the swept least-distance test
+   (Wolfe / NNLS min-norm point of the swept Minkowski difference), which decides
+   exactly; also ``offset=False`` sends every rounded pair straight there. Against
+   a plane the closed form is exact (counted as the null-set stage: a half-space
+   offset by r is exact). Sphere and capsule geoms are exact (no circumscribed
+   polytope), so ``approx_error`` is 0 for them.
+
+   ``PairOutcome.info["stage"]`` names the stage that decided the pair (the latest
+   stage any span needed): ``"sbounds"``, ``"divide_and_conquer"``, ``"null_set"`` or
+   ``"exact_swept"`` (:data:`STAGES`); :func:`search_summary` counts them.
+6. **Earliest witness** (§5). Spans are visited in time order, and a pair found
    colliding in a span gets the exact first-contact time in that span (LP
    ``min tau`` over the intersection polytope, or bisection of the convex core
    distance). ``witness_time`` is the earliest time at which the overlap reaches
@@ -72,6 +92,7 @@ from monitor.certify.common import Budget, PairOutcome
 from monitor.certify.extrusion_null import (
     Leaf,
     NullResult,
+    dual_certificate,
     halfspace_null_test,
     lp_earliest,
     lp_null_test,
@@ -107,6 +128,9 @@ class TranslatingPair:
         origins_a: (k+1, 3) body origin (m, world) at the breakpoints.
         shape_b, R_b, times_b, origins_b: the same for B.
         name: (geom_a, geom_b) names for reports.
+        bodies: optional (body_a, body_b) names: the n-ary search (``check_pairs(...,
+            nary=True)``) groups geoms into bodies by name and identical motion, and names
+            its bodies (stats) after them.
     """
 
     shape_a: ConvexShape
@@ -118,6 +142,7 @@ class TranslatingPair:
     times_b: np.ndarray
     origins_b: np.ndarray
     name: tuple[str, str] = ("a", "b")
+    bodies: tuple[str, str] = ("", "")
 
 
 @dataclass(frozen=True)
@@ -226,11 +251,52 @@ class _Body:
         return self.origins[i] + v * (t0 - ta), v
 
 
-def _leaf(shape: ConvexShape, R: np.ndarray, o: np.ndarray, v: np.ndarray, c: np.ndarray) -> Leaf:
-    """Leaf data centred at ``c`` (world) for a geom of a body at origin ``o`` (span start)."""
+_DIAG = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float) / np.sqrt(3.0)
+_POINT_NORMALS = np.vstack([np.eye(3), -np.eye(3), _DIAG])
+"""(14, 3) unit normals of the polytope circumscribing a ball about a point core (cube + octahedron)."""
+
+
+def core_hrep(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray]:
+    """H-representation ``N x <= h`` (body frame) of a shape's core, unit normals.
+
+    Polytopes and half-spaces use their own. Point and segment cores (sphere,
+    capsule) get a synthesised one with ``h`` the core's exact support values: 14
+    directions (cube + octahedron) about a point; about a segment with axis ``a``
+    the two end caps ``+-a`` and 8 directions 45 degrees apart around it (an
+    octagonal prism). Offsetting these rows by the radius gives a polytope that
+    contains the rounded shape (the construction of the offset null-set test).
+
+    Returns:
+        ``(N (f, 3), h (f,))``.
+    """
+    if shape.kind in ("polytope", "halfspace"):
+        return shape.normals, shape.offsets
+    P = shape.points
+    if shape.kind == "capsule" and len(P) >= 2 and np.linalg.norm(P[1] - P[0]) > 0:
+        a = (P[1] - P[0]) / np.linalg.norm(P[1] - P[0])
+        u = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))])
+        u /= np.linalg.norm(u)
+        w = np.cross(a, u)
+        ang = np.arange(8) * (np.pi / 4)
+        ring = np.cos(ang)[:, None] * u + np.sin(ang)[:, None] * w
+        N = np.vstack([a, -a, ring])
+    else:
+        N = _POINT_NORMALS
+    return N, (N @ P.T).max(axis=1)
+
+
+def _leaf(shape: ConvexShape, R: np.ndarray, o: np.ndarray, v: np.ndarray, c: np.ndarray,
+          offset: float = 0.0) -> Leaf:
+    """Leaf data centred at ``c`` (world) for a geom of a body at origin ``o`` (span start).
+
+    ``offset`` (m) moves every half-space of the core's H-rep outwards (``h + offset``,
+    unit normals): the offset polytope of §4.2's null-set test on rounded shapes.
+    ``V`` and ``radius`` stay the exact core (the exact swept test uses them).
+    """
     d = o - c
-    N = shape.normals @ R.T if len(shape.normals) else np.zeros((0, 3))
-    h = shape.offsets + N @ d if len(shape.offsets) else np.zeros(0)
+    Nb, hb = core_hrep(shape)
+    N = Nb @ R.T if len(Nb) else np.zeros((0, 3))
+    h = hb + offset + N @ d if len(hb) else np.zeros(0)
     V = shape.points @ R.T + d
     return Leaf(shape.kind, N, h, V, v, float(shape.radius))
 
@@ -242,7 +308,10 @@ class _PairState:
     ib: int
     gb: int
     r: float
-    mode: str  # "lp" | "quadratic" | "halfspace"
+    mode: str  # "lp" | "offset" | "quadratic" | "halfspace"
+    off_a: float = 0.0  # outward offset (m) of A's half-spaces (offset mode)
+    off_b: float = 0.0
+    stage: int = 0  # index into STAGES of the deciding stage so far
     verdict: str = "certified"
     tests: int = 0
     max_depth: int = 0
@@ -275,14 +344,27 @@ def _empty_in_own_frames(rb: Any, va: np.ndarray, vb: np.ndarray) -> bool:
     return False
 
 
-def _mode(sa: ConvexShape, sb: ConvexShape, r: float, name: tuple[str, str]) -> str:
-    """Which exact test decides a leaf pair."""
+STAGES = ("sbounds", "divide_and_conquer", "null_set", "exact_swept")
+"""Deciding stages, in pipeline order (``PairOutcome.info["stage"]``): S-bounds (§4.3,
+App. B), divide and conquer (§4.1 region tests), the null-set LP (§4.2; also the closed
+form against a half-space), the exact swept least-distance test (fallback, not in the paper).
+A pair's stage is the latest stage any of its spans needed."""
+
+
+def _mode(sa: ConvexShape, sb: ConvexShape, r: float, name: tuple[str, str], offset: bool = True) -> str:
+    """Which exact test decides a leaf pair.
+
+    ``"lp"``: two sharp polytopes at zero margin (§4.2 as in the paper); ``"offset"``:
+    r > 0, the null-set LP on the offset half-spaces first, the exact swept test only
+    where it leaves the region open; ``"quadratic"``: the exact swept test alone
+    (``offset=False``); ``"halfspace"``: closed form against a plane.
+    """
     if sa.kind == "halfspace" and sb.kind == "halfspace":
         raise UnsupportedGeometryError(f"pair {name}: two half-spaces (planes) cannot be collided")
     if sa.kind == "halfspace" or sb.kind == "halfspace":
         return "halfspace"
     if r > 0.0:
-        return "quadratic"
+        return "offset" if offset else "quadratic"
     return "lp"
 
 
@@ -292,7 +374,10 @@ class _Search:
     def __init__(self, bodies: Sequence[_Body], pairs: Sequence[tuple[int, int, int, int]],
                  window: tuple[float, float], margin: float, tol: Tolerances,
                  budget: Budget | None, earliest: bool, clearance: bool,
-                 divide: bool = True) -> None:
+                 divide: bool = True, offset: bool = True, division: str = "bisect") -> None:
+        if division not in ("bisect", "16way"):
+            raise InvalidInputError(f"division must be 'bisect' or '16way', got {division!r}")
+        self.division = division
         self.bodies = bodies
         self.window = window
         self.margin = margin
@@ -301,12 +386,6 @@ class _Search:
         self.earliest = earliest
         self.want_clearance = clearance
         self.divide = divide
-        self.states: list[_PairState] = []
-        for ia, ga, ib, gb in pairs:
-            sa, sb = bodies[ia].shapes[ga], bodies[ib].shapes[gb]
-            r = sa.radius + sb.radius + margin
-            nm = (bodies[ia].geoms[ga], bodies[ib].geoms[gb])
-            self.states.append(_PairState(ia, ga, ib, gb, r, _mode(sa, sb, r, nm)))
         coords = [np.abs(b.origins).max() + max(float(np.abs(s.points).max()) for s in b.shapes)
                   for b in bodies]
         self.scale = float(max(coords)) if coords else 0.0
@@ -314,9 +393,39 @@ class _Search:
         # rounding made when leaves are placed in the world and centred (|o - c| from
         # coordinates of size `scale`): widens every exact-test bound (rel_pad = 64 ulp)
         self.data_pad = self.tol.rel_pad * self.scale + self.tol.abs_pad
+        # offset null-set test: each side's half-spaces move out by its radius + margin/2
+        # + delta. If the rounded shapes came within the margin at some instant, the
+        # midpoint of the closest points would lie in both offset polytopes with slack
+        # >= delta; the LP certifies max slack <= extrusion_slack < delta, so an offset
+        # certificate proves core distance > r_a + r_b + margin over the region.
+        self.delta = 2.0 * self.tol.extrusion_slack + self.data_pad + 1e-12
+        self.states: list[_PairState] = []
+        for ia, ga, ib, gb in pairs:
+            sa, sb = bodies[ia].shapes[ga], bodies[ib].shapes[gb]
+            r = sa.radius + sb.radius + margin
+            nm = (bodies[ia].geoms[ga], bodies[ib].geoms[gb])
+            st = _PairState(ia, ga, ib, gb, r, _mode(sa, sb, r, nm, offset))
+            if st.mode == "offset":
+                st.off_a = sa.radius + 0.5 * margin + self.delta
+                st.off_b = sb.radius + 0.5 * margin + self.delta
+            self.states.append(st)
         self._w = np.zeros(3)
         self.stats: dict[str, Any] = {"spans": [], "lps": 0, "nnls": 0, "regions": 0,
-                                      "full_region_proofs": 0, "leaf_pairs": len(pairs)}
+                                      "full_region_proofs": 0, "leaf_pairs": len(pairs),
+                                      "offset_lps": 0, "offset_certified": 0, "offset_open": 0,
+                                      "exact_swept": 0, "dual_shortcut": 0}
+
+    @staticmethod
+    def _stage(p: _PairState, name: str) -> None:
+        """Record that ``name`` was needed for ``p`` (the latest stage wins)."""
+        p.stage = max(p.stage, STAGES.index(name))
+
+    def _leaves(self, p: _PairState, st: dict, c: np.ndarray) -> tuple[Leaf, Leaf]:
+        """Both leaves of a pair centred at ``c`` (offset H-reps in offset mode)."""
+        A, B = self.bodies[p.ia], self.bodies[p.ib]
+        (oa, va), (ob, vb) = st[p.ia], st[p.ib]
+        return (_leaf(A.shapes[p.ga], A.R, oa, va, c, p.off_a),
+                _leaf(B.shapes[p.gb], B.R, ob, vb, c, p.off_b))
 
     # -- spans
     def spans(self) -> list[tuple[float, float]]:
@@ -398,9 +507,16 @@ class _Search:
             span_stats["leaves_in"] += len(ga) + len(gb)
             sb = pair_sbounds(a_lo, a_hi, np.ones(len(ga), bool), va, b_lo, b_hi,
                               np.ones(len(gb), bool), vb, 0.0, T)
+            bp = {"bodies": [A.name, B.name], "leaves_in": len(ga) + len(gb), "leaves_out": 0}
+            span_stats.setdefault("body_pair_sbounds", []).append(bp)
             if sb is None:
                 span_stats["body_pairs_pruned"] += 1
                 continue
+            bp["leaves_out"] = int(sb.a_alive.sum() + sb.b_alive.sum())
+            bp["survivors"] = [A.geoms[g] for g, a in zip(ga, sb.a_alive) if a] + \
+                [B.geoms[g] for g, b in zip(gb, sb.b_alive) if b]
+            bp["time_bounds"] = [s0 + sb.t_lo, s0 + sb.t_hi]
+            bp["passes"] = sb.passes
             span_stats["passes"] = max(span_stats["passes"], sb.passes)
             span_stats["leaves_out"] += int(sb.a_alive.sum() + sb.b_alive.sum())
             span_stats.setdefault("time_bounds", []).append([s0 + sb.t_lo, s0 + sb.t_hi])
@@ -417,9 +533,12 @@ class _Search:
                                   sb.b_lo[kb:kb + 1], sb.b_hi[kb:kb + 1], one, vb, sb.t_lo, sb.t_hi)
                 rb = None if lb is None else RootBound(lb.t_lo, lb.t_hi, lb.a_lo[0], lb.a_hi[0],
                                                        lb.b_lo[0], lb.b_hi[0])
-                if rb is None or _empty_in_own_frames(rb, va, vb) or self._pruned_in_own_frame(p, rb, st):
+                if rb is None or _empty_in_own_frames(rb, va, vb):
+                    continue
+                if self._pruned_in_own_frame(p, rb, st):
                     span_stats["leaf_pairs_pruned_own_region"] = span_stats.get(
-                        "leaf_pairs_pruned_own_region", 0) + (rb is not None)
+                        "leaf_pairs_pruned_own_region", 0) + 1
+                    self._stage(p, "divide_and_conquer")
                     continue
                 items.append((p, rb))
         # optimal fitting of the final region (App. B): measure space in a frame moving with
@@ -450,7 +569,7 @@ class _Search:
         or B's velocity); a leaf with one extruded half-space excluding the whole
         region cannot meet the other there.
         """
-        if p.mode != "lp":
+        if p.mode not in ("lp", "offset"):
             return False
         va, vb = st[p.ia][1], st[p.ib][1]
         w = np.zeros(3)
@@ -464,10 +583,7 @@ class _Search:
             w[k] = va[k] if widths[0] <= widths[1] else vb[k]
         lo, hi = _pair_box(rb, va - w, vb - w)
         rlo, rhi = np.r_[lo, rb.t_lo], np.r_[hi, rb.t_hi]
-        A, B = self.bodies[p.ia], self.bodies[p.ib]
-        z = np.zeros(3)
-        la = _leaf(A.shapes[p.ga], A.R, st[p.ia][0], va - w, z)
-        lb = _leaf(B.shapes[p.gb], B.R, st[p.ib][0], vb - w, z)
+        la, lb = self._leaves(p, {p.ia: (st[p.ia][0], va - w), p.ib: (st[p.ib][0], vb - w)}, np.zeros(3))
         return self._classify(la, rlo, rhi)[0] == "empty" or self._classify(lb, rlo, rhi)[0] == "empty"
 
     def _frame_velocity(self, items: list, st: dict) -> np.ndarray:
@@ -496,12 +612,12 @@ class _Search:
         return w
 
     def _exact_stage(self, s0: float, s1: float, st: dict, work: list, span_stats: dict) -> None:
-        """Divide and conquer for LP pairs, direct exact tests for the others."""
-        # non-LP pairs: exact tests over their S-bound time interval directly
+        """Divide and conquer for LP and offset pairs, direct exact tests for the others."""
+        # quadratic / half-space pairs: exact tests over their S-bound time interval directly
         lp_work = []
         for item in work:
             p = item[0]
-            if p.mode == "lp":
+            if p.mode in ("lp", "offset"):
                 lp_work.append(item)
             else:
                 self._round_pair(p, s0, s1, st, item[1], item[2])
@@ -540,6 +656,7 @@ class _Search:
         lb = _leaf(B.shapes[p.gb], B.R, ob, vb, c)
         self._charge()
         p.tests += 1
+        self._stage(p, "null_set" if p.mode == "halfspace" else "exact_swept")
         if p.mode == "halfspace":
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
             res, first = halfspace_null_test(plane, other, p.r, tl, th, self.tol, self.data_pad)
@@ -559,6 +676,7 @@ class _Search:
             return
         res = quadratic_null_test(la, lb, p.r, tl, th, self.tol, self.data_pad)
         self.stats["nnls"] += 1
+        self.stats["exact_swept"] += 1
         if res.verdict == "violation":
             first, fpoint, n1 = quadratic_first_time(la, lb, p.r, tl, res.tau, p.r, self.tol)
             dmin = res.upper + p.r
@@ -577,6 +695,7 @@ class _Search:
                    fpoint: np.ndarray, tw: float, wpoint: np.ndarray, res: NullResult, how: str) -> None:
         p.verdict = "violation"
         p.done = True
+        p.stage = STAGES.index("exact_swept" if how == "quadratic" else "null_set")
         p.clearance = -np.inf
         p.witness_time = float(s0 + tw)
         p.witness_point = np.asarray(wpoint, float) + c + self._w * tw
@@ -601,10 +720,7 @@ class _Search:
         tested: set[int] = set()
         leaves = {}  # (pair idx) -> (world leaves at span start, uncentred) for region tests
         for k, (p, *_r) in enumerate(work):
-            A, B = self.bodies[p.ia], self.bodies[p.ib]
-            (oa, va), (ob, vb) = st[p.ia], st[p.ib]
-            z = np.zeros(3)
-            leaves[k] = (_leaf(A.shapes[p.ga], A.R, oa, va, z), _leaf(B.shapes[p.gb], B.R, ob, vb, z))
+            leaves[k] = self._leaves(p, st, np.zeros(3))
         while heap:
             if self._exhausted():
                 for _, _, _, rlo, rhi, idx in heap:
@@ -637,13 +753,20 @@ class _Search:
                 if cb == "empty":
                     continue
                 if ca == "full" and cb == "full":
-                    self.stats["full_region_proofs"] += 1
-                    self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="full region")
+                    if p.mode == "lp":
+                        self.stats["full_region_proofs"] += 1
+                        self._stage(p, "divide_and_conquer")
+                        self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="full region")
+                    else:  # offset polytopes over-approximate: the exact swept test decides
+                        tested.add(k)
+                        self.stats["offset_open"] += 1
+                        self._round_pair(p, s0, s1, st, tl, th)
                     continue
                 live_idx.append(k)
             if not live_idx:
                 continue
-            if not self.divide or len(live_idx) <= kappa(d) or d >= KAPPA_MAX_DEPTH:
+            max_d = KAPPA_MAX_DEPTH // 4 if self.division == "16way" else KAPPA_MAX_DEPTH
+            if not self.divide or len(live_idx) <= kappa(d) or d >= max_d:
                 # conquer: one LP per leaf pair and span, over its whole S-bound box (the
                 # regions prune, prove full collisions and order by time; re-testing a
                 # pair per region would only multiply LPs)
@@ -654,6 +777,15 @@ class _Search:
                     tested.add(k)
                     p.max_depth = max(p.max_depth, d)
                     self._lp_region(p, s0, s1, st, np.r_[x_lo, tl], np.r_[x_hi, th], tl, th, x_lo, x_hi)
+                continue
+            if self.division == "16way":  # the paper's rule: halve all four axes
+                mid4 = 0.5 * (rlo + rhi)
+                for code in range(16):
+                    bits = np.array([(code >> j) & 1 for j in range(4)], bool)
+                    nlo = np.where(bits, mid4, rlo)
+                    nhi = np.where(bits, rhi, mid4)
+                    counter += 1
+                    heapq.heappush(heap, (float(nlo[3]), counter, d + 1, nlo, nhi, live_idx))
                 continue
             # divide: bisect the longest axis (time in metres via the fastest speed)
             ext = rhi - rlo
@@ -669,6 +801,9 @@ class _Search:
                     nlo[ax] = mid
                 counter += 1
                 heapq.heappush(heap, (float(nlo[3]), counter, d + 1, nlo, nhi, live_idx))
+        for k, (p, *_r) in enumerate(work):
+            if k not in tested and p.stage < 1 and not (p.done and p.verdict == "violation"):
+                self._stage(p, "divide_and_conquer")  # every region excluded it (§4.1)
         self.stats["regions"] += regions
         span_stats["regions"] = regions
 
@@ -689,9 +824,7 @@ class _Search:
         return "crossing", None
 
     def _centred(self, p: _PairState, st: dict, c: np.ndarray) -> tuple[Leaf, Leaf]:
-        A, B = self.bodies[p.ia], self.bodies[p.ib]
-        (oa, va), (ob, vb) = st[p.ia], st[p.ib]
-        return _leaf(A.shapes[p.ga], A.R, oa, va, c), _leaf(B.shapes[p.gb], B.R, ob, vb, c)
+        return self._leaves(p, st, c)
 
     def _lp_region(self, p: _PairState, s0: float, s1: float, st: dict, blo: np.ndarray,
                    bhi: np.ndarray, tl: float, th: float, x_lo: np.ndarray, x_hi: np.ndarray) -> None:
@@ -699,9 +832,26 @@ class _Search:
         la, lb = self._centred(p, st, c)
         cz = np.r_[c, 0.0]
         self._charge()
-        self.stats["lps"] += 1
         p.tests += 1
+        if dual_certificate(la, lb, blo - cz, bhi - cz, self.tol, self.data_pad) <= self.tol.extrusion_slack:
+            # the LP's own weak-duality certificate, found among 1- and 2-row duals (§4.2)
+            self.stats["dual_shortcut"] += 1
+            if p.mode == "offset":
+                self.stats["offset_certified"] += 1
+            self._stage(p, "null_set")
+            return
+        self.stats["lps"] += 1
         res = lp_null_test(la, lb, blo - cz, bhi - cz, self.tol, self.data_pad)
+        if p.mode == "offset":
+            self.stats["offset_lps"] += 1
+            if res.verdict == "certified":
+                self.stats["offset_certified"] += 1
+                self._stage(p, "null_set")
+            else:  # the offset polytopes meet: not a collision proof, the exact test decides
+                self.stats["offset_open"] += 1
+                self._round_pair(p, s0, s1, st, tl, th)
+            return
+        self._stage(p, "null_set")
         if res.verdict == "violation":
             self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="lp", found=res, found_c=c)
         elif res.verdict == "unresolved":
@@ -744,6 +894,8 @@ class _Search:
         self._violation(p, s0, s1, c, first_tau, first_x, w_tau, w_x, res, "lp")
         p.info["earliest_exact"] = bool(self.earliest)  # False: earliest_time is just a violating time
         p.info["proof"] = proof
+        if proof == "full region":
+            p.stage = STAGES.index("divide_and_conquer")
         p.info["max_slack"] = float(smax)
 
     # -- results
@@ -754,6 +906,7 @@ class _Search:
             info = dict(p.info)
             info["geoms"] = [A.geoms[p.ga], B.geoms[p.gb]]
             info["test"] = info.get("test", p.mode)
+            info["stage"] = STAGES[p.stage]
             if p.verdict == "violation":
                 out.append(PairOutcome("violation", p.tests, p.max_depth, list(p.unresolved),
                                        float("-inf"), p.witness_time, p.witness_point, info))
@@ -782,7 +935,7 @@ def _bodies_from_pair(p: TranslatingPair, window: tuple[float, float]) -> list[_
 
 def check_pairs(pairs: Sequence[TranslatingPair], window: tuple[float, float], margin: float = 0.0,
                 tolerances: Tolerances = DEFAULT, budget: Budget | None = None, earliest: bool = True,
-                clearance: bool = True, nary: bool = False) -> list[PairOutcome]:
+                clearance: bool = True, nary: bool = False, offset: bool = True) -> list[PairOutcome]:
     """Decide each translating geom pair exactly over ``window``.
 
     Args:
@@ -797,6 +950,8 @@ def check_pairs(pairs: Sequence[TranslatingPair], window: tuple[float, float], m
             identical motion (R, times, origins) and geoms by name; same verdicts and
             first-contact times as the pairwise loop (tested), usually much faster.
             Pairs whose two geoms fall into one group are decided one by one.
+        offset: pairs with radii or a margin go through the null-set LP on offset
+            half-spaces first (§4.2); False: straight to the exact swept test.
 
     Returns:
         One :class:`PairOutcome` per pair. "violation" carries ``witness_time`` (s),
@@ -808,11 +963,13 @@ def check_pairs(pairs: Sequence[TranslatingPair], window: tuple[float, float], m
     """
     w = _check_window(window, margin)
     if nary:
-        return _check_pairs_nary(list(pairs), w, float(margin), tolerances, budget, earliest, clearance)
+        return _check_pairs_nary(list(pairs), w, float(margin), tolerances, budget, earliest, clearance,
+                                 offset)
     out = []
     for p in pairs:
         bodies = _bodies_from_pair(p, w)
-        s = _Search(bodies, [(0, 0, 1, 0)], w, float(margin), tolerances, budget, earliest, clearance)
+        s = _Search(bodies, [(0, 0, 1, 0)], w, float(margin), tolerances, budget, earliest, clearance,
+                    offset=offset)
         s.run()
         o = s.outcomes()[0]
         o.info["stats"] = _compact_stats(s.stats)
@@ -821,22 +978,24 @@ def check_pairs(pairs: Sequence[TranslatingPair], window: tuple[float, float], m
 
 
 def _check_pairs_nary(pairs: list[TranslatingPair], w: tuple[float, float], margin: float,
-                      tol: Tolerances, budget: Budget | None, earliest: bool, clearance: bool
-                      ) -> list[PairOutcome]:
-    """check_pairs through one n-ary search (bodies grouped by identical motion)."""
+                      tol: Tolerances, budget: Budget | None, earliest: bool, clearance: bool,
+                      offset: bool = True) -> list[PairOutcome]:
+    """check_pairs through one n-ary search (bodies grouped by name and identical motion)."""
     groups: dict[bytes, int] = {}
     members: list[dict[str, ConvexShape]] = []
     motion: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    gnames: list[str] = []
     ends: list[tuple[int, int] | None] = []
     for p in pairs:
         bodies = _bodies_from_pair(p, w)  # validates
         gi = []
-        for b, nm in zip(bodies, p.name):
-            key = b.R.tobytes() + b.times.tobytes() + b.origins.tobytes()
+        for b, nm, bn in zip(bodies, p.name, p.bodies):
+            key = str(bn).encode() + b"\0" + b.R.tobytes() + b.times.tobytes() + b.origins.tobytes()
             if key not in groups:
                 groups[key] = len(members)
                 members.append({})
                 motion.append((b.R, b.times, b.origins))
+                gnames.append(str(bn) if bn else f"group{len(gnames)}")
             k = groups[key]
             if members[k].get(nm, b.shapes[0]) is not b.shapes[0]:
                 gi = None  # two different shapes under one name: decide alone
@@ -844,21 +1003,23 @@ def _check_pairs_nary(pairs: list[TranslatingPair], w: tuple[float, float], marg
             members[k][nm] = b.shapes[0]
             gi.append(k)
         ends.append(None if gi is None or gi[0] == gi[1] else (gi[0], gi[1]))
-    tb = [TranslatingBody(f"group{k}", tuple(m.values()), tuple(m.keys()), *motion[k])
+    tb = [TranslatingBody(gnames[k], tuple(m.values()), tuple(m.keys()), *motion[k])
           for k, m in enumerate(members)]
     names = [p.name for p, e in zip(pairs, ends) if e is not None]
     seen_names = [n for m in members for n in m]
     out: list[PairOutcome | None] = [None] * len(pairs)
     if names and len(seen_names) == len(set(seen_names)):
-        res = search_many(tb, names, w, margin, tol, budget, earliest, clearance)
+        res = search_many(tb, names, w, margin, tol, budget, earliest, clearance, offset=offset)
         it = iter(res.outcomes)
         for i, e in enumerate(ends):
             if e is not None:
                 out[i] = next(it)
-                out[i].info["stats"] = {"nary": True}
+                # one shared dict per search (not copied per pair): summarise with search_summary
+                out[i].info["stats"] = res.stats
+                out[i].info["nary"] = True
     for i, o in enumerate(out):
         if o is None:
-            out[i] = check_pairs([pairs[i]], w, margin, tol, budget, earliest, clearance)[0]
+            out[i] = check_pairs([pairs[i]], w, margin, tol, budget, earliest, clearance, offset=offset)[0]
     return out  # type: ignore[return-value]
 
 
@@ -907,7 +1068,7 @@ def _resolve_pairs(bodies: list[_Body], allowed: Iterable[tuple[str, str]] | Non
 def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple[str, str]] | None,
                 window: tuple[float, float], margin: float = 0.0, tolerances: Tolerances = DEFAULT,
                 budget: Budget | None = None, earliest: bool = True, clearance: bool = True,
-                divide: bool = True) -> SearchResult:
+                divide: bool = True, offset: bool = True, division: str = "bisect") -> SearchResult:
     """The n-ary operator of §6 over all translating bodies in one search, with statistics.
 
     Args:
@@ -916,6 +1077,11 @@ def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple
             every other leaf pair has an empty S-bound. None = all cross-body pairs.
         window, margin, tolerances, budget, earliest, clearance: as :func:`check_pairs`.
         divide: run the divide-and-conquer stage (False: conquer every region at once).
+        offset: null-set LP on offset half-spaces for pairs with radii / margin (see
+            :func:`check_pairs`).
+        division: ``"bisect"`` (longest axis, time in metres by the fastest speed; the
+            default, see docs/notes/issue-14-extrusion.md) or ``"16way"`` (the paper's
+            split of all four axes, at most 3 levels).
 
     Returns:
         :class:`SearchResult` with one outcome per pair (request order) and stats.
@@ -923,7 +1089,7 @@ def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple
     w = _check_window(window, margin)
     bl = _bodies_many(bodies, w)
     idx = _resolve_pairs(bl, allowed_pairs)
-    s = _Search(bl, idx, w, float(margin), tolerances, budget, earliest, clearance, divide)
+    s = _Search(bl, idx, w, float(margin), tolerances, budget, earliest, clearance, divide, offset, division)
     s.run()
     names = [(bl[i].geoms[ga], bl[j].geoms[gb]) for i, ga, j, gb in idx]
     return SearchResult(s.outcomes(), names, _compact_stats(s.stats))
@@ -936,6 +1102,40 @@ def check_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple[
     """Outcomes of :func:`search_many` (one per allowed geom pair, in request order)."""
     return search_many(bodies, allowed_pairs, window, margin, tolerances, budget, earliest,
                        clearance).outcomes
+
+
+def search_summary(outcomes: Sequence[PairOutcome]) -> dict[str, Any]:
+    """Aggregate stage counts and S-bound figures over outcomes of one or more searches.
+
+    Returns:
+        dict with ``stages`` ({stage: pairs}, the deciding stage of each outcome, see
+        :data:`STAGES`), ``lps``, ``offset_lps``, ``offset_certified``, ``offset_open``
+        (offset LPs that left the region to the exact swept test), ``exact_swept``,
+        ``regions``, ``searches`` and ``sbounds``: per span and body pair the primitives
+        in, the survivors and the time bounds (§4.3).
+    """
+    stages: dict[str, int] = {}
+    for o in outcomes:
+        st = o.info.get("stage")
+        if st is not None:
+            stages[st] = stages.get(st, 0) + 1
+    out: dict[str, Any] = {"stages": stages, "searches": 0, "sbounds": []}
+    keys = ("lps", "dual_shortcut", "nnls", "offset_lps", "offset_certified", "offset_open", "exact_swept",
+            "regions")
+    for k in keys:
+        out[k] = 0
+    seen: set[int] = set()
+    for s in [o.info.get(k) for o in outcomes for k in ("stats", "first_pass_stats")]:
+        if not isinstance(s, dict) or id(s) in seen or "spans" not in s:
+            continue
+        seen.add(id(s))
+        out["searches"] += 1
+        for k in keys:
+            out[k] += int(s.get(k, 0))
+        for sp in s["spans"]:
+            for bp in sp.get("body_pair_sbounds", []):
+                out["sbounds"].append({"span": sp["span"], **bp})
+    return out
 
 
 def earliest_violation(outcomes: Sequence[PairOutcome]) -> PairOutcome | None:
@@ -984,4 +1184,5 @@ def compare_pairwise_nary(bodies: Sequence[TranslatingBody], allowed_pairs: Iter
 
 
 __all__ = ["TranslatingPair", "TranslatingBody", "SearchResult", "check_pairs", "check_many",
-           "search_many", "earliest_violation", "compare_pairwise_nary", "kappa", "KAPPA_MAX_DEPTH"]
+           "search_many", "earliest_violation", "compare_pairwise_nary", "kappa", "KAPPA_MAX_DEPTH",
+           "STAGES", "core_hrep", "search_summary"]

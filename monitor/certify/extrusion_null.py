@@ -33,7 +33,18 @@ Three exact tests, chosen per pair by the *inflation* ``r = radius_a + radius_b 
     Overlaps of inscribed depth in ``(pad, extrusion_slack]`` may be reported
     either way; outside this band the verdict is exact.
 
-``quadratic`` (r > 0: spheres, capsules, or any pair with a margin)
+    :func:`dual_certificate` tries every 1- and 2-row dual ``y`` first (the
+    certificate of two antiparallel faces or of a face against the box): the same
+    weak-duality bound, no solver call.
+
+``lp`` on offset half-spaces (r > 0, the engine's path)
+    The caller moves each leaf's rows outward by its radius + margin/2 + delta
+    (``Leaf.h`` already offset). A certificate ``max s <= extrusion_slack < delta``
+    proves core distance > r; a positive slack proves nothing (the offset
+    polytope over-approximates the rounded shape, by up to r(sqrt 3 - 1) at a box
+    corner) and the caller falls back to the quadratic test below.
+
+``quadratic`` (r > 0: the exact swept fallback)
     The exact quadratic extrusion ``{(x, tau) : dist(x, core(tau)) <= radius}``.
     For translating convex cores the core distance ``d(tau)`` is the distance
     from the origin to ``K + w tau`` (``K`` = Minkowski difference of the cores at
@@ -56,6 +67,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy.optimize import linprog, nnls
 
 from monitor.tolerances import Tolerances
@@ -123,6 +135,165 @@ def _solve(c, A, b, bounds):
     return None
 
 
+@njit(cache=True)
+def _solve_small(M, rhs, out):  # pragma: no cover - compiled
+    """Gaussian elimination with partial pivoting on a copy of (n, n) ``M``; False if singular."""
+    n = M.shape[0]
+    A = M.copy()
+    x = rhs.copy()
+    for col in range(n):
+        piv = col
+        for r in range(col + 1, n):
+            if abs(A[r, col]) > abs(A[piv, col]):
+                piv = r
+        if abs(A[piv, col]) < 1e-14:
+            return False
+        if piv != col:
+            for k in range(n):
+                A[col, k], A[piv, k] = A[piv, k], A[col, k]
+            x[col], x[piv] = x[piv], x[col]
+        for r in range(col + 1, n):
+            f = A[r, col] / A[col, col]
+            if f != 0.0:
+                for k in range(col, n):
+                    A[r, k] -= f * A[col, k]
+                x[r] -= f * x[col]
+    for r in range(n - 1, -1, -1):
+        acc = x[r]
+        for k in range(r + 1, n):
+            acc -= A[r, k] * out[k]
+        out[r] = acc / A[r, r]
+    return True
+
+
+@njit(cache=True)
+def _dual_simplex_kernel(G, h, lo, hi, max_iter):  # pragma: no cover - compiled
+    """Compiled body of :func:`small_slack_lp`; status 0 = optimal, 1 = failed."""
+    m = h.shape[0]
+    n = m + 8
+    A = np.zeros((5, n))
+    c = np.zeros(n)
+    for i in range(m):
+        for k in range(4):
+            A[k, i] = G[i, k]
+        A[4, i] = 1.0
+        c[i] = h[i]
+    for k in range(4):
+        A[k, m + k] = 1.0
+        A[k, m + 4 + k] = -1.0
+        c[m + k] = hi[k]
+        c[m + 4 + k] = -lo[k]
+    b = np.zeros(5)
+    b[4] = 1.0
+    best, j = np.inf, 0
+    for i in range(m):
+        v = h[i]
+        for k in range(4):
+            v += max(-G[i, k] * lo[k], -G[i, k] * hi[k])
+        if v < best:
+            best, j = v, i
+    basis = np.zeros(5, np.int64)
+    basis[0] = j
+    for k in range(4):
+        basis[k + 1] = m + k if G[j, k] <= 0.0 else m + 4 + k
+    scale = np.abs(c).max() + np.abs(A).max()
+    tol = 1e-12 * scale
+    z = np.zeros(4)
+    y = np.zeros(m)
+    B = np.zeros((5, 5))
+    cB = np.zeros(5)
+    xB = np.zeros(5)
+    pi = np.zeros(5)
+    u = np.zeros(5)
+    inb = np.zeros(n, np.bool_)
+    for it in range(max_iter):
+        inb[:] = False
+        for r in range(5):
+            B[:, r] = A[:, basis[r]]
+            cB[r] = c[basis[r]]
+            inb[basis[r]] = True
+        if not _solve_small(B, b, xB):
+            return 1, z, 0.0, y
+        Bt = B.T.copy()
+        if not _solve_small(Bt, cB, pi):
+            return 1, z, 0.0, y
+        e = -1
+        dmin = -tol
+        for q in range(n):
+            if inb[q]:
+                continue
+            d = c[q]
+            for k in range(5):
+                d -= A[k, q] * pi[k]
+            if d < -tol:
+                if it >= 50:  # Bland: first improving column
+                    e = q
+                    break
+                if d < dmin:
+                    dmin, e = d, q
+        if e < 0:
+            for r in range(5):
+                if basis[r] < m:
+                    y[basis[r]] = max(xB[r], 0.0)
+            z[:] = pi[:4]
+            return 0, z, pi[4], y
+        if not _solve_small(B, A[:, e].copy(), u):
+            return 1, z, 0.0, y
+        leave = -1
+        rmin = np.inf
+        for r in range(5):
+            if u[r] > 1e-12:
+                ratio = max(xB[r], 0.0) / u[r]
+                if leave < 0 or ratio < rmin * (1.0 - 1e-15) - 1e-300:
+                    rmin, leave = ratio, r
+                elif ratio <= rmin * (1.0 + 1e-15) + 1e-300 and basis[r] < basis[leave]:
+                    leave = r  # Bland's tie-break
+        if leave < 0:
+            return 1, z, 0.0, y
+        basis[leave] = e
+    return 1, z, 0.0, y
+
+
+def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                   max_iter: int = 200) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The slack LP ``max s : G z + s <= h, lo <= z <= hi`` by a dense revised simplex on its dual.
+
+    Dual (standard form, 5 equality rows): ``min h.y + hi.p - lo.q`` subject to
+    ``G^T y + p - q = 0``, ``1.y = 1``, ``y, p, q >= 0``. The start basis is the best
+    single row ``y = e_j`` with ``p - q = -G_j`` (feasible, unit triangular), so no
+    phase 1 is needed; Dantzig pricing, Bland's rule after 50 pivots (no cycling).
+    The simplex multipliers are the primal ``(z, s)``. Compiled (numba).
+
+    Nothing here is trusted: the caller verifies ``z`` (slack in float64) and ``y``
+    (weak-duality bound) exactly as for the HiGHS answer, and falls back to HiGHS
+    when neither proves a verdict.
+
+    The kernel is never compiled here (seconds, inside a caller's budget): until
+    :func:`warm_small_lp` has compiled or loaded it in this process (``monitor.warmup``),
+    this returns None and the caller uses HiGHS.
+
+    Returns:
+        ``(z (4,), s, y (m,))`` or None (not warm, non-finite box, iteration cap, singular basis).
+    """
+    if not _dual_simplex_kernel.signatures:
+        return None
+    if len(h) == 0 or not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        return None
+    f64 = np.float64
+    status, z, s, y = _dual_simplex_kernel(np.ascontiguousarray(G, f64), np.ascontiguousarray(h, f64),
+                                           np.ascontiguousarray(lo, f64), np.ascontiguousarray(hi, f64),
+                                           int(max_iter))
+    if status != 0 or not (np.all(np.isfinite(z)) and np.isfinite(s) and np.all(np.isfinite(y))):
+        return None
+    return z, float(s), y
+
+
+def warm_small_lp() -> None:
+    """Compile (or load from the numba cache) :func:`small_slack_lp`'s kernel: for ``monitor.warmup``."""
+    G = np.array([[1.0, 0, 0, 0], [-1.0, 0, 0, 0], [0, 1.0, 0, 0]])
+    _dual_simplex_kernel(G, np.ones(3), -np.ones(4), np.ones(4), 10)
+
+
 def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) -> float:
     """Rigorous lower bound on ``min_i h_i - G_i z`` evaluated in float64 (m)."""
     terms = h - G @ z
@@ -142,15 +313,26 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
     """
     G = np.vstack([a.G, b.G])
     h = np.concatenate([a.h, b.h])
+    fast = small_slack_lp(G, h, np.asarray(lo, float), np.asarray(hi, float))
+    if fast is not None:
+        res = _verify_slack(G, h, lo, hi, fast[0], fast[2], tol, data_pad)
+        if res.verdict != "unresolved":
+            return res
     A = np.hstack([G, np.ones((len(h), 1))])
     bounds = [(float(lo[k]), float(hi[k])) for k in range(4)] + [(None, None)]
-    res = _solve(np.array([0, 0, 0, 0, -1.0]), A, h, bounds)
-    if res is None:
+    sol = _solve(np.array([0, 0, 0, 0, -1.0]), A, h, bounds)
+    if sol is None:
         return NullResult("unresolved", -np.inf, np.inf, float(lo[3]), 0.5 * (lo[:3] + hi[:3]))
-    z = np.clip(res.x[:4], lo, hi)
+    return _verify_slack(G, h, lo, hi, sol.x[:4], -sol.ineqlin.marginals, tol, data_pad)
+
+
+def _verify_slack(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray, z: np.ndarray,
+                  y: np.ndarray, tol: Tolerances, data_pad: float) -> NullResult:
+    """Float64 verification of a slack-LP answer: primal point ``z`` (4,) and dual ``y`` (m,)."""
+    z = np.clip(z, lo, hi)
     s_lo = slack_lower(G, h, z, tol) - data_pad
     # dual certificate: s <= y.h - (G^T y).z for every feasible (z, s) when y >= 0, sum y = 1
-    y = np.clip(-res.ineqlin.marginals, 0.0, None)
+    y = np.clip(y, 0.0, None)
     ub = np.inf
     if y.sum() > 0:
         y = y / y.sum()
@@ -166,6 +348,35 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
     else:
         verdict = "unresolved"
     return NullResult(verdict, -ub, -s_lo, float(z[3]), z[:3].copy())
+
+
+def dual_certificate(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Tolerances,
+                     data_pad: float = 0.0) -> float:
+    """Best weak-duality bound on the max slack of :func:`lp_null_test` over 1- and 2-row duals.
+
+    Any ``y >= 0`` with ``sum y = 1`` bounds the LP: ``max s <= y.h + sum_k max(-r_k lo_k,
+    -r_k hi_k)`` with ``r = G^T y`` (the box absorbs the residual). Trying every single
+    row and every pair (one row of each leaf, weights 1/2) finds the certificate of the
+    usual separations (two antiparallel faces, a face against the box) without a solver
+    call: same bound and padding as :func:`lp_null_test`, so ``<= extrusion_slack``
+    certifies exactly as the LP would. Vectorised, O(f_a f_b).
+
+    Returns:
+        the smallest padded upper bound (m) on the max slack found (``inf`` if none).
+    """
+    Ga, Gb = a.G, b.G
+    if len(Ga) == 0 or len(Gb) == 0:
+        return float("inf")
+    zmax = np.maximum(np.abs(lo), np.abs(hi))
+    ma = np.abs(a.h) + np.abs(Ga) @ zmax  # (fa,) magnitudes for the rounding pad
+    mb = np.abs(b.h) + np.abs(Gb) @ zmax
+    R = 0.5 * (Ga[:, None, :] + Gb[None, :, :])  # (fa, fb, 4)
+    H = 0.5 * (a.h[:, None] + b.h[None, :])
+    ub = H + np.maximum(-R * lo, -R * hi).sum(axis=2) + 8 * tol.rel_pad * (ma[:, None] + mb[None, :])
+    single = [h + np.maximum(-G * lo, -G * hi).sum(axis=1) + 16 * tol.rel_pad * m
+              for G, h, m in ((Ga, a.h, ma), (Gb, b.h, mb))]
+    best = min(float(ub.min()), float(single[0].min()), float(single[1].min()))
+    return best + tol.abs_pad + data_pad
 
 
 def lp_earliest(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, depth: float,
@@ -410,5 +621,6 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
     return res, float(first.min())
 
 
-__all__ = ["Leaf", "NullResult", "slack_lower", "lp_null_test", "lp_earliest", "min_norm", "static_distance",
-           "quadratic_null_test", "quadratic_first_time", "halfspace_null_test"]
+__all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "warm_small_lp", "lp_null_test",
+           "dual_certificate", "lp_earliest", "min_norm", "static_distance", "quadratic_null_test",
+           "quadratic_first_time", "halfspace_null_test"]
