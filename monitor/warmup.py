@@ -82,6 +82,11 @@ def ensure_warm() -> dict[str, Any]:
             plan = Plan(np.array([0.0, 0.1]), q0 + q, model)
             cert = certify(scene, plan, margin=0.001, epsilon=1e-3, budget=Budget())
             out[name] = (str(cert.verdict), time.perf_counter() - t)
+        from monitor.certify.extrusion_null import warm_small_lp  # the null-set test's compiled simplex
+
+        t = time.perf_counter()
+        warm_small_lp()
+        out["null-set LP kernel"] = ("compiled", time.perf_counter() - t)
         _REPORT = {"seconds": time.perf_counter() - t_start, "cases": out}
         return _REPORT
 

@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
         good = verdict == _EXPECTED.get(name, verdict)
         ok &= good
         note = "" if good else f"  (expected {_EXPECTED[name]})"
-        print(f"  {name:16s} {verdict:10s} {seconds:8.2f} s{note}")
+        print(f"  {name:18s} {verdict:10s} {seconds:8.2f} s{note}")
     print(f"monitor warmup: certification kernels ready in {rep['seconds']:.1f} s "
           "(numba machine code cached on disk for later processes)")
     return 0 if ok else 1
