@@ -57,6 +57,8 @@ class GeomPack(NamedTuple):
         cparam: (G, 3) cylinder (radius, half length, 0) / ellipsoid radii (m).
         cframe: (G, 3, 3) rotation geom frame -> body frame of the curved geom.
         ccenter: (G, 3) geom origin in the body frame (m).
+        bcenter: (G, 3) centre of a sphere containing the geom (core + radius), body frame (m).
+        brad: (G,) its radius (m); inf for half-spaces and geoms without a shape.
     """
 
     verts: np.ndarray
@@ -79,6 +81,8 @@ class GeomPack(NamedTuple):
     cparam: np.ndarray
     cframe: np.ndarray
     ccenter: np.ndarray
+    bcenter: np.ndarray
+    brad: np.ndarray
 
 
 CURVE_NONE = 0
@@ -147,6 +151,8 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
     cparam = np.zeros((G, 3))
     cframe = np.tile(np.eye(3), (G, 1, 1))
     ccenter = np.zeros((G, 3))
+    bcenter = np.zeros((G, 3))
+    brad = np.full(G, np.inf)
     for i, cv in enumerate(curved or []):
         if cv is None or shapes[i] is None or shapes[i].kind != "polytope":
             continue
@@ -170,6 +176,9 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
             rho_max.append(np.inf)
             continue
         c = _core(s, f"shapes[{i}]")
+        if s.kind != "halfspace":
+            bcenter[i] = np.asarray(s.bounding_center, float)
+            brad[i] = float(s.bounding_radius)
         V.append(c.P)
         E.append(c.E)
         N.append(c.N)
@@ -197,7 +206,8 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
         mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
         curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
-        ccenter=np.ascontiguousarray(ccenter))
+        ccenter=np.ascontiguousarray(ccenter), bcenter=np.ascontiguousarray(bcenter),
+        brad=np.ascontiguousarray(brad))
 
 
 class ScenePack(NamedTuple):
