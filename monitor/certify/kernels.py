@@ -688,10 +688,10 @@ def _swept_spheres(gp, mp, t0, t1, rel_pad, abs_pad, scale_pad, sc, sr, lo, hi):
     rot = np.empty((T, nbody, 3, 3))
     trans = np.empty((T, nbody))
     ang = np.empty((T, nbody))
-    span = t1 - t0
+    step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
     for t in range(T):
-        ta = t0 if t == 0 else t0 + span * (t / T)
-        tb = t1 if t == T - 1 else t0 + span * ((t + 1) / T)
+        ta = t * step + t0
+        tb = t1 if t == T - 1 else (t + 1) * step + t0
         tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
     mag = 0.0
     for t in range(T):
@@ -712,7 +712,6 @@ def _swept_spheres(gp, mp, t0, t1, rel_pad, abs_pad, scale_pad, sc, sr, lo, hi):
                 lo[g, r] = -np.inf
                 hi[g, r] = np.inf
             continue
-        rad = rad * (1.0 + 4.0 * 2.0**-52)
         c = gp.bcenter[g]
         ref = mp.ref_points[b]
         lever = _norm3(c[0] - ref[0], c[1] - ref[1], c[2] - ref[2]) + rad
@@ -721,7 +720,7 @@ def _swept_spheres(gp, mp, t0, t1, rel_pad, abs_pad, scale_pad, sc, sr, lo, hi):
             hi[g, r] = -np.inf
         for t in range(T):
             R = rot[t, b]
-            rr = rad + (trans[t, b] + _chord(ang[t, b]) * lever) * grow_f
+            rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
             if not rr >= 0.0:
                 rr = np.inf
             sr[t, g] = rr
@@ -762,16 +761,20 @@ def _halfspace_gap(gp, h, c, sc, sr, trans, ang, rot, pos, pad):
         if trans[t, bh] > 0.0 or ang[t, bh] > 0.0:
             return -np.inf     # a moving plane: no cull
     n0 = gp.nstart[h]
+    v0 = gp.vstart[h]
+    n = gp.normals[n0]
+    q = gp.verts[v0]
     g = np.inf
     for t in range(T):
+        # as broadphase.halfspace_gaps: (c - X(m) q) . R n - r, q the plane's point, n its unit normal
         R = rot[t, bh]
-        nx = R[0, 0] * gp.normals[n0, 0] + R[0, 1] * gp.normals[n0, 1] + R[0, 2] * gp.normals[n0, 2]
-        ny = R[1, 0] * gp.normals[n0, 0] + R[1, 1] * gp.normals[n0, 1] + R[1, 2] * gp.normals[n0, 2]
-        nz = R[2, 0] * gp.normals[n0, 0] + R[2, 1] * gp.normals[n0, 1] + R[2, 2] * gp.normals[n0, 2]
-        nn = _norm3(nx, ny, nz)
-        # plane n . x <= offset in the body frame: signed distance of x = (n_W . (x - p) - offset) / |n|
-        d = (nx * (sc[t, c, 0] - pos[t, bh, 0]) + ny * (sc[t, c, 1] - pos[t, bh, 1])
-             + nz * (sc[t, c, 2] - pos[t, bh, 2]) - gp.offset[h]) / nn - sr[t, c]
+        nx = R[0, 0] * n[0] + R[0, 1] * n[1] + R[0, 2] * n[2]
+        ny = R[1, 0] * n[0] + R[1, 1] * n[1] + R[1, 2] * n[2]
+        nz = R[2, 0] * n[0] + R[2, 1] * n[1] + R[2, 2] * n[2]
+        qx = R[0, 0] * q[0] + R[0, 1] * q[1] + R[0, 2] * q[2] + pos[t, bh, 0]
+        qy = R[1, 0] * q[0] + R[1, 1] * q[1] + R[1, 2] * q[2] + pos[t, bh, 1]
+        qz = R[2, 0] * q[0] + R[2, 1] * q[1] + R[2, 2] * q[2] + pos[t, bh, 2]
+        d = (sc[t, c, 0] - qx) * nx + (sc[t, c, 1] - qy) * ny + (sc[t, c, 2] - qz) * nz - sr[t, c]
         if not (d > -np.inf and d < np.inf):
             return -np.inf
         if d < g:
