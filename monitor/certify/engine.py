@@ -371,16 +371,25 @@ class _WindowPairs:
     """
 
     def __init__(self, sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
-                 res: np.ndarray, unfin: np.ndarray, results: dict, names: list, bnames: list,
+                 res: np.ndarray, unfin: np.ndarray, results: dict, geoms: tuple,
                  window: tuple[float, float], sc: np.ndarray, sr: np.ndarray, pad: float) -> None:
         self.sel, self.pid, self.code, self.gap, self.surv, self.res = sel, pid, code, gap, surv, res
-        self.unfin, self.results, self.names, self.bnames = unfin, results, names, bnames
+        self.unfin, self.results = unfin, results
+        self.geoms = geoms          # the scene's geoms tuple of this window (sync() replaces, never edits it)
+        self.names: list | None = None
+        self.bnames: list | None = None
         self.window, self.sc, self.sr, self.pad = window, sc, sr, pad
+
+    def _names(self) -> None:
+        if self.names is None:
+            self.names = [g.name for g in self.geoms]
+            self.bnames = [g.body for g in self.geoms]
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
         from monitor.certify import kernels as KS
 
+        self._names()
         a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
         geoms, bodies = (self.names[a], self.names[b]), (self.bnames[a], self.bnames[b])
         row = self.res[s]
@@ -417,6 +426,7 @@ class _WindowPairs:
             if int(code[k]) in decided:
                 results[int(self.sel[k])] = self.kernel_result(k, s)
         cull = np.where((code == KS.WK_CULLED) | (code == KS.WK_SS), gap, np.nan)
+        self._names()
         return _build_ordered(self.sel.tolist(), cull.tolist(), self.unfin.tolist(), self.window,
                               self.pid[:, 0].tolist(), self.pid[:, 1].tolist(), results, self.names,
                               self.bnames)
@@ -502,65 +512,70 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                          surv, res, sc, sr, info)
         done_to = S
     # -- the Python stages on what the kernel left open -------------------------------------
+    # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
     mix: dict[str, int] = {}
     unfin = np.zeros(P, bool)
-    sv = surv[:S]
     geoms = scene.geoms
     if done_to < S:                       # budget: survivors the kernel never reached
-        unfin[sv[done_to:]] = True
-    cs = code[sv[:done_to]]
-    lslots = np.nonzero((cs == KS.WK_PYTHON) | (cs == KS.WK_OPEN) | (cs == KS.WK_UNRES))[0]
+        unfin[surv[done_to:S]] = True
+    svl = surv[:done_to].tolist()
+    codes = code[surv[:done_to]].tolist() if done_to else []
     todo = []
     start_known: dict[int, bool] = {}   # i -> start pose NOT proven clear (the kernel's exact test)
-    for s in lslots.tolist():
-        k = int(sv[s])
-        i, ga, gb = int(sel[k]), geoms[int(pid[k, 0])], geoms[int(pid[k, 1])]
-        todo.append((i, ga, gb))
-        if cs[s] != KS.WK_PYTHON:
-            lo = float(res[s, KS.R_START_LO])
-            start_known[i] = not (lo > margin or lo + ga.shape.radius + gb.shape.radius > 0)
+    vslots, cslots, wslots = [], [], []
+    n_static = 0
+    for s, (k, c) in enumerate(zip(svl, codes)):
+        if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
+            i, ga, gb = int(sel[k]), geoms[int(pid[k, 0])], geoms[int(pid[k, 1])]
+            todo.append((i, ga, gb))
+            if c != KS.WK_PYTHON:
+                lo = float(res[s, KS.R_START_LO])
+                start_known[i] = not (lo > margin or lo + ga.shape.radius + gb.shape.radius > 0)
+            continue
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
+            vslots.append(s)
+        else:
+            cslots.append(s)
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_STATIC_CERT:
+            n_static += 1
+        else:
+            wslots.append(s)
 
     def unfinished(items: list) -> None:
         ks = np.searchsorted(sel, np.fromiter((it[0] for it in items if it[0] not in results), np.int64))
         unfin[ks] = True
 
-    counts = np.bincount(code, minlength=10)
-    n_culled = int(counts[KS.WK_SS] + counts[KS.WK_CULLED])
+    n_culled = P - S                      # every pair that did not survive stage 0 was culled
     if n_culled:
         mix["culled"] = n_culled
-    n_static = int(counts[KS.WK_STATIC_VIOL] + counts[KS.WK_STATIC_CERT])
     if n_static:
         mix["static"] = n_static
-    n_ws = int(counts[KS.WK_CERT] + counts[KS.WK_VIOL])
-    if n_ws:
-        mix["toleranced/whole-shape"] = n_ws
-    tests_total, depth_max = _python_stages(scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo,
-                                           moving, results, mix, unfinished, whole_shape=not narrow,
-                                           start_known=start_known)
-    n_unfin = int(np.count_nonzero(unfin))
+    if wslots:
+        mix["toleranced/whole-shape"] = len(wslots)
+    tests_total, depth_max = 0, 0
+    if todo:
+        tests_total, depth_max = _python_stages(scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo,
+                                               moving, results, mix, unfinished, whole_shape=not narrow,
+                                               start_known=start_known)
+    n_unfin = int(np.count_nonzero(unfin)) if (todo or done_to < S) else 0
     if n_unfin:
         mix["budget"] = n_unfin
     # -- 6. combine (arrays for the kernel's pairs, PairResults for the Python ones) ------------
-    ws = sv[:done_to][(cs == KS.WK_CERT) | (cs == KS.WK_VIOL)]
-    wslots = np.nonzero((cs == KS.WK_CERT) | (cs == KS.WK_VIOL))[0]
-    if len(ws):
-        tests_total += int(res[wslots, KS.R_TESTS].sum())
-        depth_max = max(depth_max, int(res[wslots, KS.R_DEPTH].max()))
-    vslots = np.nonzero((cs == KS.WK_VIOL) | (cs == KS.WK_STATIC_VIOL))[0]
-    cslots = np.nonzero((cs == KS.WK_CERT) | (cs == KS.WK_STATIC_CERT))[0]
-    checked_r = [results[i] for i in sorted(results)]
-    has_viol = len(vslots) > 0 or any(r.verdict == "violation" for r in checked_r)
+    for s in wslots:
+        tests_total += int(res[s, KS.R_TESTS])
+        depth_max = max(depth_max, int(res[s, KS.R_DEPTH]))
+    checked_r = [results[i] for i in sorted(results)] if results else []
+    has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
     has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
     verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
-    lazy = _WindowPairs(sel, pid, code, gap, sv[:done_to].copy(), res[:done_to].copy(), unfin, results,
-                        [g.name for g in geoms], [g.body for g in geoms], (t0, t1), sc, sr,
-                        float(info[KS.WI_PAD]))
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to].copy(), res[:done_to].copy(), unfin, results,
+                        geoms, (t0, t1), sc, sr, float(info[KS.WI_PAD]))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
             if r.verdict == "violation" and r.witness is not None]
-    for s in vslots.tolist():
-        k = int(sv[s])
+    for s in vslots:
+        k = svl[s]
         cand.append((float(res[s, KS.R_WTIME]), int(sel[k]), None, k, s))
     witness = None
     if cand:
@@ -570,18 +585,16 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if verdict != "certified":
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
         starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
-        for s in vslots.tolist():
-            starts.append(t0 if cs[s] == KS.WK_STATIC_VIOL else float(res[s, KS.R_FIRST_UNRES]))
+        for s in vslots:
+            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else float(res[s, KS.R_FIRST_UNRES]))
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
-    if len(cslots):
-        clears.append(float(res[cslots, KS.R_CLEAR].min()))
-    if len(vslots):
+    clears += [float(res[s, KS.R_CLEAR]) for s in cslots]
+    if vslots or n_unfin:
         clears.append(float("-inf"))
-    if np.isfinite(info[KS.WI_BEST]):
-        clears.append(float(info[KS.WI_BEST]))
-    if n_unfin:
-        clears.append(float("-inf"))
+    best_cull = float(info[KS.WI_BEST])
+    if best_cull < float("inf"):
+        clears.append(best_cull)
     clearance = float(min(clears)) if clears else float("inf")
     stats = {"pairs": P, "pairs_culled": n_culled,
              "tests": tests_total, "max_depth": depth_max,
