@@ -669,76 +669,6 @@ computed (m), tests spent, survivors, deepest level."""
 
 
 @njit(cache=True)
-def _swept_spheres(gp, mp, t0, t1, rel_pad, abs_pad, scale_pad, sc, sr, lo, hi):
-    """Swept bounding spheres and AABBs of every geom over T = sc.shape[0] equal sub-intervals.
-
-    The argument of :mod:`monitor.certify.broadphase` (``swept_geom_spheres``), compiled:
-    on [ta, tb] with midpoint m, the geom's bounding sphere (centre c, radius rad) stays in
-    the ball about X(m) c of radius ``rad + trans + chord(angle) (|c - ref| + rad)``
-    (``trans, angle``: the motion kernel's ``tree_bounds``, the motion-bound contract),
-    inflated by ``1 + 8 rel_pad``. Writes sc (T, G, 3) world centres, sr (T, G) radii
-    (inf: half-space / no shape), lo / hi (G, 3) the AABB of the union of the T balls
-    (-inf / inf when not finite). Returns the gap pad ``rel_pad S + abs_pad + scale_pad S``
-    with S = 1 + the largest body-origin coordinate at the midpoints (as the numpy broad phase).
-    """
-    T = sc.shape[0]
-    nbody = mp.body_parent.shape[0]
-    G = gp.kind.shape[0]
-    pos = np.empty((T, nbody, 3))
-    rot = np.empty((T, nbody, 3, 3))
-    trans = np.empty((T, nbody))
-    ang = np.empty((T, nbody))
-    step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
-    for t in range(T):
-        ta = t * step + t0
-        tb = t1 if t == T - 1 else (t + 1) * step + t0
-        tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
-    mag = 0.0
-    for t in range(T):
-        for b in range(nbody):
-            for r in range(3):
-                mag = max(mag, abs(pos[t, b, r]))
-    mag += 1.0
-    grow_f = 1.0 + 8.0 * rel_pad
-    for g in range(G):
-        b = gp.body[g]
-        rad = gp.brad[g]
-        if gp.kind[g] < 0 or not rad < np.inf:
-            for t in range(T):
-                sr[t, g] = np.inf
-                for r in range(3):
-                    sc[t, g, r] = 0.0
-            for r in range(3):
-                lo[g, r] = -np.inf
-                hi[g, r] = np.inf
-            continue
-        c = gp.bcenter[g]
-        ref = mp.ref_points[b]
-        lever = _norm3(c[0] - ref[0], c[1] - ref[1], c[2] - ref[2]) + rad
-        for r in range(3):
-            lo[g, r] = np.inf
-            hi[g, r] = -np.inf
-        for t in range(T):
-            R = rot[t, b]
-            rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
-            if not rr >= 0.0:
-                rr = np.inf
-            sr[t, g] = rr
-            for r in range(3):
-                x = R[r, 0] * c[0] + R[r, 1] * c[1] + R[r, 2] * c[2] + pos[t, b, r]
-                sc[t, g, r] = x
-                if not x - rr >= lo[g, r]:
-                    lo[g, r] = x - rr
-                if not x + rr <= hi[g, r]:
-                    hi[g, r] = x + rr
-            for r in range(3):    # NaN anywhere: an unbounded box (never culls)
-                if not (lo[g, r] == lo[g, r] and hi[g, r] == hi[g, r]):
-                    lo[g, r] = -np.inf
-                    hi[g, r] = np.inf
-    return rel_pad * mag + abs_pad + scale_pad * mag, trans, ang, rot, pos
-
-
-@njit(cache=True)
 def sphere_gap(sc, sr, ga, gb, pad):
     """Min over sub-intervals of |c_a - c_b| - r_a - r_b, minus ``pad`` (-inf if not all finite)."""
     g = np.inf
@@ -753,17 +683,15 @@ def sphere_gap(sc, sr, ga, gb, pad):
 
 
 @njit(cache=True)
-def _halfspace_gap(gp, h, c, sc, sr, trans, ang, rot, pos, pad):
-    """Certified gap of geom c's swept spheres from half-space geom h (plane world-fixed), else -inf."""
-    bh = gp.body[h]
+def _halfspace_gap(n, q, bh, c, sc, sr, trans, ang, rot, pos, pad):
+    """Certified gap of geom c's swept spheres from a half-space (unit normal n, point q, body bh).
+
+    -inf when the plane's body moves (no cull), as :func:`broadphase.halfspace_gaps`.
+    """
     T = sc.shape[0]
     for t in range(T):
         if trans[t, bh] > 0.0 or ang[t, bh] > 0.0:
             return -np.inf     # a moving plane: no cull
-    n0 = gp.nstart[h]
-    v0 = gp.vstart[h]
-    n = gp.normals[n0]
-    q = gp.verts[v0]
     g = np.inf
     for t in range(T):
         # as broadphase.halfspace_gaps: (c - X(m) q) . R n - r, q the plane's point, n its unit normal
@@ -780,76 +708,6 @@ def _halfspace_gap(gp, h, c, sc, sr, trans, ang, rot, pos, pad):
         if d < g:
             g = d
     return g - pad
-
-
-@njit(cache=True)
-def _start_and_narrow(gp, mp, pairs, moving, route, k0, k1, prm, code, surv, res, info):
-    """Stage 1 of :func:`window_kernel` on survivor slots [k0, k1)."""
-    t0, t1 = prm[WP_T0], prm[WP_T1]
-    margin, epsilon = prm[WP_MARGIN], prm[WP_EPS]
-    rel_pad, abs_pad = prm[WP_REL], prm[WP_ABS]
-    max_depth = int(prm[WP_MAX_DEPTH])
-    max_tests = int(prm[WP_MAX_TESTS])
-    stack = np.empty((max_depth + 2, 3))
-    out = np.empty(OUT_SIZE)
-    w = np.empty(3)
-    pA = np.empty(3)
-    pB = np.empty(3)
-    RA = np.empty((3, 3))
-    RB = np.empty((3, 3))
-    for s in range(k0, k1):
-        k = surv[s]
-        if code[k] != WK_OPEN:
-            continue
-        ga, gb = pairs[k, 0], pairs[k, 1]
-        ba, bb = gp.body[ga], gp.body[gb]
-        row = res[s]
-        for j in range(R_SIZE):
-            row[j] = 0.0
-        row[R_WTIME] = np.nan
-        row[R_FIRST_UNRES] = np.nan
-        body_pose(mp, ba, t0, pA, RA)
-        body_pose(mp, bb, t0, pB, RB)
-        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
-        info[WI_TESTS] += 1.0
-        row[R_START_LO] = lo
-        approx = gp.approx[ga] + gp.approx[gb]
-        if up + approx < margin:
-            code[k] = WK_STATIC_VIOL
-            row[R_VERDICT] = VIOLATION
-            row[R_WTIME] = t0
-            for r in range(3):
-                row[R_WPOINT + r] = w[r]
-            row[R_WUPPER] = up + approx
-            row[R_CLEAR] = -np.inf
-            continue
-        if moving[ba] == 0 and moving[bb] == 0:
-            if lo > margin:
-                code[k] = WK_STATIC_CERT
-                row[R_VERDICT] = CERTIFIED
-                row[R_CLEAR] = lo
-            else:
-                code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
-            continue
-        if route.shape[0] > 0 and route[s] == 0:
-            continue                   # extrusion route: the Python pipeline
-        row[R_STARTED] = 2.0
-        v = pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
-                        rel_pad, abs_pad, stack, row)
-        info[WI_TESTS] += row[R_TESTS]
-        row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
-        if row[R_DEPTH] > info[WI_DEPTH]:
-            info[WI_DEPTH] = row[R_DEPTH]
-        if v == CERTIFIED:
-            code[k] = WK_CERT
-        elif v == VIOLATION:
-            code[k] = WK_VIOL
-            fu = row[R_FIRST_UNRES]
-            if not (fu <= row[R_WTIME]):
-                row[R_FIRST_UNRES] = row[R_WTIME]
-        else:
-            code[k] = WK_UNRES
-
 
 @njit(cache=True)
 def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr,
@@ -893,66 +751,186 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     Returns:
         S (stage 0) or the number of survivor slots processed (stage 1).
     """
-    if stage == 1:
-        _start_and_narrow(gp, mp, pairs, moving, route, k0, k1, prm, code, surv, res, info)
-        return k1 - k0
-    margin = prm[WP_MARGIN]
-    G = gp.kind.shape[0]
-    lo = np.empty((G, 3))
-    hi = np.empty((G, 3))
-    pad, trans, ang, rot, pos = _swept_spheres(gp, mp, prm[WP_T0], prm[WP_T1], prm[WP_REL], prm[WP_ABS],
-                                               prm[WP_SCALE_PAD], sc, sr, lo, hi)
-    info[WI_PAD] = pad
-    best = np.inf
+    # (one function body, no helper taking the packs: each function typed on the two packs
+    # costs about a second of cold compile)
+    t0, t1 = prm[WP_T0], prm[WP_T1]
+    margin, epsilon = prm[WP_MARGIN], prm[WP_EPS]
+    rel_pad, abs_pad = prm[WP_REL], prm[WP_ABS]
+    max_depth = int(prm[WP_MAX_DEPTH])
+    max_tests = int(prm[WP_MAX_TESTS])
     S = 0
-    for k in range(pairs.shape[0]):
-        ga, gb = pairs[k, 0], pairs[k, 1]
-        if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
-            code[k] = WK_SS
-            gap[k] = np.inf
-            continue
-        ka, kb = gp.kind[ga], gp.kind[gb]
-        gap[k] = np.nan
-        if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
-            code[k] = WK_PYTHON
-            surv[S] = k
-            S += 1
-            continue
-        if ka == -1:
-            g = _halfspace_gap(gp, ga, gb, sc, sr, trans, ang, rot, pos, pad)
-        elif kb == -1:
-            g = _halfspace_gap(gp, gb, ga, sc, sr, trans, ang, rot, pos, pad)
-        else:
-            sep = -np.inf
-            scale = 1.0
-            for r in range(3):
-                s1 = lo[gb, r] - hi[ga, r]
-                s2 = lo[ga, r] - hi[gb, r]
-                if s1 > sep:
-                    sep = s1
-                if s2 > sep:
-                    sep = s2
-                scale = max(scale, abs(lo[ga, r]), abs(hi[ga, r]), abs(lo[gb, r]), abs(hi[gb, r]))
-            # rounding of c +- r and of the separation: 1e-12 relative covers it many times over
-            sep = sep - pad - 1e-12 * scale
-            if sep > margin and sep >= best:
-                code[k] = WK_CULLED
+    if stage == 0:
+        # -- swept spheres and AABBs per geom (the argument of broadphase.swept_geom_spheres) --
+        T = sc.shape[0]
+        nbody = mp.body_parent.shape[0]
+        G = gp.kind.shape[0]
+        pos = np.empty((T, nbody, 3))
+        rot = np.empty((T, nbody, 3, 3))
+        trans = np.empty((T, nbody))
+        ang = np.empty((T, nbody))
+        step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
+        for t in range(T):
+            ta = t * step + t0
+            tb = t1 if t == T - 1 else (t + 1) * step + t0
+            tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
+        mag = 0.0
+        for t in range(T):
+            for b in range(nbody):
+                for r in range(3):
+                    mag = max(mag, abs(pos[t, b, r]))
+        mag += 1.0
+        pad = rel_pad * mag + abs_pad + prm[WP_SCALE_PAD] * mag
+        grow_f = 1.0 + 8.0 * rel_pad
+        lo = np.empty((G, 3))
+        hi = np.empty((G, 3))
+        for g in range(G):
+            b = gp.body[g]
+            rad = gp.brad[g]
+            if gp.kind[g] < 0 or not rad < np.inf:
+                for t in range(T):
+                    sr[t, g] = np.inf
+                    for r in range(3):
+                        sc[t, g, r] = 0.0
+                for r in range(3):
+                    lo[g, r] = -np.inf
+                    hi[g, r] = np.inf
                 continue
-            g = sphere_gap(sc, sr, ga, gb, pad)
-        if g > margin:
-            code[k] = WK_CULLED
-            gap[k] = g
-            if g < best:
-                best = g
+            cg = gp.bcenter[g]
+            ref = mp.ref_points[b]
+            lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+            for r in range(3):
+                lo[g, r] = np.inf
+                hi[g, r] = -np.inf
+            for t in range(T):
+                R = rot[t, b]
+                rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
+                if not rr >= 0.0:
+                    rr = np.inf
+                sr[t, g] = rr
+                for r in range(3):
+                    x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[t, b, r]
+                    sc[t, g, r] = x
+                    if not x - rr >= lo[g, r]:
+                        lo[g, r] = x - rr
+                    if not x + rr <= hi[g, r]:
+                        hi[g, r] = x + rr
+            for r in range(3):    # NaN anywhere: an unbounded box (never culls)
+                if not (lo[g, r] == lo[g, r] and hi[g, r] == hi[g, r]):
+                    lo[g, r] = -np.inf
+                    hi[g, r] = np.inf
+        info[WI_PAD] = pad
+        # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
+        best = np.inf
+        for k in range(pairs.shape[0]):
+            ga, gb = pairs[k, 0], pairs[k, 1]
+            if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
+                code[k] = WK_SS
+                gap[k] = np.inf
+                continue
+            ka, kb = gp.kind[ga], gp.kind[gb]
+            gap[k] = np.nan
+            if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
+                code[k] = WK_PYTHON
+                surv[S] = k
+                S += 1
+                continue
+            if ka == -1 or kb == -1:
+                h, c = (ga, gb) if ka == -1 else (gb, ga)
+                g = _halfspace_gap(gp.normals[gp.nstart[h]], gp.verts[gp.vstart[h]], gp.body[h], c, sc, sr,
+                                   trans, ang, rot, pos, pad)
+            else:
+                sep = -np.inf
+                scale = 1.0
+                for r in range(3):
+                    s1 = lo[gb, r] - hi[ga, r]
+                    s2 = lo[ga, r] - hi[gb, r]
+                    if s1 > sep:
+                        sep = s1
+                    if s2 > sep:
+                        sep = s2
+                    scale = max(scale, abs(lo[ga, r]), abs(hi[ga, r]), abs(lo[gb, r]), abs(hi[gb, r]))
+                # rounding of c +- r and of the separation: 1e-12 relative covers it many times over
+                sep = sep - pad - 1e-12 * scale
+                if sep > margin and sep >= best:
+                    code[k] = WK_CULLED
+                    continue
+                g = sphere_gap(sc, sr, ga, gb, pad)
+            if g > margin:
+                code[k] = WK_CULLED
+                gap[k] = g
+                if g < best:
+                    best = g
+            else:
+                code[k] = WK_OPEN
+                surv[S] = k
+                S += 1
+        info[WI_BEST] = best
+        info[WI_SURV] = S
+        k0 = 0
+        k1 = min(k1, S)
+    # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
+    stack = np.empty((max_depth + 2, 3))
+    out = np.empty(OUT_SIZE)
+    w = np.empty(3)
+    pA = np.empty(3)
+    pB = np.empty(3)
+    RA = np.empty((3, 3))
+    RB = np.empty((3, 3))
+    for s in range(k0, k1):
+        k = surv[s]
+        if code[k] != WK_OPEN:
+            continue
+        ga, gb = pairs[k, 0], pairs[k, 1]
+        ba, bb = gp.body[ga], gp.body[gb]
+        row = res[s]
+        for j in range(R_SIZE):
+            row[j] = 0.0
+        row[R_WTIME] = np.nan
+        row[R_FIRST_UNRES] = np.nan
+        body_pose(mp, ba, t0, pA, RA)
+        body_pose(mp, bb, t0, pB, RB)
+        lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+        info[WI_TESTS] += 1.0
+        row[R_START_LO] = lo_d
+        approx = gp.approx[ga] + gp.approx[gb]
+        if up_d + approx < margin:
+            code[k] = WK_STATIC_VIOL
+            row[R_VERDICT] = VIOLATION
+            row[R_WTIME] = t0
+            for r in range(3):
+                row[R_WPOINT + r] = w[r]
+            row[R_WUPPER] = up_d + approx
+            row[R_CLEAR] = -np.inf
+            continue
+        if moving[ba] == 0 and moving[bb] == 0:
+            if lo_d > margin:
+                code[k] = WK_STATIC_CERT
+                row[R_VERDICT] = CERTIFIED
+                row[R_CLEAR] = lo_d
+            else:
+                code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
+            continue
+        if route.shape[0] > 0 and route[s] == 0:
+            continue                   # extrusion route: the Python pipeline
+        row[R_STARTED] = 2.0
+        v = pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
+                        rel_pad, abs_pad, stack, row)
+        info[WI_TESTS] += row[R_TESTS]
+        row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
+        if row[R_DEPTH] > info[WI_DEPTH]:
+            info[WI_DEPTH] = row[R_DEPTH]
+        if v == CERTIFIED:
+            code[k] = WK_CERT
+        elif v == VIOLATION:
+            code[k] = WK_VIOL
+            fu = row[R_FIRST_UNRES]
+            if not (fu <= row[R_WTIME]):
+                row[R_FIRST_UNRES] = row[R_WTIME]
         else:
-            code[k] = WK_OPEN
-            surv[S] = k
-            S += 1
-    info[WI_BEST] = best
-    info[WI_SURV] = S
-    if k1 > 0:
-        _start_and_narrow(gp, mp, pairs, moving, route, 0, min(k1, S), prm, code, surv, res, info)
-    return S
+            code[k] = WK_UNRES
+    if stage == 0:
+        return S
+    return k1 - k0
 
 
 def new_result() -> np.ndarray:

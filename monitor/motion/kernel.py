@@ -575,24 +575,6 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
 
     ``need`` must be closed under ancestors. Fills xpos (nbody, 3), xmat (nbody, 3, 3),
     trans (nbody,) m and angle (nbody,) rad for those bodies (0 for static ones).
-    The scratch arrays are views into two buffers allocated here (two allocations per
-    call instead of ~20: about half of a small tree's cost was the allocator).
-    """
-    nbody = xpos.shape[0]
-    njnt = mp.jnt_type.shape[0]
-    nq = mp.qpos.shape[1]
-    nv = 2 * njnt
-    wf = np.empty(nq + 7 * nbody + 10 * njnt + 8 + 17 * nv)
-    wi = np.empty(2 * nv + nbody, dtype=np.int64)
-    _bounds_core_ws(mp, ta, tb, need, xpos, xmat, trans, angle, wf, wi)
-
-
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
-def _bounds_core_ws(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
-                    trans: np.ndarray, angle: np.ndarray, wf: np.ndarray, wi: np.ndarray) -> None:
-    """:func:`_bounds_core` with its scratch arrays carved out of ``wf`` (float64) and ``wi`` (int64).
-
-    Sizes: wf >= nq + 7 nbody + 10 njnt + 8 + 17 nv, wi >= 2 nv + nbody (nv = 2 njnt).
     """
     rel = mp.tol[TOL_REL]
     abs_pad = mp.tol[TOL_ABS]
@@ -611,19 +593,12 @@ def _bounds_core_ws(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray
     lm = _locate(times, tm)
     lo = _search_right(times, ta)
     hi = _search_left(times, tb)
-    nv = 2 * njnt
-    o = 0
-    qm = wf[o:o + nq]
-    o += nq
+    qm = np.empty(nq)
     _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, lm[0], lm[1], lm[2], qm)
-    xquat = wf[o:o + 4 * nbody].reshape((nbody, 4))
-    o += 4 * nbody
-    janchor = wf[o:o + 3 * njnt].reshape((njnt, 3))
-    o += 3 * njnt
-    jaxis = wf[o:o + 3 * njnt].reshape((njnt, 3))
-    o += 3 * njnt
-    jframe = wf[o:o + 4 * njnt].reshape((njnt, 4))
-    o += 4 * njnt
+    xquat = np.empty((nbody, 4))
+    janchor = np.empty((njnt, 3))
+    jaxis = np.empty((njnt, 3))
+    jframe = np.empty((njnt, 4))
     _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
         mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
         qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
@@ -638,23 +613,15 @@ def _bounds_core_ws(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray
         h = max(max(s_b - lm[1], lm[1] - la[1]), 0.0)
 
     # Virtual joints (2 slots per joint: [2j] translation / single, [2j+1] free rotation).
-    vkind = wi[0:nv]
-    vanchor = wf[o:o + 3 * nv].reshape((nv, 3))
-    o += 3 * nv
-    vaxis = wf[o:o + 3 * nv].reshape((nv, 3))
-    o += 3 * nv
-    vcoef = wf[o:o + nv]
-    o += nv
-    vang = wf[o:o + nv]
-    o += nv
-    vrate = wf[o:o + 3 * nv].reshape((nv, 3))
-    o += 3 * nv
-    for i in range(o - 11 * nv, o):     # vanchor .. vrate start at zero
-        wf[i] = 0.0
-    qu = wf[o:o + 4]
-    o += 4
-    om = wf[o:o + 4]
-    o += 4
+    nv = 2 * njnt
+    vkind = np.empty(nv, dtype=np.int64)
+    vanchor = np.zeros((nv, 3))
+    vaxis = np.zeros((nv, 3))
+    vcoef = np.zeros(nv)
+    vang = np.zeros(nv)
+    vrate = np.zeros((nv, 3))
+    qu = np.empty(4)
+    om = np.empty(4)
     for b in range(1, nbody):
         if need[b] == 0 or mp.body_moving[b] == 0:
             continue
@@ -712,18 +679,13 @@ def _bounds_core_ws(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray
                         vrate[v, c] = rate * jaxis[j, c]
 
     # Per body: chain root -> body over the moving bodies.
-    chain = wi[nv:2 * nv]
-    stack = wi[2 * nv:2 * nv + nbody]
-    p_ref = wf[o:o + 3 * nbody].reshape((nbody, 3))
-    o += 3 * nbody
-    D = wf[o:o + 3 * nv].reshape((nv, 3))
-    o += 3 * nv
-    r0 = wf[o:o + nv]
-    o += nv
-    suffix = wf[o:o + nv]
-    o += nv
-    rmax = wf[o:o + nv]
-    o += nv
+    chain = np.empty(nv, dtype=np.int64)
+    stack = np.empty(nbody, dtype=np.int64)
+    p_ref = np.empty((nbody, 3))
+    D = np.empty((nv, 3))
+    r0 = np.empty(nv)
+    suffix = np.empty(nv)
+    rmax = np.empty(nv)
     for b in range(nbody):
         if need[b] == 0:
             continue
