@@ -14,7 +14,8 @@ every sub-interval prove the pair clear; the smallest gap is a certified clearan
 bound. The gap is padded downwards by ``Tolerances.pad`` of the coordinate magnitude.
 
 Cost: the spheres are computed once per geom (:func:`swept_geom_spheres`, one
-``body_poses`` and one ``motion_bounds`` call), then the gaps of all P pairs are pure
+``body_poses`` and one ``motion_bounds`` call, or one call of the compiled motion kernel
+when the trajectory packs), then the gaps of all P pairs are pure
 array arithmetic in blocks (:func:`sphere_pair_gaps`, O(P T) flops, no Python per pair).
 """
 
@@ -59,8 +60,18 @@ def subinterval_bounds(traj: Trajectory, t0: float, t1: float,
     """
     edges = np.linspace(t0, t1, n + 1)
     ta, tb = edges[:-1], edges[1:]
-    pos, rot = traj.body_poses(0.5 * (ta + tb))
-    mb = traj.motion_bounds(ta, tb)
+    from monitor.certify.kernels import trajectory_pack  # lazy: kernels imports numba
+
+    mp = trajectory_pack(traj)
+    if mp is not None:
+        # the compiled motion kernel (same contract, checked against the trajectory's own poses),
+        # so this numpy broad phase and the engine's compiled one use the same bounds
+        from monitor.motion.pack import poses_and_bounds
+
+        pos, rot, mb = poses_and_bounds(mp, ta, tb)
+    else:
+        pos, rot = traj.body_poses(0.5 * (ta + tb))
+        mb = traj.motion_bounds(ta, tb)
     return pos, rot, mb, np.asarray(traj.ref_points, float), chord(mb.angle)
 
 
@@ -200,10 +211,7 @@ def halfspace_gaps(traj: Trajectory, spheres: SweptSpheres, planes: Sequence[Con
     out = np.full(H, -np.inf)
     if H == 0:
         return out
-    edges = np.linspace(float(window[0]), float(window[1]), nsub + 1)
-    ta, tb = edges[:-1], edges[1:]
-    pos, rot = traj.body_poses(0.5 * (ta + tb))
-    mb = traj.motion_bounds(ta, tb)
+    pos, rot, mb, _ref, _ch = subinterval_bounds(traj, float(window[0]), float(window[1]), nsub)
     for h in range(H):
         bb, sb, g = int(plane_bodies[h]), planes[h], int(ball_geoms[h])
         if (mb.trans[:, bb] > 0).any() or (mb.angle[:, bb] > 0).any():

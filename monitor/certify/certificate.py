@@ -121,6 +121,36 @@ class PairResult:
                    Witness.from_dict(d["witness"]) if d.get("witness") else None, str(d.get("note", "")))
 
 
+class _PairsField:
+    """Descriptor of :attr:`Certificate.pairs`: a tuple of :class:`PairResult`, built on first read.
+
+    The engine's compiled path hands the certificate a source object with a
+    ``build_pairs()`` method (arrays per pair, no Python object per pair); the tuple is
+    built from it the first time ``pairs`` is read and then kept (same content and
+    order as an eagerly built tuple). Anything else is stored as a tuple. The
+    dataclass machinery sees an ordinary field with default ``()`` (its ``__init__``,
+    ``replace``, ``==`` and ``repr`` read and write through this descriptor), and
+    ``cert.pairs = x`` still raises ``FrozenInstanceError``.
+    """
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._slot = f"_{name}_store"
+
+    def __get__(self, obj: Any, objtype: type | None = None) -> Any:
+        if obj is None:
+            return ()
+        v = obj.__dict__.get(self._slot, ())
+        if not isinstance(v, tuple):
+            v = tuple(v.build_pairs())
+            obj.__dict__[self._slot] = v
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        if not isinstance(value, tuple) and not hasattr(value, "build_pairs"):
+            value = tuple(value)
+        obj.__dict__[self._slot] = value
+
+
 @dataclass(frozen=True)
 class Certificate:
     """Result of :func:`monitor.certify` for one window.
@@ -135,7 +165,8 @@ class Certificate:
         earliest_time: earliest time (s) at which a violation could not be excluded;
             None when certified.
         clearance: certified lower bound (m) on min clearance over the window.
-        pairs: one :class:`PairResult` per candidate pair, in scene order.
+        pairs: one :class:`PairResult` per candidate pair, in scene order (built on first
+            read when the engine's compiled path made the certificate; see :class:`_PairsField`).
         stats: totals, e.g. ``pairs``, ``pairs_culled``, ``tests``, ``max_depth``,
             ``wall_seconds``, ``checker_mix`` ({method: count}).
         allowed: ((geom_a, geom_b, reason), ...) candidate pairs that were NOT checked
@@ -151,7 +182,7 @@ class Certificate:
     witness: Witness | None
     earliest_time: float | None
     clearance: float
-    pairs: tuple[PairResult, ...] = ()
+    pairs: tuple[PairResult, ...] = _PairsField()  # type: ignore[assignment]
     stats: dict[str, Any] = field(default_factory=dict)
     allowed: tuple[tuple[str, str, str], ...] = ()
 

@@ -108,9 +108,10 @@ def _check_model(scene: Any, plan: Any) -> Any:
     return plan
 
 
-def _select(scene: Any, pairs: Any) -> list[int]:
+def _select(scene: Any, pairs: Any) -> np.ndarray:
+    """Sorted (S,) int64 indices of the selected candidate pairs (all of them when ``pairs`` is None)."""
     if pairs is None:
-        return list(range(len(scene.pair_ids)))
+        return np.arange(len(scene.pair_ids), dtype=np.int64)
     index = {}
     for i, (a, b) in enumerate(scene.candidate_pairs):
         index[(a, b)] = i
@@ -124,7 +125,7 @@ def _select(scene: Any, pairs: Any) -> list[int]:
         if (a, b) not in index:
             raise InvalidInputError(f"pairs[{k}] = ({a!r}, {b!r}) is not a candidate pair of the scene")
         out.append(index[(a, b)])
-    return sorted(set(out))
+    return np.array(sorted(set(out)), dtype=np.int64)
 
 
 def _stage_budget(bud: Budget, npairs: int) -> Budget:
@@ -138,8 +139,7 @@ def _stage_budget(bud: Budget, npairs: int) -> Budget:
         return bud
     reserve = min(0.5 * bud.seconds, _FINALISE_SECONDS_PER_PAIR[0] * npairs)
     stage = Budget(seconds=bud.seconds - reserve, tests=bud.tests)
-    stage._start = bud._start
-    stage._used_tests = bud._used_tests
+    stage.share_clock(bud)
     return stage
 
 
@@ -238,9 +238,15 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
                                 "budget_exhausted": False, "nothing_checked": True}, allowed)
-    stage = _stage_budget(bud, len(sel))
+    fast = _fast_inputs(scene, plan)
+    # the compiled path builds no PairResult objects (cert.pairs is built on first read)
+    stage = _stage_budget(bud, len(sel) if fast is None else 0)
     with active_budget(stage):
-        cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
+        if fast is not None and not stage.exhausted:
+            cert = _certify_fast(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0,
+                                 allowed, fast)
+        else:
+            cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
     if ongoing == "deepen":  # issue 13: contacts present at t0 (monitor/certify/ongoing.py)
         cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
                       budget=bud, tolerances=tol, penetration_tol=pen_tol)
@@ -248,7 +254,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
 
 
 def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
-             bud: Budget, tol: Tolerances, sel: list[int], wall0: float, allowed: tuple) -> Certificate:
+             bud: Budget, tol: Tolerances, sel: np.ndarray, wall0: float, allowed: tuple) -> Certificate:
     """The pipeline of :func:`certify` on validated arguments (``bud`` is the active budget).
 
     Every stage may end early with :class:`BudgetExhausted` (raised by the motion, polled
@@ -258,11 +264,6 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     static = np.asarray(scene.body_static, bool)
     results: dict[int, PairResult] = {}
     mix: dict[str, int] = {}
-    tests_total, depth_max = 0, 0
-
-    def done(i: int, r: PairResult) -> None:
-        results[i] = r
-        mix[r.method] = mix.get(r.method, 0) + 1
 
     # -- 1./2. cull (vectorised over all selected pairs; no Python per culled pair) ---------
     sel_a = np.asarray(sel, np.int64)
@@ -293,6 +294,337 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     n_culled = int(np.count_nonzero(~np.isnan(cull_clear)))
     if n_culled:
         mix["culled"] = n_culled
+    tests_total, depth_max, ext_stats = _python_stages(
+        scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo, moving, results, mix, unfinished,
+        whole_shape=True)
+    n_unfin = int(np.count_nonzero(unfin))
+    if n_unfin:
+        mix["budget"] = n_unfin
+    # -- 6. combine -------------------------------------------------------------------------
+    names = [g.name for g in scene.geoms]
+    bnames = [g.body for g in scene.geoms]
+    fin0 = time.perf_counter()
+    ordered = _build_ordered(sel_a.tolist(), cull_clear.tolist(), unfin.tolist(), (t0, t1),
+                             pid[:, 0].tolist(), pid[:, 1].tolist(),
+                             results, names, bnames)
+    checked_r = [results[i] for i in sorted(results)]
+    verdict = combine_verdicts([r.verdict for r in checked_r] + (["uncertain"] if n_unfin else []))
+    witnesses = [r.witness for r in checked_r if r.verdict == "violation" and r.witness is not None]
+    witness = min(witnesses, key=lambda w: w.time) if witnesses else None
+    earliest = None
+    if verdict != "certified":
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+        starts += [w.time for w in witnesses] + ([t0] if n_unfin else [])
+        earliest = float(min(starts)) if starts else t0
+    finite_cull = cull_clear[np.isfinite(cull_clear)]
+    clears = [r.clearance for r in checked_r] + ([float(finite_cull.min())] if len(finite_cull) else [])
+    if n_unfin:
+        clears.append(float("-inf"))
+    clearance = float(min(clears)) if clears else float("inf")
+    stats = {"pairs": len(ordered), "pairs_culled": n_culled,
+             "tests": tests_total, "max_depth": depth_max,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
+    cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
+                       ordered, stats, allowed)
+    if len(ordered) >= 10_000:  # learn the assembly cost on big scenes (small ones are noise)
+        per_pair = (time.perf_counter() - fin0) / len(ordered)
+        _FINALISE_SECONDS_PER_PAIR[0] = max(_FINALISE_SECONDS_PER_PAIR[0], min(per_pair, 1e-4))
+    return cert
+
+
+
+_FAST_CHUNK = 4
+"""Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
+
+
+def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
+    """(ScenePack, MotionPack) for the compiled window path, or None (then the Python pipeline runs).
+
+    Both are cached (:func:`monitor.certify.kernels.scene_pack` per scene and geoms,
+    :func:`~monitor.certify.kernels.trajectory_pack` per trajectory object, checked once
+    against the trajectory's own poses).
+    """
+    from monitor.certify import kernels as KS
+    from monitor.errors import MonitorError
+
+    mp = KS.trajectory_pack(plan)
+    if mp is None:
+        return None
+    try:
+        sp = KS.scene_pack(scene)
+    except (MonitorError, TypeError, AttributeError, ValueError):
+        return None
+    if sp.geoms.body.shape[0] != len(scene.geoms) or int(plan.nbody) != mp.nbody:
+        return None
+    return sp, mp
+
+
+class _WindowPairs:
+    """Per-pair results of the compiled window as arrays; :meth:`build_pairs` makes the PairResults.
+
+    Read by :class:`monitor.certify.certificate.Certificate` the first time ``cert.pairs``
+    is read (then kept there). Same objects, content and order as the eager assembly
+    (:func:`_build_ordered`): culled / static-static / budget pairs, the kernel's
+    decisions (start-pose violations and certificates, whole-shape certificates and
+    violations with their witnesses), and the Python pipeline's PairResults.
+    """
+
+    def __init__(self, sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
+                 res: np.ndarray, unfin: np.ndarray, results: dict, geoms: tuple,
+                 window: tuple[float, float], sc: np.ndarray, sr: np.ndarray, pad: float) -> None:
+        self.sel, self.pid, self.code, self.gap, self.surv, self.res = sel, pid, code, gap, surv, res
+        self.unfin, self.results = unfin, results
+        self.geoms = geoms          # the scene's geoms tuple of this window (sync() replaces, never edits it)
+        self.names: list | None = None
+        self.bnames: list | None = None
+        self.window, self.sc, self.sr, self.pad = window, sc, sr, pad
+
+    def _names(self) -> None:
+        if self.names is None:
+            self.names = [g.name for g in self.geoms]
+            self.bnames = [g.body for g in self.geoms]
+
+    def kernel_result(self, k: int, s: int) -> PairResult:
+        """PairResult of pair k decided by the kernel (survivor slot s)."""
+        from monitor.certify import kernels as KS
+
+        self._names()
+        a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
+        geoms, bodies = (self.names[a], self.names[b]), (self.bnames[a], self.bnames[b])
+        row = self.res[s]
+        c = int(self.code[k])
+        if c == KS.WK_STATIC_CERT:
+            return PairResult(geoms, bodies, "certified", "static", clearance=float(row[KS.R_CLEAR]))
+        if c == KS.WK_CERT:
+            return PairResult(geoms, bodies, "certified", "toleranced", int(row[KS.R_TESTS]),
+                              int(row[KS.R_DEPTH]), (), float(row[KS.R_CLEAR]))
+        w = Witness(float(row[KS.R_WTIME]), geoms, row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(),
+                    float(row[KS.R_WUPPER]))
+        if c == KS.WK_STATIC_VIOL:
+            t0 = float(self.window[0])
+            return PairResult(geoms, bodies, "violation", "static", intervals=((t0, t0),), witness=w)
+        return PairResult(geoms, bodies, "violation", "toleranced", int(row[KS.R_TESTS]),
+                          int(row[KS.R_DEPTH]), ((float(row[KS.R_FIRST_UNRES]), w.time),), float("-inf"), w)
+
+    def build_pairs(self) -> tuple:
+        from monitor.certify import kernels as KS
+
+        code, gap = self.code, self.gap.copy()
+        miss = np.nonzero((code == KS.WK_CULLED) & np.isnan(gap))[0]
+        for s in range(0, len(miss), 1 << 15):  # their exact sphere gaps (skipped by the AABB test)
+            k = miss[s:s + (1 << 15)]
+            a, b = self.pid[k, 0], self.pid[k, 1]
+            d = np.linalg.norm(self.sc[:, a] - self.sc[:, b], axis=2) - self.sr[:, a] - self.sr[:, b]
+            g = d.min(axis=0) - self.pad
+            g[~np.isfinite(d).all(axis=0)] = -np.inf
+            gap[k] = g
+        slot = {int(k): s for s, k in enumerate(self.surv.tolist())}
+        decided = (KS.WK_STATIC_VIOL, KS.WK_STATIC_CERT, KS.WK_CERT, KS.WK_VIOL)
+        results = dict(self.results)
+        for k, s in slot.items():
+            if int(code[k]) in decided:
+                results[int(self.sel[k])] = self.kernel_result(k, s)
+        cull = np.where((code == KS.WK_CULLED) | (code == KS.WK_SS), gap, np.nan)
+        self._names()
+        return _build_ordered(self.sel.tolist(), cull.tolist(), self.unfin.tolist(), self.window,
+                              self.pid[:, 0].tolist(), self.pid[:, 1].tolist(), results, self.names,
+                              self.bnames)
+
+
+def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
+                  bud: Budget, tol: Tolerances, sel: np.ndarray, wall0: float, allowed: tuple,
+                  fast: tuple) -> Certificate:
+    """The pipeline of :func:`certify` with stages 1-4 in :func:`monitor.certify.kernels.window_kernel`.
+
+    One compiled call culls every selected pair (static-static, swept spheres), tests the
+    survivors' start poses and runs the whole-shape stage on the pairs of the toleranced
+    route (``method="toleranced"``, or ``"auto"`` for pairs that do not both translate);
+    further compiled calls of ``_FAST_CHUNK`` survivors each follow when there are more
+    (the budget is checked between calls). Pairs the kernel leaves open (whole-shape
+    unresolved, the extrusion route, static pairs not proven clear, unsupported kinds) go
+    through the Python stages 3-5 exactly as in :func:`_certify`. Results stay arrays;
+    ``cert.pairs`` is built on first read (:class:`_WindowPairs`).
+    """
+    from monitor.certify import kernels as KS
+
+    sp, mp = fast
+    moving = np.asarray(plan.moving_bodies(), bool)
+    static = np.asarray(scene.body_static, bool)
+    P = len(sel)
+    pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
+    fixed = (static & ~moving).astype(np.int64)
+    mov = moving.astype(np.int64)
+    # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
+    # every surviving pair takes the Python route, which calls the replacement
+    narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
+    route_all = narrow and method == "toleranced"
+    prm = np.array([t0, t1, margin, epsilon, tol.rel_pad, tol.abs_pad, tol.scale_pad, float(tol.max_depth),
+                    float(KS.WHOLE_SHAPE_MAX_TESTS)])
+    code = np.empty(P, np.int64)
+    gap = np.empty(P)
+    surv = np.empty(P, np.int64)
+    res = np.empty((P, KS.R_SIZE))
+    G = sp.geoms.kind.shape[0]
+    sc = np.empty((_NSUB, G, 3))
+    sr = np.empty((_NSUB, G))
+    info = np.zeros(KS.WI_SIZE)
+    none = np.zeros(0, np.int64)
+    chunk = 1 if bud.tests is not None else _FAST_CHUNK
+    first = chunk if route_all else 0
+    S = int(KS.window_kernel(sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
+                             sc, sr, info))
+    done_to = min(first, S)
+    charged = info[KS.WI_TESTS]
+    bud.charge(int(charged))
+    route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
+    stopped = False
+    if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
+        route = np.ones(S, np.int64)
+        trans: dict[int, bool] = {}
+        try:
+            for s, k in enumerate(surv[:S].tolist()):
+                if code[k] != KS.WK_OPEN:
+                    continue
+                for gi in (int(pid[k, 0]), int(pid[k, 1])):
+                    b = int(sp.geoms.body[gi])
+                    if b not in trans:
+                        trans[b] = plan.translation_segments(b) is not None
+                if trans[int(sp.geoms.body[pid[k, 0]])] and trans[int(sp.geoms.body[pid[k, 1]])]:
+                    route[s] = 0
+        except BudgetExhausted:
+            stopped = True
+    while done_to < S and not stopped:
+        if bud.exhausted:
+            stopped = True
+            break
+        k1 = min(S, done_to + chunk)
+        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
+                         sc, sr, info)
+        bud.charge(int(info[KS.WI_TESTS] - charged))
+        charged = info[KS.WI_TESTS]
+        done_to = k1
+    if done_to < S and stopped:
+        # budget spent: the rest get their start-pose test only (the Python pipeline tests every
+        # start pose before any checker runs; start tests are not charged), then go on to the
+        # checkers, which leave them undecided on the exhausted budget
+        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code, gap,
+                         surv, res, sc, sr, info)
+        done_to = S
+    # -- the Python stages on what the kernel left open -------------------------------------
+    # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
+    results: dict[int, PairResult] = {}
+    mix: dict[str, int] = {}
+    unfin = np.zeros(P, bool)
+    geoms = scene.geoms
+    if done_to < S:                       # budget: survivors the kernel never reached
+        unfin[surv[done_to:S]] = True
+    svl = surv[:done_to].tolist()
+    codes = code[surv[:done_to]].tolist() if done_to else []
+    todo = []
+    start_known: dict[int, bool] = {}   # i -> start pose NOT proven clear (the kernel's exact test)
+    vslots, cslots, wslots = [], [], []
+    n_static = 0
+    for s, (k, c) in enumerate(zip(svl, codes)):
+        if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
+            i, ga, gb = int(sel[k]), geoms[int(pid[k, 0])], geoms[int(pid[k, 1])]
+            todo.append((i, ga, gb))
+            if c != KS.WK_PYTHON:
+                lo = float(res[s, KS.R_START_LO])
+                start_known[i] = not (lo > margin or lo + ga.shape.radius + gb.shape.radius > 0)
+            continue
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
+            vslots.append(s)
+        else:
+            cslots.append(s)
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_STATIC_CERT:
+            n_static += 1
+        else:
+            wslots.append(s)
+
+    def unfinished(items: list) -> None:
+        ks = np.searchsorted(sel, np.fromiter((it[0] for it in items if it[0] not in results), np.int64))
+        unfin[ks] = True
+
+    n_culled = P - S                      # every pair that did not survive stage 0 was culled
+    if n_culled:
+        mix["culled"] = n_culled
+    if n_static:
+        mix["static"] = n_static
+    if wslots:
+        mix["toleranced/whole-shape"] = len(wslots)
+    tests_total, depth_max, ext_stats = 0, 0, {}
+    if todo:
+        tests_total, depth_max, ext_stats = _python_stages(
+            scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo, moving, results, mix, unfinished,
+            whole_shape=not narrow, start_known=start_known)
+    n_unfin = int(np.count_nonzero(unfin)) if (todo or done_to < S) else 0
+    if n_unfin:
+        mix["budget"] = n_unfin
+    # -- 6. combine (arrays for the kernel's pairs, PairResults for the Python ones) ------------
+    for s in wslots:
+        tests_total += int(res[s, KS.R_TESTS])
+        depth_max = max(depth_max, int(res[s, KS.R_DEPTH]))
+    checked_r = [results[i] for i in sorted(results)] if results else []
+    has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
+    has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
+    verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to].copy(), res[:done_to].copy(), unfin, results,
+                        geoms, (t0, t1), sc, sr, float(info[KS.WI_PAD]))
+    # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
+    cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
+            if r.verdict == "violation" and r.witness is not None]
+    for s in vslots:
+        k = svl[s]
+        cand.append((float(res[s, KS.R_WTIME]), int(sel[k]), None, k, s))
+    witness = None
+    if cand:
+        best = min(cand, key=lambda c: (c[0], c[1]))
+        witness = best[2] if best[2] is not None else lazy.kernel_result(best[3], best[4]).witness
+    earliest = None
+    if verdict != "certified":
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+        starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
+        for s in vslots:
+            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else float(res[s, KS.R_FIRST_UNRES]))
+        earliest = float(min(starts)) if starts else t0
+    clears = [r.clearance for r in checked_r]
+    clears += [float(res[s, KS.R_CLEAR]) for s in cslots]
+    if vslots or n_unfin:
+        clears.append(float("-inf"))
+    best_cull = float(info[KS.WI_BEST])
+    if best_cull < float("inf"):
+        clears.append(best_cull)
+    clearance = float(min(clears)) if clears else float("inf")
+    stats = {"pairs": P, "pairs_culled": n_culled,
+             "tests": tests_total, "max_depth": depth_max,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
+    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
+                       lazy, stats, allowed)
+
+
+def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
+                   bud: Budget, tol: Tolerances, todo: list, moving: np.ndarray, results: dict, mix: dict,
+                   unfinished: Any, whole_shape: bool,
+                   start_known: dict[int, bool] | None = None) -> tuple[int, int, dict[str, Any]]:
+    """Stages 3-5 (start pose, dispatch, checkers, witnesses) on ``todo`` [(i, GeomInfo a, GeomInfo b)].
+
+    Fills ``results`` {i: PairResult} and ``mix``; calls ``unfinished(items)`` for pairs the
+    budget left undecided. ``whole_shape``: run the compiled whole-shape stage
+    (:func:`monitor.certify.kernels.whole_shape_stage`) before the fat-feature checker
+    (False when :func:`window_kernel` already ran it on these pairs). ``start_known``:
+    pairs of moving bodies whose start pose the window kernel has tested exactly
+    (``posed_distance``, rigorous bounds; no violation at t0), mapped to "start pose not
+    proven clear"; they skip the start-pose stage here.
+    Returns (tests, deepest level, extrusion stats for ``cert.stats``: :func:`extrusion_stats`).
+    """
+    tests_total, depth_max = 0, 0
+
+    def done(i: int, r: PairResult) -> None:
+        results[i] = r
+        mix[r.method] = mix.get(r.method, 0) + 1
+
     # -- 3. start pose -----------------------------------------------------------------
     from monitor.geometry.distance import shape_distance
 
@@ -300,10 +632,15 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     start_unproven: set[int] = set()
     checked = []
     try:
-        if todo:
+        if any(start_known is None or it[0] not in start_known for it in todo):
             bud.check()
             pos0, rot0 = plan.body_poses(np.array([t0]))
         for i, ga, gb in todo:
+            if start_known is not None and i in start_known:
+                if start_known[i]:
+                    start_unproven.add(i)
+                checked.append((i, ga, gb))
+                continue
             bud.check()
             d = shape_distance(ga.shape, (rot0[0, ga.body_id], pos0[0, ga.body_id]),
                                gb.shape, (rot0[0, gb.body_id], pos0[0, gb.body_id]), tolerances=tol)
@@ -357,7 +694,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in ext_items]
         for (i, _ga, _gb, _), o in zip(ext_items, outs):
             outcomes[i] = ("extrusion", o)
-    if tol_items:  # issue 12: the compiled whole-shape stage first; what it certifies is done
+    if tol_items and whole_shape:  # issue 12: the compiled whole-shape stage first; what it certifies is done
         from monitor.certify.kernels import whole_shape_stage
         try:
             pre = whole_shape_stage(scene, plan, [(ga, gb) for _i, ga, gb in tol_items], (t0, t1), margin,
@@ -391,9 +728,6 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in tol_items]
         for (i, _ga, _gb), o in zip(tol_items, outs):
             outcomes[i] = ("toleranced", o)
-    n_unfin = int(np.count_nonzero(unfin))
-    if n_unfin:
-        mix["budget"] = n_unfin
     # -- 5. witnesses ---------------------------------------------------------------------
     by_i = {i: (ga, gb) for i, ga, gb in checked}
     refine: list[int] = []
@@ -447,37 +781,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
             if c > r.clearance:
                 results[i] = PairResult(r.geoms, r.bodies, r.verdict, r.method, r.tests, r.max_depth,
                                         r.intervals, float(c), r.witness)
-    # -- 6. combine -------------------------------------------------------------------------
-    names = [g.name for g in scene.geoms]
-    bnames = [g.body for g in scene.geoms]
-    fin0 = time.perf_counter()
-    ordered = _build_ordered(sel_a.tolist(), cull_clear.tolist(), unfin.tolist(), (t0, t1),
-                             pid[:, 0].tolist(), pid[:, 1].tolist(),
-                             results, names, bnames)
-    checked_r = [results[i] for i in sorted(results)]
-    verdict = combine_verdicts([r.verdict for r in checked_r] + (["uncertain"] if n_unfin else []))
-    witnesses = [r.witness for r in checked_r if r.verdict == "violation" and r.witness is not None]
-    witness = min(witnesses, key=lambda w: w.time) if witnesses else None
-    earliest = None
-    if verdict != "certified":
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
-        starts += [w.time for w in witnesses] + ([t0] if n_unfin else [])
-        earliest = float(min(starts)) if starts else t0
-    finite_cull = cull_clear[np.isfinite(cull_clear)]
-    clears = [r.clearance for r in checked_r] + ([float(finite_cull.min())] if len(finite_cull) else [])
-    if n_unfin:
-        clears.append(float("-inf"))
-    clearance = float(min(clears)) if clears else float("inf")
-    stats = {"pairs": len(ordered), "pairs_culled": n_culled,
-             "tests": tests_total, "max_depth": depth_max,
-             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
-    cert = Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
-                       ordered, stats, allowed)
-    if len(ordered) >= 10_000:  # learn the assembly cost on big scenes (small ones are noise)
-        per_pair = (time.perf_counter() - fin0) / len(ordered)
-        _FINALISE_SECONDS_PER_PAIR[0] = max(_FINALISE_SECONDS_PER_PAIR[0], min(per_pair, 1e-4))
-    return cert
+    return tests_total, depth_max, ext_stats
 
 
 def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: float, t1: float,

@@ -79,7 +79,7 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import body_bound, body_pose
+from monitor.motion.kernel import body_bound, body_pose, tree_bounds
 
 # ---------------------------------------------------------------------------- codes
 
@@ -111,7 +111,8 @@ R_FIRST_UNRES = 10
 R_PAPER = 11            # sub-intervals where a paper ball (R rho_max) was the smallest bound
 R_SP = 12               # stack pointer (resumable state)
 R_STARTED = 13
-R_SIZE = 14
+R_START_LO = 14         # window_kernel: lower bound (m) of the start-pose distance
+R_SIZE = 15
 
 _EPS_REL = 1e-14
 _MAX_ITER = 200
@@ -402,10 +403,22 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
     precomputed max |v - ref| of A and B. ``stats[0]`` is incremented when a paper
     ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
+
+    A body the motion does not move (``mp.body_moving[b] == 0``: no coordinate on its
+    chain changes anywhere in the trajectory) has bound (0, 0) and the same pose at
+    every time (lerp of equal values and slerp of bit-identical quaternions return them
+    exactly), which is what ``body_bound`` would return; its pose is then not recomputed:
+    the caller must have written it into (pA, RA) / (pB, RB) (:func:`pair_window` does).
     """
     ba, bb = gp.body[ga], gp.body[gb]
-    TA, angA = body_bound(mp, ba, ta, tb, pA, RA)
-    TB, angB = body_bound(mp, bb, ta, tb, pB, RB)
+    if mp.body_moving[ba] != 0:
+        TA, angA = body_bound(mp, ba, ta, tb, pA, RA)
+    else:
+        TA, angA = 0.0, 0.0
+    if mp.body_moving[bb] != 0:
+        TB, angB = body_bound(mp, bb, ta, tb, pB, RB)
+    else:
+        TB, angB = 0.0, 0.0
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
     hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
@@ -472,7 +485,9 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         stack: (max_depth + 2, 3) float64 work array (ta, tb, depth); keep it between
             calls to resume a PAUSED search.
         res: (R_SIZE,) float64 result row; set ``res[R_STARTED] = 0`` for a fresh search
-            (:func:`new_result`). Holds verdict, witness time / point / upper bound,
+            (:func:`new_result`), or 2 for a fresh search whose start pose the caller has
+            already tested (no start test here; used by :func:`window_kernel`). Holds verdict,
+            witness time / point / upper bound,
             clearance lower bound, tests, max depth, unresolved count, first unresolved
             time, paper-ball wins, and the resumable state.
 
@@ -507,7 +522,13 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     vn = np.empty(3)
     spent = 0
     sp = int(res[R_SP])
-    if res[R_STARTED] == 0.0:
+    # poses of bodies the motion does not move: constant, set once (see interval_bound)
+    if mp.body_moving[gp.body[ga]] == 0:
+        body_pose(mp, gp.body[ga], t0, pA, RA)
+    if mp.body_moving[gp.body[gb]] == 0:
+        body_pose(mp, gp.body[gb], t0, pB, RB)
+    if res[R_STARTED] == 0.0 or res[R_STARTED] == 2.0:
+        start_done = res[R_STARTED] == 2.0     # the caller ran the start-pose test already
         res[R_STARTED] = 1.0
         res[R_WTIME] = np.nan
         res[R_CLEAR] = np.inf
@@ -516,20 +537,21 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         res[R_DEPTH] = 0.0
         res[R_UNRES] = 0.0
         res[R_PAPER] = 0.0
-        # start pose: exact static test at t0
-        body_pose(mp, gp.body[ga], t0, pA, RA)
-        body_pose(mp, gp.body[gb], t0, pB, RB)
-        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
-        spent += 1
-        res[R_TESTS] += 1.0
-        if up + approx < margin:
-            res[R_WTIME] = t0
-            for r in range(3):
-                res[R_WPOINT + r] = w[r]
-            res[R_WUPPER] = up + approx
-            res[R_VERDICT] = VIOLATION
-            res[R_SP] = 0.0
-            return VIOLATION
+        if not start_done:
+            # start pose: exact static test at t0
+            body_pose(mp, gp.body[ga], t0, pA, RA)
+            body_pose(mp, gp.body[gb], t0, pB, RB)
+            lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+            spent += 1
+            res[R_TESTS] += 1.0
+            if up + approx < margin:
+                res[R_WTIME] = t0
+                for r in range(3):
+                    res[R_WPOINT + r] = w[r]
+                res[R_WUPPER] = up + approx
+                res[R_VERDICT] = VIOLATION
+                res[R_SP] = 0.0
+                return VIOLATION
         sp = _push(stack, 0, t0, t1, 0.0)
     while sp > 0:
         if spent >= max_tests:
@@ -615,6 +637,302 @@ def pairs_window(gp, mp, pairs, t0, t1, margin, epsilon, max_depth, max_tests, m
                     rel_pad, abs_pad, stack, res[k])
 
 
+# ------------------------------------------------------------------ the whole window (issue 12, item 1)
+
+WK_SS = 1
+"""Both bodies welded to the world and not moved by the plan: culled, clearance +inf."""
+WK_CULLED = 2
+"""Swept spheres further apart than the margin: culled; ``gap`` (NaN: not computed, see below)."""
+WK_PYTHON = 3
+"""Left to the Python pipeline (start-pose stage on): two half-spaces, a geom without a shape,
+or a static pair whose start pose is not proven clear."""
+WK_OPEN = 4
+"""Survived the broad phase, start pose clear, not narrowed here (extrusion route, or stage 1 not run)."""
+WK_STATIC_VIOL = 5
+"""Start-pose violation (``upper + approx < margin`` at t0): witness in the result row."""
+WK_STATIC_CERT = 6
+"""Neither body moves and the start pose is clear beyond the margin (``R_CLEAR`` = lower bound)."""
+WK_CERT = 7
+"""Certified by the whole-shape stage (``R_CLEAR``)."""
+WK_VIOL = 8
+"""Violation confirmed by the whole-shape stage (witness in the result row)."""
+WK_UNRES = 9
+"""The whole-shape stage left a sub-interval open: the fat-feature toleranced checker decides."""
+
+WP_T0, WP_T1, WP_MARGIN, WP_EPS, WP_REL, WP_ABS, WP_SCALE_PAD, WP_MAX_DEPTH, WP_MAX_TESTS = range(9)
+WP_SIZE = 9
+"""Layout of the float parameter vector of :func:`window_kernel`."""
+WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH = range(5)
+WI_SIZE = 5
+"""Layout of the info vector of :func:`window_kernel`: sphere-gap pad (m), smallest culled gap
+computed (m), tests spent, survivors, deepest level."""
+
+
+@njit(cache=True)
+def sphere_gap(sc, sr, ga, gb, pad):
+    """Min over sub-intervals of |c_a - c_b| - r_a - r_b, minus ``pad`` (-inf if not all finite)."""
+    g = np.inf
+    for t in range(sc.shape[0]):
+        d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1], sc[t, ga, 2] - sc[t, gb, 2])
+             - sr[t, ga] - sr[t, gb])
+        if not (d > -np.inf and d < np.inf):
+            return -np.inf
+        if d < g:
+            g = d
+    return g - pad
+
+
+@njit(cache=True)
+def _halfspace_gap(n, q, bh, c, sc, sr, trans, ang, rot, pos, pad):
+    """Certified gap of geom c's swept spheres from a half-space (unit normal n, point q, body bh).
+
+    -inf when the plane's body moves (no cull), as :func:`broadphase.halfspace_gaps`.
+    """
+    T = sc.shape[0]
+    for t in range(T):
+        if trans[t, bh] > 0.0 or ang[t, bh] > 0.0:
+            return -np.inf     # a moving plane: no cull
+    g = np.inf
+    for t in range(T):
+        # as broadphase.halfspace_gaps: (c - X(m) q) . R n - r, q the plane's point, n its unit normal
+        R = rot[t, bh]
+        nx = R[0, 0] * n[0] + R[0, 1] * n[1] + R[0, 2] * n[2]
+        ny = R[1, 0] * n[0] + R[1, 1] * n[1] + R[1, 2] * n[2]
+        nz = R[2, 0] * n[0] + R[2, 1] * n[1] + R[2, 2] * n[2]
+        qx = R[0, 0] * q[0] + R[0, 1] * q[1] + R[0, 2] * q[2] + pos[t, bh, 0]
+        qy = R[1, 0] * q[0] + R[1, 1] * q[1] + R[1, 2] * q[2] + pos[t, bh, 1]
+        qz = R[2, 0] * q[0] + R[2, 1] * q[1] + R[2, 2] * q[2] + pos[t, bh, 2]
+        d = (sc[t, c, 0] - qx) * nx + (sc[t, c, 1] - qy) * ny + (sc[t, c, 2] - qz) * nz - sr[t, c]
+        if not (d > -np.inf and d < np.inf):
+            return -np.inf
+        if d < g:
+            g = d
+    return g - pad
+
+@njit(cache=True)
+def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr,
+                  info):
+    """One window of a packed scene and motion: cull, start pose, whole-shape stage (no Python per pair).
+
+    Args:
+        gp: :class:`monitor.certify.packed.GeomPack` (index = geom id).
+        mp: :class:`monitor.motion.pack.MotionPack`.
+        pairs: (P, 2) int64 geom ids of the selected candidate pairs.
+        fixed: (nbody,) int64, 1 where the body is welded to the world and not moved by the plan.
+        moving: (nbody,) int64, the plan's ``moving_bodies()``.
+        route: (S,) int64 per survivor slot, 1 = whole-shape stage, 0 = leave to Python
+            (extrusion route); an empty array means 1 for every slot.
+        stage: 0 = broad phase over all P pairs (fills code, gap, surv, sc, sr, info), then
+            stage 1 on survivor slots [0, min(k1, S)); 1 = stage 1 on survivor slots [k0, k1).
+        prm: (WP_SIZE,) float parameters (window, margin, epsilon, pads, max depth, tests per pair).
+        code: (P,) int64 outcome per pair (``WK_*``).
+        gap: (P,) certified sphere gap (m) of culled pairs; NaN where not computed because the
+            pair's swept AABBs are further apart than the margin AND than a culled gap already
+            computed (then its gap is not the window's minimum; :func:`sphere_gap` gives it).
+        surv: (P,) int64: surviving pair indices in slots [0, S).
+        res: (>= S, R_SIZE) result rows per survivor slot (see :func:`pair_window`).
+        sc, sr: (T, G, 3), (T, G) swept spheres (stage 0 output, kept for :func:`sphere_gap`).
+        info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth.
+
+    Broad phase (stage 0, O(G T + P)): per geom the swept spheres and their AABB (one
+    ``tree_bounds`` per sub-interval for all bodies). Per pair: static-static -> ``WK_SS``;
+    a half-space pair gets its exact plane gap; otherwise the AABB separation
+    ``max_axis (lo_b - hi_a, lo_a - hi_b)`` minus the pads is a lower bound on every
+    sub-interval's sphere gap (a ball lies in its box), so when it exceeds the margin
+    the pair is culled without the O(T) sphere test, unless it could still be the
+    smallest culled gap (then the exact gap is computed, so ``info[WI_BEST]`` is the
+    same minimum as the pairwise sphere test gives). Pairs not culled are survivors.
+
+    Stage 1 (per survivor): the exact start-pose test at t0 (``posed_distance``:
+    ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
+    not move are decided by it (certified if ``lower > margin``, else left to Python);
+    the rest run :func:`pair_window` (MODE_CERTIFY_ONLY) unless routed to Python.
+
+    Returns:
+        S (stage 0) or the number of survivor slots processed (stage 1).
+    """
+    # (one function body, no helper taking the packs: each function typed on the two packs
+    # costs about a second of cold compile)
+    t0, t1 = prm[WP_T0], prm[WP_T1]
+    margin, epsilon = prm[WP_MARGIN], prm[WP_EPS]
+    rel_pad, abs_pad = prm[WP_REL], prm[WP_ABS]
+    max_depth = int(prm[WP_MAX_DEPTH])
+    max_tests = int(prm[WP_MAX_TESTS])
+    S = 0
+    if stage == 0:
+        # -- swept spheres and AABBs per geom (the argument of broadphase.swept_geom_spheres) --
+        T = sc.shape[0]
+        nbody = mp.body_parent.shape[0]
+        G = gp.kind.shape[0]
+        pos = np.empty((T, nbody, 3))
+        rot = np.empty((T, nbody, 3, 3))
+        trans = np.empty((T, nbody))
+        ang = np.empty((T, nbody))
+        step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
+        for t in range(T):
+            ta = t * step + t0
+            tb = t1 if t == T - 1 else (t + 1) * step + t0
+            tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
+        mag = 0.0
+        for t in range(T):
+            for b in range(nbody):
+                for r in range(3):
+                    mag = max(mag, abs(pos[t, b, r]))
+        mag += 1.0
+        pad = rel_pad * mag + abs_pad + prm[WP_SCALE_PAD] * mag
+        grow_f = 1.0 + 8.0 * rel_pad
+        lo = np.empty((G, 3))
+        hi = np.empty((G, 3))
+        for g in range(G):
+            b = gp.body[g]
+            rad = gp.brad[g]
+            if gp.kind[g] < 0 or not rad < np.inf:
+                for t in range(T):
+                    sr[t, g] = np.inf
+                    for r in range(3):
+                        sc[t, g, r] = 0.0
+                for r in range(3):
+                    lo[g, r] = -np.inf
+                    hi[g, r] = np.inf
+                continue
+            cg = gp.bcenter[g]
+            ref = mp.ref_points[b]
+            lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+            for r in range(3):
+                lo[g, r] = np.inf
+                hi[g, r] = -np.inf
+            for t in range(T):
+                R = rot[t, b]
+                rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
+                if not rr >= 0.0:
+                    rr = np.inf
+                sr[t, g] = rr
+                for r in range(3):
+                    x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[t, b, r]
+                    sc[t, g, r] = x
+                    if not x - rr >= lo[g, r]:
+                        lo[g, r] = x - rr
+                    if not x + rr <= hi[g, r]:
+                        hi[g, r] = x + rr
+            for r in range(3):    # NaN anywhere: an unbounded box (never culls)
+                if not (lo[g, r] == lo[g, r] and hi[g, r] == hi[g, r]):
+                    lo[g, r] = -np.inf
+                    hi[g, r] = np.inf
+        info[WI_PAD] = pad
+        # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
+        best = np.inf
+        for k in range(pairs.shape[0]):
+            ga, gb = pairs[k, 0], pairs[k, 1]
+            if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
+                code[k] = WK_SS
+                gap[k] = np.inf
+                continue
+            ka, kb = gp.kind[ga], gp.kind[gb]
+            gap[k] = np.nan
+            if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
+                code[k] = WK_PYTHON
+                surv[S] = k
+                S += 1
+                continue
+            if ka == -1 or kb == -1:
+                h, c = (ga, gb) if ka == -1 else (gb, ga)
+                g = _halfspace_gap(gp.normals[gp.nstart[h]], gp.verts[gp.vstart[h]], gp.body[h], c, sc, sr,
+                                   trans, ang, rot, pos, pad)
+            else:
+                sep = -np.inf
+                scale = 1.0
+                for r in range(3):
+                    s1 = lo[gb, r] - hi[ga, r]
+                    s2 = lo[ga, r] - hi[gb, r]
+                    if s1 > sep:
+                        sep = s1
+                    if s2 > sep:
+                        sep = s2
+                    scale = max(scale, abs(lo[ga, r]), abs(hi[ga, r]), abs(lo[gb, r]), abs(hi[gb, r]))
+                # rounding of c +- r and of the separation: 1e-12 relative covers it many times over
+                sep = sep - pad - 1e-12 * scale
+                if sep > margin and sep >= best:
+                    code[k] = WK_CULLED
+                    continue
+                g = sphere_gap(sc, sr, ga, gb, pad)
+            if g > margin:
+                code[k] = WK_CULLED
+                gap[k] = g
+                if g < best:
+                    best = g
+            else:
+                code[k] = WK_OPEN
+                surv[S] = k
+                S += 1
+        info[WI_BEST] = best
+        info[WI_SURV] = S
+        k0 = 0
+        k1 = min(k1, S)
+    # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
+    stack = np.empty((max_depth + 2, 3))
+    out = np.empty(OUT_SIZE)
+    w = np.empty(3)
+    pA = np.empty(3)
+    pB = np.empty(3)
+    RA = np.empty((3, 3))
+    RB = np.empty((3, 3))
+    for s in range(k0, k1):
+        k = surv[s]
+        if code[k] != WK_OPEN:
+            continue
+        ga, gb = pairs[k, 0], pairs[k, 1]
+        ba, bb = gp.body[ga], gp.body[gb]
+        row = res[s]
+        for j in range(R_SIZE):
+            row[j] = 0.0
+        row[R_WTIME] = np.nan
+        row[R_FIRST_UNRES] = np.nan
+        body_pose(mp, ba, t0, pA, RA)
+        body_pose(mp, bb, t0, pB, RB)
+        lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+        info[WI_TESTS] += 1.0
+        row[R_START_LO] = lo_d
+        approx = gp.approx[ga] + gp.approx[gb]
+        if up_d + approx < margin:
+            code[k] = WK_STATIC_VIOL
+            row[R_VERDICT] = VIOLATION
+            row[R_WTIME] = t0
+            for r in range(3):
+                row[R_WPOINT + r] = w[r]
+            row[R_WUPPER] = up_d + approx
+            row[R_CLEAR] = -np.inf
+            continue
+        if moving[ba] == 0 and moving[bb] == 0:
+            if lo_d > margin:
+                code[k] = WK_STATIC_CERT
+                row[R_VERDICT] = CERTIFIED
+                row[R_CLEAR] = lo_d
+            else:
+                code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
+            continue
+        if route.shape[0] > 0 and route[s] == 0:
+            continue                   # extrusion route: the Python pipeline
+        row[R_STARTED] = 2.0
+        v = pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
+                        rel_pad, abs_pad, stack, row)
+        info[WI_TESTS] += row[R_TESTS]
+        row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
+        if row[R_DEPTH] > info[WI_DEPTH]:
+            info[WI_DEPTH] = row[R_DEPTH]
+        if v == CERTIFIED:
+            code[k] = WK_CERT
+        elif v == VIOLATION:
+            code[k] = WK_VIOL
+            fu = row[R_FIRST_UNRES]
+            if not (fu <= row[R_WTIME]):
+                row[R_FIRST_UNRES] = row[R_WTIME]
+        else:
+            code[k] = WK_UNRES
+    if stage == 0:
+        return S
+    return k1 - k0
+
+
 def new_result() -> np.ndarray:
     """A fresh (R_SIZE,) result row for :func:`pair_window`."""
     return np.zeros(R_SIZE)
@@ -678,30 +996,87 @@ def check_pair_window(gp, mp, ga: int, gb: int, window: tuple[float, float], mar
 
 
 
-@njit(cache=True)
-def _poses_agree(mp, bodies, times, P_W, R_WB):
-    """True if the packed motion reproduces the trajectory's own poses (T, nbody, 3 / 3, 3) at ``times``.
-
-    A guard of the engine hook: the certificate is about the trajectory's motion, so a
-    packed motion that interpolates differently (e.g. the other arc of an exact
-    half-turn slerp, where the sign test of the quaternion dot product is decided by
-    rounding) must not be used. Tolerance 1e-9 relative (rotation entries: absolute).
-    """
-    p = np.empty(3)
-    R = np.empty((3, 3))
-    for k in range(times.shape[0]):
-        for b in bodies:
-            body_pose(mp, b, times[k], p, R)
-            for r in range(3):
-                if not abs(p[r] - P_W[k, b, r]) <= 1e-9 * (1.0 + abs(P_W[k, b, r])):
-                    return False
-                for c in range(3):
-                    if not abs(R[r, c] - R_WB[k, b, r, c]) <= 1e-9:
-                        return False
-    return True
-
-
 _SCENE_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+def scene_pack(scene):
+    """The scene's :class:`~monitor.certify.packed.ScenePack`, packed once and cached per scene.
+
+    Keyed on the scene object AND its current ``geoms`` tuple and ``pair_ids`` array:
+    :meth:`monitor.Scene.sync` replaces both when it rebuilds the shapes after an in-place
+    model edit, so a stale pack is never used.
+    """
+    cached = _SCENE_PACKS.get(scene)
+    if cached is not None and cached[0] is scene.geoms and len(cached) == 3 and cached[1] is scene.pair_ids:
+        return cached[2]
+    from monitor.certify.packed import pack_scene
+    sp = pack_scene(scene)
+    _SCENE_PACKS[scene] = (scene.geoms, scene.pair_ids, sp)
+    return sp
+
+
+_MOTION_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _pack_agrees(traj, mp) -> bool:
+    """The packed motion reproduces the trajectory's own poses at every waypoint and segment midpoint.
+
+    Checked once per pack (the pack is a function of the trajectory object, whose
+    waypoint arrays are read-only copies: :class:`monitor.Plan`, :class:`monitor.BodyMotion`).
+    Why once is enough: :func:`monitor.motion.pack.pack_trajectory` copies the
+    trajectory's own slerp tracks (``QuatTrack``: sign-aligned targets, half angles,
+    bit-identical-ends flags), so every branch of the interpolation (which arc of a
+    half turn, the same-quaternion shortcut) is the trajectory's own decision, for any
+    window; what is left are rounding differences (quaternion FK vs ``mj_kinematics``,
+    ~1e-15 m), far below the 1e-9 tolerance of this check. The check is defence in
+    depth against a packing error (tree, mocap, joint frames): such an error shows at
+    the segment midpoints, where the interpolation is exercised. Tolerance: 1e-9
+    relative (positions), 1e-9 absolute (rotation entries), as the per-call guard it
+    replaces (the former per-call ``_poses_agree``).
+    """
+    from monitor.motion.pack import body_poses
+
+    wp = np.asarray(mp.times, np.float64)
+    times = np.sort(np.concatenate([wp, 0.5 * (wp[:-1] + wp[1:])]))
+    P_W, R_WB = traj.body_poses(times)
+    p_k, R_k = body_poses(mp, times)
+    P_W = np.asarray(P_W, np.float64)
+    R_WB = np.asarray(R_WB, np.float64)
+    return bool((np.abs(p_k - P_W) <= 1e-9 * (1.0 + np.abs(P_W))).all()
+                and (np.abs(R_k - R_WB) <= 1e-9).all())
+
+
+def trajectory_pack(traj):
+    """The trajectory's :class:`~monitor.motion.pack.MotionPack` for the compiled window, or None.
+
+    None when the motion packer does not support the trajectory (screw / Bézier motions,
+    other Trajectory classes) or when the packed poses differ from the trajectory's own
+    (:func:`_pack_agrees`). Cached per trajectory object (weakly): a :class:`monitor.Plan`
+    or :class:`monitor.BodyMotion` never changes after construction (its waypoint arrays
+    are read-only copies, held mocap poses are copies); a plan whose model was edited in
+    place is replaced by a new object (``Plan.refreshed``, see ``engine._check_model``)
+    before it gets here, so it gets its own pack.
+    """
+    try:
+        hit = _MOTION_PACKS.get(traj)
+    except TypeError:          # not weak-referenceable / hashable: no cache
+        hit = None
+    if hit is not None:
+        return hit[0]
+    from monitor.errors import MonitorError
+    from monitor.motion.pack import pack_trajectory
+
+    try:
+        mp = pack_trajectory(traj)
+        if not _pack_agrees(traj, mp):
+            mp = None
+    except (MonitorError, TypeError, AttributeError, ValueError):
+        mp = None
+    try:
+        _MOTION_PACKS[traj] = (mp,)
+    except TypeError:
+        pass
+    return mp
+
 
 WHOLE_SHAPE_MAX_TESTS = 4096
 """Distance tests one pair may spend in the engine's whole-shape stage before it falls through."""
@@ -726,37 +1101,16 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
         ``witness_time`` and ``first_unresolved``: the first contact is not earlier than it),
         else None (the pair falls through to the existing checker unchanged). A trajectory the
         motion packer does not support, or whose packed poses differ from its own
-        ``body_poses`` at the window's start, midpoint, end or a waypoint segment's midpoint
-        inside the window, makes every entry None.
+        ``body_poses`` at a waypoint or a segment midpoint (:func:`trajectory_pack`), makes
+        every entry None.
     """
-    from monitor.errors import MonitorError
-    from monitor.motion.pack import pack_trajectory
-
     out: list[dict | None] = [None] * len(geom_pairs)
     if not geom_pairs or (budget is not None and budget.exhausted):
         return out
-    try:
-        mp = pack_trajectory(plan)
-    except (MonitorError, TypeError, AttributeError):
+    mp = trajectory_pack(plan)     # None: not packable, or packed poses differ from the plan's own
+    if mp is None:
         return out
-    bodies = np.unique(np.array([[ga.body_id, gb.body_id] for ga, gb in geom_pairs], np.int64))
-    t0, t1 = float(window[0]), float(window[1])
-    wp = np.asarray(getattr(plan, "times", [t0, t1]), np.float64)
-    mids = 0.5 * (wp[:-1] + wp[1:])
-    times = np.concatenate([[t0, 0.5 * (t0 + t1), t1], mids[(mids > t0) & (mids < t1)]])
-    P_W, R_WB = plan.body_poses(times)
-    if not _poses_agree(mp, bodies, times, np.ascontiguousarray(P_W, np.float64),
-                        np.ascontiguousarray(R_WB, np.float64)):
-        return out
-    # keyed on the scene's current geoms tuple too: Scene.sync() replaces it when it rebuilds the
-    # shapes after an in-place model edit, so a stale pack is never used
-    cached = _SCENE_PACKS.get(scene)
-    if cached is not None and cached[0] is scene.geoms:
-        gp = cached[1]
-    else:
-        from monitor.certify.packed import pack_scene
-        gp = pack_scene(scene).geoms
-        _SCENE_PACKS[scene] = (scene.geoms, gp)
+    gp = scene_pack(scene).geoms
     stack = np.empty((int(tolerances.max_depth) + 2, 3))
     for k, (ga, gb) in enumerate(geom_pairs):
         if budget is not None and budget.exhausted:
@@ -778,6 +1132,10 @@ def whole_shape_stage(scene, plan, geom_pairs, window: tuple[float, float], marg
     return out
 
 
+whole_shape_stage._compiled_stage = True  # the engine's window kernel runs this stage itself (see engine)
+
+
 __all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MODE_FULL", "MODE_CERTIFY_ONLY",
            "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
-           "check_pair_window", "whole_shape_stage"]
+           "check_pair_window", "whole_shape_stage", "window_kernel", "sphere_gap", "scene_pack",
+           "trajectory_pack"]

@@ -57,6 +57,8 @@ class GeomPack(NamedTuple):
         cparam: (G, 3) cylinder (radius, half length, 0) / ellipsoid radii (m).
         cframe: (G, 3, 3) rotation geom frame -> body frame of the curved geom.
         ccenter: (G, 3) geom origin in the body frame (m).
+        bcenter: (G, 3) centre of a sphere containing the geom (core + radius), body frame (m).
+        brad: (G,) its radius (m); inf for half-spaces and geoms without a shape.
     """
 
     verts: np.ndarray
@@ -79,6 +81,8 @@ class GeomPack(NamedTuple):
     cparam: np.ndarray
     cframe: np.ndarray
     ccenter: np.ndarray
+    bcenter: np.ndarray
+    brad: np.ndarray
 
 
 CURVE_NONE = 0
@@ -120,6 +124,41 @@ def _cat(arrs: list[np.ndarray], width: int, dtype) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([a.reshape(-1, width) for a in arrs]), dtype=dtype)
 
 
+_MEMO: dict = {}
+_MEMO_MAX = 4096
+"""Per-content memo of :func:`_pack_one` (bounded; cleared when full)."""
+
+
+def _content_key(s: ConvexShape) -> tuple | None:
+    """Everything :func:`_pack_one` reads from a shape, as bytes (None: not a plain ConvexShape)."""
+    if not isinstance(s, ConvexShape):
+        return None
+    try:
+        arrs = tuple(np.asarray(a) for a in (s.points, s.edges, s.normals, s.offsets))
+        return (s.kind, float(s.radius), float(s.approx_error)) + tuple(
+            (a.dtype.str, a.shape, a.tobytes()) for a in arrs)
+    except (TypeError, ValueError):
+        return None
+
+
+def _pack_one(s: ConvexShape, name: str) -> tuple:
+    """Validated core, metric points / weights, rho_max, bounding centre and radius of one shape.
+
+    A function of the shape's content only (:func:`_content_key`): the scaling scenes'
+    1000 equal boxes are validated once (the depth pad of a polytope's normals costs ms).
+    """
+    from monitor.geometry.distance import _core
+    from monitor.motion.metric import shape_metric
+
+    c = _core(s, name)
+    if c.code < 0:
+        return c, np.zeros((0, 3)), np.zeros(0), np.inf, np.zeros(3), np.inf
+    m = shape_metric(s)
+    rho = float(np.sqrt(np.max(m.rho2(c.P)))) * _RHO_INFLATE
+    return (c, np.asarray(m.points, float), np.asarray(m.weights, float), rho,
+            np.asarray(s.bounding_center, float), float(s.bounding_radius))
+
+
 def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray,
                 curved: list[tuple | None] | None = None) -> GeomPack:
     """Pack shapes (body frames) with their body ids.
@@ -134,9 +173,6 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
     Raises:
         InvalidInputError: a bad shape (message names ``shapes[i]``), or lengths differ.
     """
-    from monitor.geometry.distance import _core
-    from monitor.motion.metric import shape_metric
-
     bodies = np.asarray(bodies, dtype=np.int64).reshape(-1)
     if len(bodies) != len(shapes):
         raise InvalidInputError(f"bodies has {len(bodies)} entries, shapes has {len(shapes)}")
@@ -147,6 +183,8 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
     cparam = np.zeros((G, 3))
     cframe = np.tile(np.eye(3), (G, 1, 1))
     ccenter = np.zeros((G, 3))
+    bcenter = np.zeros((G, 3))
+    brad = np.full(G, np.inf)
     for i, cv in enumerate(curved or []):
         if cv is None or shapes[i] is None or shapes[i].kind != "polytope":
             continue
@@ -169,7 +207,17 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
             approx.append(0.0)
             rho_max.append(np.inf)
             continue
-        c = _core(s, f"shapes[{i}]")
+        key = _content_key(s)
+        hit = _MEMO.get(key) if key is not None else None
+        if hit is None:
+            hit = _pack_one(s, f"shapes[{i}]")
+            if key is not None:
+                if len(_MEMO) >= _MEMO_MAX:
+                    _MEMO.clear()
+                _MEMO[key] = hit
+        c, mp_, mw_, rho_, bc_, br_ = hit
+        bcenter[i] = bc_
+        brad[i] = br_
         V.append(c.P)
         E.append(c.E)
         N.append(c.N)
@@ -178,15 +226,9 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         offset.append(float(c.offset))
         dpad.append(float(c.dpad))
         approx.append(float(s.approx_error))
-        if c.code < 0:
-            MP.append(np.zeros((0, 3)))
-            MW.append(np.zeros(0))
-            rho_max.append(np.inf)
-        else:
-            m = shape_metric(s)
-            MP.append(np.asarray(m.points, float))
-            MW.append(np.asarray(m.weights, float))
-            rho_max.append(float(np.sqrt(np.max(m.rho2(c.P)))) * _RHO_INFLATE)
+        MP.append(mp_)
+        MW.append(mw_)
+        rho_max.append(rho_)
     return GeomPack(
         verts=_cat(V, 3, np.float64), vstart=_starts([len(v) for v in V]),
         edges=_cat(E, 2, np.int64), estart=_starts([len(e) for e in E]),
@@ -197,7 +239,8 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
         mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
         curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
-        ccenter=np.ascontiguousarray(ccenter))
+        ccenter=np.ascontiguousarray(ccenter), bcenter=np.ascontiguousarray(bcenter),
+        brad=np.ascontiguousarray(brad))
 
 
 class ScenePack(NamedTuple):

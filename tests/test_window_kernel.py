@@ -1,0 +1,168 @@
+"""The engine's compiled window (monitor.certify.kernels.window_kernel) and its caches.
+
+Oracles: the Python pipeline of the same engine (``engine._certify``, reached by turning the
+compiled path off), the numpy swept-sphere broad phase (``broadphase.swept_geom_spheres`` +
+``sphere_pair_gaps``), closed forms (a ball on a hinge passing a post). Seeded; no timings.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+import monitor
+from monitor.bench.cases import make_cases
+from monitor.bench.suites import scaling_scene
+from monitor.certify import engine
+from monitor.certify import kernels as K
+from monitor.certify.broadphase import sphere_pair_gaps, swept_geom_spheres
+from monitor.certify.certificate import Certificate
+
+_HINGE_XML = """<mujoco><worldbody>
+  <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.5 0 0"/>
+  <body name="b"><joint name="h" type="hinge" axis="0 0 1"/>
+    <geom name="ball" type="sphere" size="0.1" pos="0.3 0 0"/></body>
+</worldbody></mujoco>"""
+
+
+def _python_path(monkeypatch):
+    monkeypatch.setattr(engine, "_fast_inputs", lambda scene, plan: None)
+
+
+def _both(monkeypatch, scene, plan, **kw):
+    fast = monitor.certify(scene, plan, **kw)
+    with monkeypatch.context() as mp:
+        _python_path(mp)
+        old = monitor.certify(scene, plan, **kw)
+    return fast, old
+
+
+def test_same_pairs_as_the_python_pipeline_on_the_peers_cases(monkeypatch):
+    """Verdicts, methods, intervals, clearances and witness times equal the Python pipeline's.
+
+    Differences allowed: the culled clearance (motion bounds of the compiled kernel vs
+    numpy, equal up to rounding) and a whole-shape witness's point / distance (the kernel's
+    exact static test at the same time instead of the Python re-confirmation; both below
+    the margin)."""
+    cases = [c for c in make_cases(seed=7, quick=True) if "1e-04" not in c.name]  # 1e-4: fat-feature checker
+    assert len(cases) >= 20
+    for c in cases:
+        scene, bm = c.scene(16), c.body_motion()
+        fast, old = _both(monkeypatch, scene, bm, margin=0.0, epsilon=1e-3, method="toleranced")
+        assert fast.verdict == old.verdict, c.name
+        assert fast.stats["checker_mix"] == old.stats["checker_mix"], c.name
+        assert fast.stats["tests"] == old.stats["tests"], c.name
+        assert len(fast.pairs) == len(old.pairs) == 1
+        pf, po = fast.pairs[0], old.pairs[0]
+        assert (pf.geoms, pf.bodies, pf.verdict, pf.method, pf.tests, pf.max_depth) == \
+               (po.geoms, po.bodies, po.verdict, po.method, po.tests, po.max_depth), c.name
+        assert pf.intervals == po.intervals, c.name
+        if pf.verdict == "violation":
+            assert fast.witness.time == old.witness.time and fast.witness.geoms == old.witness.geoms
+            assert fast.witness.distance < 0.0 and fast.earliest_time == old.earliest_time
+        else:
+            assert fast.clearance == pytest.approx(old.clearance, rel=1e-9, abs=1e-12), c.name
+
+
+def test_broad_phase_gaps_equal_the_numpy_sphere_test():
+    """Every culled pair's clearance (incl. those the AABB pre-test skipped) and the window's
+    minimum equal the numpy swept-sphere broad phase on the same motion (up to rounding)."""
+    model, bm = scaling_scene(64, "sparse", "rotating", seed=3)
+    scene = monitor.Scene.from_model(model, pairs="all")
+    cert = monitor.certify(scene, bm, epsilon=1e-3, budget={"seconds": 60})
+    assert cert.verdict == "certified" and cert.stats["checker_mix"] == {"culled": len(scene.pair_ids)}
+    shapes = [g.shape for g in scene.geoms]
+    sph = swept_geom_spheres(bm, shapes, np.array([g.body_id for g in scene.geoms]), (0.0, 0.1), 8)
+    want = sphere_pair_gaps(sph, scene.pair_ids[:, 0], scene.pair_ids[:, 1])
+    got = np.array([p.clearance for p in cert.pairs])
+    assert all(p.method == "culled" for p in cert.pairs)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+    assert cert.clearance == pytest.approx(want.min(), rel=1e-9)
+    assert cert.clearance == min(got)
+
+
+def test_plan_edit_is_never_served_from_a_stale_pack():
+    """The motion pack is cached per trajectory object. A model edit that only matters
+    mid-window (the hinge's body moved 10 cm towards the post: the start pose stays clear)
+    must be certified on the edited model, with the SAME Plan object passed again.
+    (A cache keyed on the plan's waypoints would serve the old pack here: see the notes.)"""
+    m = mujoco.MjModel.from_xml_string(_HINGE_XML)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    plan = monitor.Plan([0.0, 0.1], [[-1.0], [1.0]], m)   # the ball passes 5 cm from the post face
+    cert = monitor.certify(scene, plan)
+    assert cert.verdict == "certified" and "toleranced/whole-shape" in cert.stats["checker_mix"], cert.stats
+    m.body_pos[m.body("b").id][0] += 0.1                  # now it passes 5 cm INTO the post
+    cert = monitor.certify(scene, plan)
+    assert cert.verdict == "violation", cert.stats
+    assert 0.0 < cert.witness.time < 0.1                 # mid-window: the start pose is clear
+    m.body_pos[m.body("b").id][0] -= 0.1
+    assert monitor.certify(scene, plan).verdict == "certified"
+
+
+def _ball_motion(x_end: float) -> monitor.BodyMotion:
+    pos = np.zeros((2, 3, 3))
+    pos[:, 1] = [[0.0, 0.0, 0.0], [x_end, 0.0, 0.0]]
+    pos[:, 2] = [0.5, 0.0, 0.0]
+    quat = np.zeros((2, 3, 4))
+    quat[..., 0] = 1.0
+    return monitor.BodyMotion([0.0, 0.1], pos, quat)
+
+
+def test_new_trajectory_objects_never_reuse_a_dead_ones_pack():
+    """Trajectories are created and dropped in a loop, alternately clear and colliding;
+    CPython reuses the ids of freed objects, so a cache keyed on id() would serve a
+    dead trajectory's pack. Waypoint arrays are read-only (no in-place mutation)."""
+    xml = """<mujoco><worldbody>
+      <body name="a"><freejoint/><geom name="ga" type="sphere" size="0.1"/></body>
+      <body name="b"><freejoint/><geom name="gb" type="box" size="0.1 0.1 0.1"/></body>
+    </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    for k in range(12):
+        collide = k % 2 == 1
+        cert = monitor.certify(scene, _ball_motion(0.35 if collide else 0.2), method="toleranced")
+        assert cert.verdict == ("violation" if collide else "certified"), (k, cert.stats)
+    bm = _ball_motion(0.2)
+    with pytest.raises(ValueError):
+        bm.pos[1, 1, 0] = 0.35
+    with pytest.raises(ValueError):
+        bm.times[1] = 0.2
+
+
+def test_lazy_pairs_read_like_a_tuple(monkeypatch):
+    c = [c for c in make_cases(seed=7, quick=True) if c.name == "rot-box-box-collide"][0]
+    scene, bm = c.scene(16), c.body_motion()
+    fast, old = _both(monkeypatch, scene, bm, method="toleranced")
+    assert "_pairs_store" in fast.__dict__ and not isinstance(fast.__dict__["_pairs_store"], tuple)
+    assert isinstance(fast.pairs, tuple) and fast.pairs is fast.pairs      # built once, then kept
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.pairs = ()                                                  # type: ignore[misc]
+    back = Certificate.from_dict(json.loads(json.dumps(fast.to_dict())))
+    assert back.pairs[0].verdict == fast.pairs[0].verdict == old.pairs[0].verdict == "violation"
+    assert set(fast.to_dict()) == set(old.to_dict())
+    assert dataclasses.replace(fast, stats={}).pairs == fast.pairs
+
+
+def test_a_tiny_seconds_budget_on_many_survivors_is_uncertain():
+    """Dense rotating boxes (neighbours' swept boxes meet: many pairs survive the cull):
+    the compiled stage runs in chunks and stops on the clock; never certified."""
+    model, bm = scaling_scene(27, "dense", "rotating", seed=1)
+    scene = monitor.Scene.from_model(model, pairs="all")
+    full = monitor.certify(scene, bm, epsilon=1e-3, budget={"seconds": 60})
+    assert full.stats["pairs"] - full.stats["pairs_culled"] > 20
+    cut = monitor.certify(scene, bm, epsilon=1e-3, budget={"seconds": 1e-4})
+    assert cut.verdict in ("uncertain", "violation") and cut.stats["budget_exhausted"]
+    assert any(p.verdict == "uncertain" for p in cut.pairs)
+
+
+def test_window_kernel_is_the_path_taken():
+    """The compiled window runs for a packable trajectory (a guard for the tests above)."""
+    m = mujoco.MjModel.from_xml_string(_HINGE_XML)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    plan = monitor.Plan([0.0, 0.1], [[-1.0], [1.0]], m)
+    assert engine._fast_inputs(scene, plan) is not None
+    assert K.trajectory_pack(plan) is K.trajectory_pack(plan)
