@@ -11,6 +11,9 @@ cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
 VENV=${VENV:-.venv}
 WORKERS=${TEST_WORKERS:-auto}
+# one BLAS thread per process: the workers already use every core (tests/conftest.py does the same)
+export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1} OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} \
+    MKL_NUM_THREADS=${MKL_NUM_THREADS:-1}
 [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV" || exit 1
 "$VENV/bin/python" -m pip install -q --upgrade pip >/dev/null 2>&1
 "$VENV/bin/python" -m pip install -q -e . || exit 1

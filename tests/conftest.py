@@ -18,7 +18,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import pytest
+# One BLAS thread per test process (before numpy loads; scripts/test.sh exports the same). With
+# OpenBLAS's default threads, a 4x4 scipy expm in the screw oracle took 7-11 ms instead of 40 us
+# on the 2-core machine once the threads had been woken (docs/notes/issue-12-tests.md).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import pytest  # noqa: E402
 
 ASSETS = Path(__file__).resolve().parent / "assets"
 """Folder of the test MJCF scenes (tests/assets/*.xml)."""
