@@ -16,7 +16,8 @@ export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1} OMP_NUM_THREADS=${OMP_NUM
     MKL_NUM_THREADS=${MKL_NUM_THREADS:-1}
 [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV" || exit 1
 "$VENV/bin/python" -m pip install -q --upgrade pip >/dev/null 2>&1
-"$VENV/bin/python" -m pip install -q -e . || exit 1
+# --no-compile: byte-code is written on first import instead (only what the tests import; 40 -> 22 s)
+"$VENV/bin/python" -m pip install -q --no-compile -e . || exit 1
 
 # Same lock file as tests/conftest.py: next to numba's cache.
 LOCK_DIR=${NUMBA_CACHE_DIR:-monitor/__pycache__}
@@ -36,7 +37,7 @@ trap finish EXIT
 # The test extra's own requirements (not `-e .[test]`: that would reinstall the package under the compile).
 "$VENV/bin/python" -c 'import tomllib; print("\n".join(tomllib.load(open("pyproject.toml", "rb"))
     ["project"]["optional-dependencies"]["test"]))' >"$WARM_LOG.req" || exit 1
-"$VENV/bin/python" -m pip install -q -r "$WARM_LOG.req" || { rm -f "$WARM_LOG.req"; exit 1; }
+"$VENV/bin/python" -m pip install -q --no-compile -r "$WARM_LOG.req" || { rm -f "$WARM_LOG.req"; exit 1; }
 rm -f "$WARM_LOG.req"
 "$VENV/bin/python" -m ruff check monitor envs tests || exit 1
 if [ "$WORKERS" = 0 ]; then
