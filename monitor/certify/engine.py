@@ -146,14 +146,11 @@ def _stage_budget(bud: Budget, npairs: int) -> Budget:
 def _make_budget(budget: Any) -> Budget:
     """The call's budget: ``None`` -> :data:`DEFAULT_BUDGET_SECONDS`; a dict is validated.
 
-    Before the default budget's clock starts, the kernels are compiled once per process
-    (:func:`monitor.warmup.ensure_warm`): compilation is not certification work and would
-    otherwise make the first windows of a fresh process "uncertain".
+    No budget's clock counts numba compile time (:class:`Budget`): a kernel compiled on first
+    use inside this call does not make the window "uncertain", and the call compiles only
+    the kernels it uses (``python -m monitor warmup`` compiles every path ahead of time).
     """
     if budget is None:
-        from monitor.warmup import ensure_warm  # lazy: monitor.certify stays free of mujoco at import
-
-        ensure_warm()
         return Budget(seconds=DEFAULT_BUDGET_SECONDS)
     if isinstance(budget, Budget):
         return budget

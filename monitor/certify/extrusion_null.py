@@ -268,15 +268,13 @@ def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     (weak-duality bound) exactly as for the HiGHS answer, and falls back to HiGHS
     when neither proves a verdict.
 
-    The kernel is never compiled here (seconds, inside a caller's budget): until
-    :func:`warm_small_lp` has compiled or loaded it in this process (``monitor.warmup``),
-    this returns None and the caller uses HiGHS.
+    The kernel compiles (or loads from numba's on-disk cache) on first use; a
+    :class:`~monitor.certify.common.Budget` does not count that time, and
+    :func:`warm_small_lp` (``python -m monitor warmup``) does it ahead of time.
 
     Returns:
-        ``(z (4,), s, y (m,))`` or None (not warm, non-finite box, iteration cap, singular basis).
+        ``(z (4,), s, y (m,))`` or None (non-finite box, iteration cap, singular basis).
     """
-    if not _dual_simplex_kernel.signatures:
-        return None
     if len(h) == 0 or not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         return None
     f64 = np.float64
