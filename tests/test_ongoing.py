@@ -171,3 +171,33 @@ def test_certificate_json_keeps_notes(model):
     cert = certify(scene, _motion(model, {"ball": [-0.05, 0.0, 0.0]}), ongoing="deepen")
     back = Certificate.from_dict(cert.to_dict())
     assert back.ongoing == cert.ongoing and back.pairs[0].note == cert.pairs[0].note
+
+
+CYL_XML = """
+<mujoco>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 .1"/>
+    <body name="can" pos="0 0 .058"><freejoint/><geom name="can" type="cylinder" size=".04 .06"/></body>
+    <body name="egg" pos=".3 0 .078"><freejoint/><geom name="egg" type="ellipsoid" size=".03 .04 .08"/></body>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("body, geom", [("can", "can"), ("egg", "egg")])
+def test_ongoing_contact_of_a_curved_geom_goes_through_the_compiled_window(body, geom):
+    """A cylinder / ellipsoid resting 2 mm into the floor slides 5 cm (the rule's pair view is packed too).
+
+    Regression: the compiled window kernel read the exact cylinder / ellipsoid of the rule's
+    geom copies from the model by their (past-the-end) ids: IndexError from packed.py.
+    Closed form: the geom stays 2 mm deep < 5 mm while sliding over the floor; pressed
+    1 cm further it reaches 12 mm > 5 mm.
+    """
+    m = mujoco.MjModel.from_xml_string(CYL_XML)
+    scene = Scene.from_model(m, pairs=[("floor", geom)])
+    plan = _motion(m, {body: [0.05, 0.0, 0.0]})
+    assert certify(scene, plan).verdict != "certified"  # plain rule: in contact at t0
+    cert = certify(scene, plan, ongoing="deepen", penetration_tol=TOL)
+    assert cert.verdict == "certified", cert.pairs
+    sunk = _motion(m, {body: [0.05, 0.0, -0.01]})  # pressed 1 cm further in: 12 mm > 5 mm
+    assert certify(scene, sunk, ongoing="deepen", penetration_tol=TOL).verdict == "violation"

@@ -111,6 +111,8 @@ class _PairScene:
     """A scene-like view with per-pair (shrunk) geom copies for :func:`monitor.certify`."""
 
     allowed_pairs: tuple = ()
+    derived_geoms = True
+    """Its geoms are modified copies (ids past the model's): never read their shape from the model."""
 
     def __init__(self, scene: Any, geoms: list[Any], pair_ids: list[tuple[int, int]],
                  names: list[tuple[str, str]]) -> None:

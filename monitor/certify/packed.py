@@ -275,14 +275,19 @@ def _curved_geoms(scene) -> list:
 
     Reads ``geom_size`` / ``geom_pos`` / ``geom_quat`` (body frame) of the scene's MjModel
     as plain arrays (no mujoco import); each entry is re-checked by :func:`_curved_ok`.
+    Geoms that are not the model's own (ids past ``ngeom``, or a scene view flagged
+    ``derived_geoms``, e.g. the ongoing-contact rule's shrunk / inflated copies, whose
+    shapes differ from the model's geom) get None: their packed polytope is used.
     """
     model = getattr(scene, "model", None)
     if model is None:
         return []
     out: list = []
+    derived = bool(getattr(scene, "derived_geoms", False))
+    ngeom = len(model.geom_size)
     for g in scene.geoms:
         code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
-        if code == CURVE_NONE or g.shape is None:
+        if code == CURVE_NONE or g.shape is None or derived or not 0 <= g.id < ngeom:
             out.append(None)
             continue
         size = np.asarray(model.geom_size[g.id], float)
