@@ -5,7 +5,11 @@ algorithms never pull in gymnasium or mcap):
 
 * Scene and trajectories: :class:`Scene`, :class:`Plan`, :class:`BodyMotion` (lerp/slerp or screw),
   :class:`BezierMotion` / :class:`RigidBezier` (rational Bézier motions)
-* Certification: :func:`certify`, :class:`Certificate`, :class:`PairResult`, :class:`Witness`
+* Certification: :func:`certify`, :class:`Certificate`, :class:`PairResult`, :class:`Witness`;
+  :class:`Verdict` (``CERTIFIED | VIOLATION | UNCERTAIN``, the type of ``Certificate.verdict``
+  and ``PairResult.verdict``) and :class:`Method` (``AUTO | TOLERANCED | EXTRUSION``, for
+  ``certify(method=...)``; plain strings are accepted too). Both are ``enum.StrEnum``: each
+  member equals, prints and serialises as its string (``cert.verdict == "certified"``).
 * Gating: :class:`Gate` (plain MuJoCo), :class:`SafetyGate` (gymnasium wrapper)
 * Logs: :class:`MonitorLog` (``monitor.log``)
 * Errors and tolerances: :mod:`monitor.errors`, :class:`Tolerances`
@@ -29,6 +33,8 @@ _LAZY = {
     "Certificate": "monitor.certify.certificate",
     "PairResult": "monitor.certify.certificate",
     "Witness": "monitor.certify.certificate",
+    "Verdict": "monitor.certify.types",
+    "Method": "monitor.certify.types",
     "Gate": "monitor.gate",
     "StepReport": "monitor.gate",
     "SafetyGate": "monitor.gym_gate",

@@ -1,6 +1,7 @@
 """Result objects of a certification: :class:`Certificate`, :class:`PairResult`, :class:`Witness`.
 
-Three verdicts, never collapsed:
+Three verdicts, never collapsed (:class:`~monitor.certify.types.Verdict`, a StrEnum:
+``Verdict.CERTIFIED == "certified"``, and JSON, ``str`` and f-strings give the plain string):
 
 * ``"certified"``: for every instant of the window, every candidate pair's
   clearance exceeds ``margin`` (rounding padded). Holds for the continuous motion.
@@ -17,16 +18,16 @@ All times are seconds of simulation time; points are world-frame metres.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from monitor._json import finite_or, jsonable
+from monitor.certify.types import Method, Verdict, as_method, as_verdict
 from monitor.errors import InvalidInputError
 
-Verdict = Literal["certified", "violation", "uncertain"]
-VERDICTS: tuple[str, ...] = ("certified", "violation", "uncertain")
-_RANK = {"certified": 0, "uncertain": 1, "violation": 2}
+VERDICTS: tuple[str, ...] = tuple(v.value for v in Verdict)
+_RANK = {Verdict.CERTIFIED: 0, Verdict.UNCERTAIN: 1, Verdict.VIOLATION: 2}
 
 
 def _f(x: float | None) -> float | None:
@@ -72,7 +73,8 @@ class PairResult:
     Attributes:
         geoms: (geom_a, geom_b) names.
         bodies: (body_a, body_b) names.
-        verdict: ``"certified" | "violation" | "uncertain"``.
+        verdict: a :class:`Verdict` (``"certified" | "violation" | "uncertain"``); a string
+            given to the constructor is converted, an unknown one raises InvalidInputError.
         method: checker that decided: ``"culled"`` (broad phase), ``"toleranced"``,
             ``"extrusion"``, or ``"static"`` (start-pose overlap).
         tests: number of elementary tests (toleranced) or LP/null tests (extrusion).
@@ -98,9 +100,12 @@ class PairResult:
     witness: Witness | None = None
     note: str = ""
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "verdict", as_verdict(self.verdict, "PairResult verdict"))
+
     def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable form (``note`` only when non-empty)."""
-        out = {"geoms": list(self.geoms), "bodies": list(self.bodies), "verdict": self.verdict,
+        """JSON-serialisable form (``note`` only when non-empty; plain strings, no enums)."""
+        out = {"geoms": list(self.geoms), "bodies": list(self.bodies), "verdict": str(self.verdict),
                "method": self.method, "tests": int(self.tests), "max_depth": int(self.max_depth),
                "intervals": [[float(a), float(b)] for a, b in self.intervals],
                "clearance": _f(self.clearance),
@@ -156,11 +161,13 @@ class Certificate:
     """Result of :func:`monitor.certify` for one window.
 
     Attributes:
-        verdict: combined verdict (see module docstring).
+        verdict: combined :class:`Verdict` (see module docstring); a string given to the
+            constructor is converted, an unknown one raises InvalidInputError.
         window: (t0, t1) seconds.
         margin: clearance (m) that counts as safe; distance < margin is a violation.
         epsilon: termination tolerance (m of body motion).
-        method: requested method (``"auto" | "toleranced" | "extrusion"``).
+        method: requested :class:`Method` (``"auto" | "toleranced" | "extrusion"``); a string
+            given to the constructor is converted, an unknown one raises InvalidInputError.
         witness: earliest confirmed violation, or None.
         earliest_time: earliest time (s) at which a violation could not be excluded;
             None when certified.
@@ -178,7 +185,7 @@ class Certificate:
     window: tuple[float, float]
     margin: float
     epsilon: float
-    method: str
+    method: Method
     witness: Witness | None
     earliest_time: float | None
     clearance: float
@@ -192,8 +199,8 @@ class Certificate:
         return tuple(p.geoms for p in self.pairs if p.note.startswith("ongoing"))
 
     def __post_init__(self) -> None:
-        if self.verdict not in _RANK:
-            raise InvalidInputError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
+        object.__setattr__(self, "verdict", as_verdict(self.verdict))
+        object.__setattr__(self, "method", as_method(self.method, "Certificate method"))
 
     @property
     def certified(self) -> bool:
@@ -201,9 +208,9 @@ class Certificate:
         return self.verdict == "certified"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable form (``json.dumps`` works on it directly)."""
-        return {"verdict": self.verdict, "window": [float(self.window[0]), float(self.window[1])],
-                "margin": float(self.margin), "epsilon": float(self.epsilon), "method": self.method,
+        """JSON-serialisable form (``json.dumps`` works on it directly; plain strings, no enums)."""
+        return {"verdict": str(self.verdict), "window": [float(self.window[0]), float(self.window[1])],
+                "margin": float(self.margin), "epsilon": float(self.epsilon), "method": str(self.method),
                 "witness": self.witness.to_dict() if self.witness else None,
                 "earliest_time": _f(self.earliest_time), "clearance": _f(self.clearance),
                 "pairs": [p.to_dict() for p in self.pairs],
@@ -223,21 +230,24 @@ class Certificate:
                        tuple(PairResult.from_dict(p) for p in d.get("pairs", [])),
                        dict(d.get("stats", {})),
                        tuple((str(a), str(b), str(r)) for a, b, r in d.get("allowed", [])))
+        except InvalidInputError:  # already names the field (unknown verdict / method)
+            raise
         except (KeyError, TypeError, IndexError, ValueError) as exc:
             raise InvalidInputError(f"malformed certificate dict: {exc!r}") from exc
 
 
 def combine_verdicts(verdicts: list[str] | tuple[str, ...]) -> Verdict:
-    """Worst verdict: violation > uncertain > certified (certified if empty)."""
-    worst = "certified"
+    """Worst verdict: violation > uncertain > certified (certified if empty); strings accepted."""
+    worst = Verdict.CERTIFIED
     for v in verdicts:
+        v = as_verdict(v)
         if _RANK[v] > _RANK[worst]:
             worst = v
-    return worst  # type: ignore[return-value]
+    return worst
 
 
 def _jsonable(x: Any) -> Any:
     return jsonable(x, "clamp")
 
 
-__all__ = ["Certificate", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts"]
+__all__ = ["Certificate", "Method", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts"]

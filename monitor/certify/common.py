@@ -7,17 +7,36 @@ test at the witness time (``monitor.geometry.distance``) before reporting it.
 
 from __future__ import annotations
 
+import enum
 import math
 import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-Outcome = Literal["certified", "violation", "unresolved"]
+from monitor.errors import InvalidInputError
+
+
+class Outcome(enum.StrEnum):
+    """A checker's three-way finding for one pair (``PairOutcome.verdict``, ``NullResult.verdict``).
+
+    The checkers' own vocabulary, distinct from the public
+    :class:`monitor.certify.types.Verdict`: ``UNRESOLVED`` means "not excluded before
+    epsilon / depth / budget", which the engine turns into ``"uncertain"`` or, after an
+    exact static test confirms a witness, into ``"violation"``. A StrEnum, so comparisons
+    with the plain strings (``o.verdict == "unresolved"``) keep working.
+    """
+
+    CERTIFIED = "certified"
+    VIOLATION = "violation"
+    UNRESOLVED = "unresolved"
+
+
+_OUTCOMES: dict[str, Outcome] = {o.value: o for o in Outcome}
 
 
 @dataclass
@@ -25,7 +44,8 @@ class PairOutcome:
     """What a checker found for one pair over the window.
 
     Attributes:
-        verdict: ``"certified"`` (proved clear over the whole window),
+        verdict: an :class:`Outcome` (strings are converted; an unknown one raises
+            InvalidInputError): ``"certified"`` (proved clear over the whole window),
             ``"violation"`` (the checker found a witness: ``witness_time`` and
             ``witness_point`` are set; the engine re-confirms it), or
             ``"unresolved"`` (``intervals`` could not be excluded before epsilon /
@@ -50,6 +70,13 @@ class PairOutcome:
     witness_time: float | None = None
     witness_point: np.ndarray | None = None
     info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        o = _OUTCOMES.get(self.verdict) if isinstance(self.verdict, str) else None
+        if o is None:
+            raise InvalidInputError(f"PairOutcome verdict must be one of {tuple(_OUTCOMES)}, "
+                                    f"got {self.verdict!r}")
+        self.verdict = o
 
 
 class _CompileClock:

@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from monitor.certify.broadphase import halfspace_gaps, sphere_pair_gaps, swept_geom_spheres
-from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
+from monitor.certify.certificate import Certificate, PairResult, Verdict, Witness, combine_verdicts
 from monitor.certify.common import (
     DEFAULT_BUDGET_SECONDS,
     Budget,
@@ -897,8 +897,8 @@ def _build_ordered(sel: list[int], cull_clear: list[float], unfin: list[bool], w
     new = object.__new__
 
     def quick(a: int, b: int, verdict: str, method: str, intervals: tuple, clearance: float) -> PairResult:
-        # Field-for-field the same PairResult as the constructor makes (frozen dataclass,
-        # no __post_init__), at a third of the cost: these are built per culled pair.
+        # Field-for-field the same PairResult as the constructor makes (frozen dataclass; its
+        # __post_init__ only makes verdict a Verdict, so pass a member), at a third of the cost.
         r = new(PairResult)
         r.__dict__.update(geoms=(names[a], names[b]), bodies=(bnames[a], bnames[b]), verdict=verdict,
                           method=method, tests=0, max_depth=0, intervals=intervals, clearance=clearance,
@@ -906,9 +906,9 @@ def _build_ordered(sel: list[int], cull_clear: list[float], unfin: list[bool], w
         return r
 
     try:
-        return tuple(quick(a, b, "uncertain", "budget", budget_iv, inf) if u else
+        return tuple(quick(a, b, Verdict.UNCERTAIN, "budget", budget_iv, inf) if u else
                      results[i] if cc != cc else  # NaN: not culled
-                     quick(a, b, "certified", "culled", (), cc)
+                     quick(a, b, Verdict.CERTIFIED, "culled", (), cc)
                      for i, cc, u, a, b in zip(sel, cull_clear, unfin, ga, gb))
     finally:
         if was:

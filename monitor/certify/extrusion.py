@@ -88,7 +88,7 @@ from typing import Any
 
 import numpy as np
 
-from monitor.certify.common import Budget, PairOutcome
+from monitor.certify.common import Budget, Outcome, PairOutcome
 from monitor.certify.extrusion_null import (
     Leaf,
     NullResult,
@@ -312,7 +312,7 @@ class _PairState:
     off_a: float = 0.0  # outward offset (m) of A's half-spaces (offset mode)
     off_b: float = 0.0
     stage: int = 0  # index into STAGES of the deciding stage so far
-    verdict: str = "certified"
+    verdict: Outcome = Outcome.CERTIFIED
     tests: int = 0
     max_depth: int = 0
     unresolved: list[tuple[float, float]] = field(default_factory=list)
@@ -660,7 +660,7 @@ class _Search:
         if p.mode == "halfspace":
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
             res, first = halfspace_null_test(plane, other, p.r, tl, th, self.tol, self.data_pad)
-            if res.verdict == "violation":
+            if res.verdict == Outcome.VIOLATION:
                 # witness: earliest time at which d <= (r + min d) / 2 (half the depth)
                 dmin = 0.5 * (res.lower + res.upper) + p.r
                 _, wt = halfspace_null_test(plane, other, 0.5 * (p.r + dmin), tl, th, self.tol)
@@ -677,7 +677,7 @@ class _Search:
         res = quadratic_null_test(la, lb, p.r, tl, th, self.tol, self.data_pad)
         self.stats["nnls"] += 1
         self.stats["exact_swept"] += 1
-        if res.verdict == "violation":
+        if res.verdict == Outcome.VIOLATION:
             first, fpoint, n1 = quadratic_first_time(la, lb, p.r, tl, res.tau, p.r, self.tol)
             dmin = res.upper + p.r
             tw, wpoint, n2 = quadratic_first_time(la, lb, p.r, tl, res.tau, 0.5 * (p.r + dmin), self.tol)
@@ -687,13 +687,13 @@ class _Search:
             self._settle(p, res, s0, tl, th)
 
     def _settle(self, p: _PairState, res: NullResult, s0: float, tl: float, th: float) -> None:
-        if res.verdict == "unresolved":
-            p.verdict = "unresolved"
+        if res.verdict == Outcome.UNRESOLVED:
+            p.verdict = Outcome.UNRESOLVED
             p.unresolved.append((s0 + tl, s0 + th))
 
     def _violation(self, p: _PairState, s0: float, s1: float, c: np.ndarray, first: float,
                    fpoint: np.ndarray, tw: float, wpoint: np.ndarray, res: NullResult, how: str) -> None:
-        p.verdict = "violation"
+        p.verdict = Outcome.VIOLATION
         p.done = True
         p.stage = STAGES.index("exact_swept" if how == "quadratic" else "null_set")
         p.clearance = -np.inf
@@ -727,7 +727,7 @@ class _Search:
                     for k in idx:
                         p = work[k][0]
                         if not p.done:
-                            p.verdict = "unresolved"
+                            p.verdict = Outcome.UNRESOLVED
                             p.info["budget_exhausted"] = True
                             p.unresolved.append((s0 + float(rlo[3]), s0 + float(rhi[3])))
                 return
@@ -802,7 +802,7 @@ class _Search:
                 counter += 1
                 heapq.heappush(heap, (float(nlo[3]), counter, d + 1, nlo, nhi, live_idx))
         for k, (p, *_r) in enumerate(work):
-            if k not in tested and p.stage < 1 and not (p.done and p.verdict == "violation"):
+            if k not in tested and p.stage < 1 and not (p.done and p.verdict == Outcome.VIOLATION):
                 self._stage(p, "divide_and_conquer")  # every region excluded it (§4.1)
         self.stats["regions"] += regions
         span_stats["regions"] = regions
@@ -844,7 +844,7 @@ class _Search:
         res = lp_null_test(la, lb, blo - cz, bhi - cz, self.tol, self.data_pad)
         if p.mode == "offset":
             self.stats["offset_lps"] += 1
-            if res.verdict == "certified":
+            if res.verdict == Outcome.CERTIFIED:
                 self.stats["offset_certified"] += 1
                 self._stage(p, "null_set")
             else:  # the offset polytopes meet: not a collision proof, the exact test decides
@@ -852,10 +852,10 @@ class _Search:
                 self._round_pair(p, s0, s1, st, tl, th)
             return
         self._stage(p, "null_set")
-        if res.verdict == "violation":
+        if res.verdict == Outcome.VIOLATION:
             self._lp_collision(p, s0, s1, st, tl, th, x_lo, x_hi, proof="lp", found=res, found_c=c)
-        elif res.verdict == "unresolved":
-            p.verdict = "unresolved"
+        elif res.verdict == Outcome.UNRESOLVED:
+            p.verdict = Outcome.UNRESOLVED
             p.unresolved.append((s0 + float(blo[3]), s0 + float(bhi[3])))
 
     def _lp_collision(self, p: _PairState, s0: float, s1: float, st: dict, tl: float, th: float,
@@ -890,7 +890,7 @@ class _Search:
             if wz is not None:
                 if slack_lower(G, h, np.r_[wz[1], wz[0]], self.tol) > self.data_pad:
                     w_tau, w_x = wz
-        res = NullResult("violation", -np.inf, -smax, w_tau, w_x)
+        res = NullResult(Outcome.VIOLATION, -np.inf, -smax, w_tau, w_x)
         self._violation(p, s0, s1, c, first_tau, first_x, w_tau, w_x, res, "lp")
         p.info["earliest_exact"] = bool(self.earliest)  # False: earliest_time is just a violating time
         p.info["proof"] = proof
@@ -907,17 +907,17 @@ class _Search:
             info["geoms"] = [A.geoms[p.ga], B.geoms[p.gb]]
             info["test"] = info.get("test", p.mode)
             info["stage"] = STAGES[p.stage]
-            if p.verdict == "violation":
-                out.append(PairOutcome("violation", p.tests, p.max_depth, list(p.unresolved),
+            if p.verdict == Outcome.VIOLATION:
+                out.append(PairOutcome(Outcome.VIOLATION, p.tests, p.max_depth, list(p.unresolved),
                                        float("-inf"), p.witness_time, p.witness_point, info))
-            elif p.verdict == "unresolved" or info.get("budget_exhausted"):
-                out.append(PairOutcome("unresolved", p.tests, p.max_depth, sorted(p.unresolved),
+            elif p.verdict == Outcome.UNRESOLVED or info.get("budget_exhausted"):
+                out.append(PairOutcome(Outcome.UNRESOLVED, p.tests, p.max_depth, sorted(p.unresolved),
                                        float("-inf"), None, None, info))
             else:
                 clr = float(p.clearance) if self.want_clearance else float("-inf")
                 if not np.isfinite(clr) and self.want_clearance:
                     clr = float("inf")  # no span reached the pair at all
-                out.append(PairOutcome("certified", p.tests, p.max_depth, [], clr, None, None, info))
+                out.append(PairOutcome(Outcome.CERTIFIED, p.tests, p.max_depth, [], clr, None, None, info))
         return out
 
 
@@ -1140,7 +1140,7 @@ def search_summary(outcomes: Sequence[PairOutcome]) -> dict[str, Any]:
 
 def earliest_violation(outcomes: Sequence[PairOutcome]) -> PairOutcome | None:
     """The violating outcome with the smallest ``info["earliest_time"]``, or None."""
-    v = [o for o in outcomes if o.verdict == "violation"]
+    v = [o for o in outcomes if o.verdict == Outcome.VIOLATION]
     return min(v, key=lambda o: o.info["earliest_time"]) if v else None
 
 

@@ -70,6 +70,7 @@ import numpy as np
 from numba import njit
 from scipy.optimize import linprog, nnls
 
+from monitor.certify.common import Outcome
 from monitor.tolerances import Tolerances
 
 _HIGHS_OPTIONS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10,
@@ -107,8 +108,9 @@ class NullResult:
     """Outcome of one exact null test of a leaf pair on a 4-D box.
 
     Attributes:
-        verdict: ``"certified" | "violation" | "unresolved"`` (unresolved only on an
-            LP solver failure in both HiGHS algorithms; never observed).
+        verdict: an :class:`~monitor.certify.common.Outcome` (``"certified" | "violation" |
+            "unresolved"``; unresolved only on an LP solver failure in both HiGHS
+            algorithms; never observed).
         lower: certified lower bound (m) of the decision quantity, which is negative
             exactly for a collision: ``-max slack`` for ``lp``; ``min core distance - r``
             for ``quadratic`` / ``halfspace``.
@@ -118,7 +120,7 @@ class NullResult:
         tests: number of LPs / NNLS solves.
     """
 
-    verdict: str
+    verdict: Outcome
     lower: float
     upper: float
     tau: float
@@ -314,13 +316,13 @@ def lp_null_test(a: Leaf, b: Leaf, lo: np.ndarray, hi: np.ndarray, tol: Toleranc
     fast = small_slack_lp(G, h, np.asarray(lo, float), np.asarray(hi, float))
     if fast is not None:
         res = _verify_slack(G, h, lo, hi, fast[0], fast[2], tol, data_pad)
-        if res.verdict != "unresolved":
+        if res.verdict != Outcome.UNRESOLVED:
             return res
     A = np.hstack([G, np.ones((len(h), 1))])
     bounds = [(float(lo[k]), float(hi[k])) for k in range(4)] + [(None, None)]
     sol = _solve(np.array([0, 0, 0, 0, -1.0]), A, h, bounds)
     if sol is None:
-        return NullResult("unresolved", -np.inf, np.inf, float(lo[3]), 0.5 * (lo[:3] + hi[:3]))
+        return NullResult(Outcome.UNRESOLVED, -np.inf, np.inf, float(lo[3]), 0.5 * (lo[:3] + hi[:3]))
     return _verify_slack(G, h, lo, hi, sol.x[:4], -sol.ineqlin.marginals, tol, data_pad)
 
 
@@ -340,11 +342,11 @@ def _verify_slack(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray, 
         mag = float(y @ (np.abs(h) + np.abs(G) @ zmax))
         ub = ub_raw + 16 * tol.rel_pad * mag + tol.abs_pad + data_pad
     if s_lo > 0.0:
-        verdict = "violation"
+        verdict = Outcome.VIOLATION
     elif ub <= tol.extrusion_slack:
-        verdict = "certified"
+        verdict = Outcome.CERTIFIED
     else:
-        verdict = "unresolved"
+        verdict = Outcome.UNRESOLVED
     return NullResult(verdict, -ub, -s_lo, float(z[3]), z[:3].copy())
 
 
@@ -540,11 +542,11 @@ def quadratic_null_test(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float
     tau = float(np.clip(tau_lo + (tau_hi - tau_lo) * lam[len(D):].sum(), tau_lo, tau_hi))
     _, _, point = static_distance(a, b, tau, tol)
     if up < r:
-        verdict = "violation"
+        verdict = Outcome.VIOLATION
     elif lo >= r - tol.extrusion_slack:
-        verdict = "certified"
+        verdict = Outcome.CERTIFIED
     else:  # pragma: no cover - needs NNLS error beyond extrusion_slack
-        verdict = "unresolved"
+        verdict = Outcome.UNRESOLVED
     return NullResult(verdict, lo - r, up - r, tau, point)
 
 
@@ -606,13 +608,13 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
     tau = tau_lo if k[0] == 0 else tau_hi
     point = other.V[k[1]] + other.v * tau - 0.5 * dmin * n
     if dmin + pad < r:
-        verdict = "violation"
+        verdict = Outcome.VIOLATION
     elif dmin - pad >= r - tol.extrusion_slack:
-        verdict = "certified"
+        verdict = Outcome.CERTIFIED
     else:  # pragma: no cover - pad is far below extrusion_slack
-        verdict = "unresolved"
+        verdict = Outcome.UNRESOLVED
     res = NullResult(verdict, dmin - pad - r, dmin + pad - r, tau, point)
-    if verdict != "violation":
+    if verdict != Outcome.VIOLATION:
         return res, None
     cross = (r - d0) / nw if nw < 0 else np.full(len(d0), np.inf)
     first = np.where(d0 + nw * tau_lo < r, tau_lo, np.clip(cross, tau_lo, tau_hi))

@@ -107,7 +107,7 @@ from typing import Any
 
 import numpy as np
 
-from monitor.certify.common import Budget, BudgetExhausted, PairOutcome, check_active_budget
+from monitor.certify.common import Budget, BudgetExhausted, Outcome, PairOutcome, check_active_budget
 from monitor.geometry.shapes import ConvexShape
 from monitor.motion.base import Trajectory, chord
 from monitor.motion.metric import Metric, edge_coefficients, face_coefficients, shape_metric
@@ -1232,7 +1232,7 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
     pds, ba, bb, swapped = [], [], [], []
     for sa, a, sb, b in items:
         if budget is not None and budget.exhausted:  # feature sets of big meshes take a while
-            return [PairOutcome("unresolved", intervals=[(t0, t1)], info={"budget_exhausted": True})
+            return [PairOutcome(Outcome.UNRESOLVED, intervals=[(t0, t1)], info={"budget_exhausted": True})
                     for _ in items]
         sw = _orient(sa, a, sb, b, static)
         if sw:
@@ -1254,7 +1254,7 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
             res = shape_distance(sa, (rot[0, a], pos[0, a]), sb, (rot[0, b], pos[0, b]),
                                  tolerances=tolerances)
             if res.lower + sa.radius + sb.radius <= 0.0 and res.lower <= margin:
-                outs[i] = PairOutcome("unresolved", intervals=[(t0, t0)],
+                outs[i] = PairOutcome(Outcome.UNRESOLVED, intervals=[(t0, t0)],
                                       info={"start_overlap": True, "start_upper": res.upper})
                 active[i] = False
     if active.any():
@@ -1263,7 +1263,7 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
         for i in np.nonzero(active)[0]:
             iv = res.intervals[i]
             outs[i] = PairOutcome(
-                "certified" if not iv else "unresolved", tests=int(res.row_tests[i]),
+                Outcome.CERTIFIED if not iv else Outcome.UNRESOLVED, tests=int(res.row_tests[i]),
                 max_depth=int(res.max_depth[i]), intervals=iv,
                 clearance=float(margin) if not iv else float("-inf"),
                 info={"unit_tests": int(res.unit_tests[i]), "row_tests": int(res.row_tests[i]),
