@@ -53,6 +53,7 @@ from monitor.certify.common import (
     active_budget,
 )
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
+from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -162,7 +163,8 @@ def _make_budget(budget: Any) -> Budget:
     raise InvalidInputError(f"budget must be None, a Budget or a dict, got {type(budget).__name__}")
 
 
-def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, method: str = "auto", *,
+def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
+            method: Method | str = "auto", *,
             window: tuple[float, float] | None = None, budget: Budget | dict | None = None,
             tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None,
             ongoing: str = "violation", penetration_tol: float = DEFAULT_PENETRATION_TOL) -> Certificate:
@@ -173,7 +175,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3, m
         plan: a Trajectory (:class:`monitor.Plan` or :class:`monitor.BodyMotion`) of the scene's model.
         margin: clearance (m) that counts as safe; distance below it is a violation.
         epsilon: termination tolerance (m of body motion), R * max rho < epsilon.
-        method: "auto" | "toleranced" | "extrusion".
+        method: a :class:`~monitor.certify.types.Method` or its string: "auto" | "toleranced" | "extrusion".
         window: (t0, t1) sub-window (s); default the plan's span.
         budget: None (a default :class:`Budget` of
             :data:`~monitor.certify.common.DEFAULT_BUDGET_SECONDS` wall seconds), a
