@@ -697,6 +697,14 @@ def _gate_note(r: dict[str, Any], what: str) -> str:
     )
 
 
+def _gate_row(key: str, r: dict[str, Any] | None, errors: dict[str, str], what: Any) -> dict[str, Any]:
+    """The target row of a plain-gate measurement ``r`` (None: its error); ``what(r)`` describes the setup."""
+    if not r:
+        return target_row(SPECS[key], None, note=errors[key])
+    return target_row(SPECS[key], r["ratio"], ours=r["gated_s"], ref=r["ungated_s"],
+                      note=_gate_note(r, what(r)))
+
+
 def _guard(
     name: str, fn: Callable[[], dict[str, Any]], errors: dict[str, str], log: Callable[[str], None]
 ) -> dict[str, Any] | None:
@@ -752,42 +760,18 @@ def suite_targets(cfg: Any) -> dict[str, Any]:
         )
 
     tun = _guard("tunnel", lambda: tunnel_gate(cfg), errors, log)
-    rows.append(
-        target_row(
-            SPECS["tunnel"],
-            tun["ratio"],
-            ours=tun["gated_s"],
-            ref=tun["ungated_s"],
-            note=_gate_note(
-                tun,
-                "Gate(margin=0.001), the README example's controller, nstep=1 "
-                f"(10 ms); blocked windows {tun['replaced']}",
-            ),
-        )
-        if tun
-        else target_row(SPECS["tunnel"], None, note=errors["tunnel"])
-    )
+    rows.append(_gate_row("tunnel", tun, errors, lambda r: (
+        f"Gate(margin=0.001), the README example's controller, nstep=1 (10 ms); "
+        f"blocked windows {r['replaced']}")))
 
     hand = None
     if smoke:
         rows.append(target_row(SPECS["hand30"], None, note="not measured in a smoke run"))
     else:
         hand = _guard("hand30", lambda: hand30_gate(cfg), errors, log)
-        rows.append(
-            target_row(
-                SPECS["hand30"],
-                hand["ratio"],
-                ours=hand["gated_s"],
-                ref=hand["ungated_s"],
-                note=_gate_note(
-                    hand,
-                    f"Gate() defaults, {hand['bodies']} bodies, random joint "
-                    f"targets, nstep=5 (10 ms); blocked windows {hand['replaced']}",
-                ),
-            )
-            if hand
-            else target_row(SPECS["hand30"], None, note=errors["hand30"])
-        )
+        rows.append(_gate_row("hand30", hand, errors, lambda r: (
+            f"Gate() defaults, {r['bodies']} bodies, random joint targets, nstep=5 (10 ms); "
+            f"blocked windows {r['replaced']}")))
 
     sp = None if smoke else _guard("sparse", lambda: sparse_scaling(cfg), errors, log)
     if sp:

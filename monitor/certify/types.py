@@ -54,6 +54,17 @@ _VERDICTS: dict[str, Verdict] = {v.value: v for v in Verdict}
 _METHODS: dict[str, Method] = {m.value: m for m in Method}
 
 
+def _member(table: dict, value: Any, name: str) -> Any:
+    """The member of ``table`` (string -> enum member) for ``value``, or InvalidInputError naming ``name``."""
+    try:
+        v = table.get(value)
+    except TypeError:  # unhashable
+        v = None
+    if v is None:
+        raise InvalidInputError(f"{name} must be one of {tuple(table)}, got {value!r}")
+    return v
+
+
 def as_verdict(value: Any, name: str = "verdict") -> Verdict:
     """``value`` (a :class:`Verdict` or its string) as a :class:`Verdict`.
 
@@ -61,13 +72,7 @@ def as_verdict(value: Any, name: str = "verdict") -> Verdict:
         InvalidInputError: ``value`` is not one of the three verdicts; the message names
             the argument ``name`` and the value.
     """
-    try:
-        v = _VERDICTS.get(value)
-    except TypeError:  # unhashable
-        v = None
-    if v is None:
-        raise InvalidInputError(f"{name} must be one of {tuple(_VERDICTS)}, got {value!r}")
-    return v
+    return _member(_VERDICTS, value, name)
 
 
 def as_method(value: Any, name: str = "method") -> Method:
@@ -78,13 +83,7 @@ def as_method(value: Any, name: str = "method") -> Method:
             ``name`` and the value (``method must be one of ('auto', 'toleranced',
             'extrusion'), got 'x'``).
     """
-    try:
-        m = _METHODS.get(value)
-    except TypeError:  # unhashable
-        m = None
-    if m is None:
-        raise InvalidInputError(f"{name} must be one of {tuple(_METHODS)}, got {value!r}")
-    return m
+    return _member(_METHODS, value, name)
 
 
 __all__ = ["Method", "Verdict", "as_method", "as_verdict"]
