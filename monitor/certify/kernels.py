@@ -249,7 +249,8 @@ def _curved_support(gp, g, R, off, v, sign, pt):
 
 
 @njit(cache=True)
-def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v, vn, X):
+def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v,
+                     vn, X):
     """The best separating-axis lower bound on ``dist(core_a, core_b)`` found (early-exit GJK), or -inf.
 
     The lean exclusion test of the whole-shape stage (§4): GJK on the posed cores in the
@@ -261,7 +262,10 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
     > ``target`` when that excluded the pair; otherwise (touching, overlapping, closer
     than target, or no progress) it is the largest bound of the directions tried (any
     of them is a valid lower bound), -inf when none was computed. The caller then runs
-    the full :func:`posed_distance` unless that bound already rules out a witness.
+    the full :func:`posed_distance` unless that bound already rules out a witness: once a
+    point of A - B closer than ``target`` is found (no exclusion possible), GJK goes on
+    only while that point is farther than ``floor`` (< target) and no bound above
+    ``floor`` has been found, to tighten the bound the caller compares with ``floor``.
     Work arrays: VA, VB (>= vertex counts, 3), W (4, 3), IA, IB (4,) int64, lam (4,),
     v, vn (3,), X (4, 3). Both geoms must be cores (no half-spaces). A circumscribed
     cylinder / ellipsoid (``gp.curve > 0``) is replaced by
@@ -337,7 +341,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
         if lb > target:
             return lb
         if sv < target - pad:     # a point of A - B closer than target: cannot be proven
-            return best
+            if best > floor or not (sv > floor):
+                return best       # a witness is ruled out already, or cannot be ruled out
         vw = 0.0
         for r in range(3):
             vw += v[r] * (xa[r] - xb[r])
@@ -582,21 +587,24 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             # core distance > margin + radii + bound (+ the subtraction pad) excludes I
             target = margin + rsum + bound
             target += rel_pad * (abs(target) + bound + margin) + abs_pad
-            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, rel_pad, abs_pad, VA, VB, W, IA, IB,
-                                  lam, v, vn, X)
+            # (no witness possible at m when the cores' lower bound exceeds floor: see below)
+            floor = margin + rsum + approx
+            floor += 2.0 * rel_pad * (abs(floor) + margin) + abs_pad
+            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, floor, rel_pad, abs_pad, VA, VB, W, IA,
+                                  IB, lam, v, vn, X)
             if lb > target:
                 slack = lb - (target - margin)      # > margin: proven clearance over I
                 if slack < res[R_CLEAR]:
                     res[R_CLEAR] = slack
                 continue
             # No witness at m when the cores' lower bound already clears margin + radii +
-            # the polytope error: posed_distance's upper bound ``up`` (of the polytope cores,
-            # which lie within ``approx`` of the exact geoms) is >= lb - rsum - approx, so
-            # ``up + approx < margin`` cannot hold, and its exclusion test ``lo - bound >
-            # margin`` needs lo >~ target, which lb <= target (GJK stopped below target)
-            # leaves to rounding. The full distance is skipped: the interval is split.
-            gap_lo = lb - rsum - approx
-            no_witness = gap_lo - (rel_pad * (abs(lb) + rsum + approx + margin) + abs_pad) > margin
+            # the polytope error (+ rounding pads): posed_distance's upper bound ``up`` (of
+            # the polytope cores, which lie within ``approx`` of the exact geoms) is
+            # >= lb - rsum - approx, so ``up + approx < margin`` cannot hold, and its
+            # exclusion test ``lo - bound > margin`` needs lo >~ target, which lb <= target
+            # (GJK found a point closer than target) leaves to rounding. The full distance
+            # is skipped: the interval is split (this never certifies anything).
+            no_witness = lb > floor
         else:
             no_witness = False
         if not no_witness:
