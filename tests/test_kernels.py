@@ -354,3 +354,38 @@ def test_engine_hook_certifies_and_confirms(monkeypatch):
     old = certify(hit.scene(16), hit.body_motion(), 0.0, 1e-3, "toleranced")
     assert old.verdict == "violation"
     assert abs(old.witness.time - t_w) < 0.05
+
+
+def test_separated_beyond_bound_is_a_lower_bound_and_tightens_to_the_floor():
+    """The early-exit GJK's returned bound never exceeds the exact distance (oracle: shape_distance).
+
+    When it cannot exclude (target above the distance), it keeps iterating while its
+    point of A - B is farther than ``floor`` so the bound can clear ``floor``
+    (pair_window then skips the full posed_distance); a floor below the distance is
+    reached in nearly every case (the former early return gave -inf there).
+    """
+    rng = np.random.default_rng(12)
+    above, n = 0, 0
+    for ka, kb in KINDS:
+        for _ in range(6):
+            shapes = [_random_shape(rng, ka).convex_shape(), _random_shape(rng, kb).convex_shape()]
+            gp = pack_shapes([None, *shapes], [0, 1, 2])
+            Ra = Rotation.random(random_state=rng).as_matrix()
+            Rb = Rotation.random(random_state=rng).as_matrix()
+            pa = rng.uniform(-1, 1, 3)
+            pb = pa + rng.uniform(0.3, 1.5) * _unit(rng)
+            d_up = shape_distance(shapes[0], (Ra, pa), shapes[1], (Rb, pb)).upper
+            rsum = shapes[0].radius + shapes[1].radius
+            core_up = d_up + rsum
+            na = gp.vstart[2] - gp.vstart[1]
+            nb = gp.vstart[3] - gp.vstart[2]
+            work = (np.empty((na, 3)), np.empty((nb, 3)), np.zeros((4, 3)), np.zeros(4, np.int64),
+                    np.zeros(4, np.int64), np.zeros(4), np.empty(3), np.empty(3), np.empty((4, 3)))
+            for target, floor in ((core_up + 0.05, 0.9 * core_up), (core_up + 0.05, np.inf),
+                                  (0.5 * core_up, -np.inf), (core_up + 1.0, core_up + 0.5)):
+                lb = K.separated_beyond(gp, 1, Ra, pa, 2, Rb, pb, target, floor, 1e-15, 1e-15, *work)
+                assert lb <= core_up + 1e-12, (ka, kb, lb, core_up)
+                if floor == 0.9 * core_up and core_up > 1e-3:
+                    n += 1
+                    above += lb > floor
+    assert n >= 30 and above >= 0.9 * n, (above, n)

@@ -138,6 +138,10 @@ def _stage_budget(bud: Budget, npairs: int) -> Budget:
     """
     if bud.seconds is None:
         return bud
+    if npairs == 0 and bud.tests is None:
+        # nothing to reserve and no test count to keep apart from ``bud``: the same clock and
+        # the same seconds limit, so ``bud`` itself (the compiled path; saves a Budget per call)
+        return bud
     reserve = min(0.5 * bud.seconds, _FINALISE_SECONDS_PER_PAIR[0] * npairs)
     stage = Budget(seconds=bud.seconds - reserve, tests=bud.tests)
     stage.share_clock(bud)

@@ -249,19 +249,26 @@ def _curved_support(gp, g, R, off, v, sign, pt):
 
 
 @njit(cache=True)
-def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v, vn):
-    """A separating-axis lower bound > ``target`` on ``dist(core_a, core_b)``, else -inf (early-exit GJK).
+def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v,
+                     vn, X):
+    """The best separating-axis lower bound on ``dist(core_a, core_b)`` found (early-exit GJK), or -inf.
 
     The lean exclusion test of the whole-shape stage (§4): GJK on the posed cores in the
     frame shifted by ``pa`` (as :func:`monitor.geometry._gjk.core_distance`), returning as
     soon as the separating-axis bound of the current direction v,
     ``(min_a v.a - max_b v.b) / |v| - pad``, exceeds ``target``. Any direction gives a
     valid lower bound, so the bound does not depend on GJK's convergence; the pad
-    ``2 rel_pad S + abs_pad`` (S = largest coordinate) is core_distance's. -inf means
-    "not proven" (touching, overlapping, closer than target, or no progress): the caller
-    then runs the full :func:`posed_distance`. Work arrays: VA, VB (>= vertex counts, 3),
-    W (4, 3), IA, IB (4,) int64, lam (4,), v, vn (3,). Both geoms must be cores (no
-    half-spaces). A circumscribed cylinder / ellipsoid (``gp.curve > 0``) is replaced by
+    ``2 rel_pad S + abs_pad`` (S = largest coordinate) is core_distance's. The result is
+    > ``target`` when that excluded the pair; otherwise (touching, overlapping, closer
+    than target, or no progress) it is the largest bound of the directions tried (any
+    of them is a valid lower bound), -inf when none was computed. The caller then runs
+    the full :func:`posed_distance` unless that bound already rules out a witness: once a
+    point of A - B closer than ``target`` is found (no exclusion possible), GJK goes on
+    only while that point is farther than ``floor`` (< target) and no bound above
+    ``floor`` has been found, to tighten the bound the caller compares with ``floor``.
+    Work arrays: VA, VB (>= vertex counts, 3), W (4, 3), IA, IB (4,) int64, lam (4,),
+    v, vn (3,), X (4, 3). Both geoms must be cores (no half-spaces). A circumscribed
+    cylinder / ellipsoid (``gp.curve > 0``) is replaced by
     its exact geom through :func:`_curved_support`: the exact geom lies inside the polytope
     (checked when packing), so S (from the polytope's vertices) still bounds its
     coordinates, and a lower bound on the distance of the exact geoms is what a
@@ -288,12 +295,14 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
     tiny_area2 = (1e-14 * S * S) ** 2
     curved_a = gp.curve[ga] > 0
     curved_b = gp.curve[gb] > 0
-    zero = np.zeros(3)
-    off_b = np.empty(3)
+    zero = X[0]
+    off_b = X[1]
     for r in range(3):
+        zero[r] = 0.0
         off_b[r] = pb[r] - pa[r]
-    xa = np.empty(3)
-    xb = np.empty(3)
+    xa = X[2]
+    xb = X[3]
+    best = -np.inf
     k = 1
     IA[0] = 0
     IB[0] = 0
@@ -304,7 +313,7 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
     vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
     for _it in range(64):
         if not vv > tiny * tiny:
-            return -np.inf
+            return best
         sv = math.sqrt(vv)
         if curved_a:
             ia, sa = -1, -_curved_support(gp, ga, Ra, zero, v, -1.0, xa)
@@ -327,19 +336,22 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
             for r in range(3):
                 xb[r] = VB[ib, r]
         lb = (sa - sb) / sv - pad
+        if lb > best:
+            best = lb
         if lb > target:
             return lb
         if sv < target - pad:     # a point of A - B closer than target: cannot be proven
-            return -np.inf
+            if best > floor or not (sv > floor):
+                return best       # a witness is ruled out already, or cannot be ruled out
         vw = 0.0
         for r in range(3):
             vw += v[r] * (xa[r] - xb[r])
         if vv - vw <= 1e-13 * vv:  # converged below target
-            return -np.inf
+            return best
         if not (curved_a or curved_b):
             for q in range(k):
                 if IA[q] == ia and IB[q] == ib:
-                    return -np.inf
+                    return best
         for r in range(3):
             W[k, r] = xa[r] - xb[r]
         IA[k] = ia
@@ -347,15 +359,15 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, rel_pad, abs_pad, VA, V
         k += 1
         mask, inside = _subalgorithm(W, k, lam, vn, tiny_len2, tiny_area2)
         if inside:
-            return -np.inf
+            return best
         vnn = vn[0] * vn[0] + vn[1] * vn[1] + vn[2] * vn[2]
         if not vnn < vv:
-            return -np.inf
+            return best
         k = _compact(mask, k, W, IA, IB, lam)
         for r in range(3):
             v[r] = vn[r]
         vv = vnn
-    return -np.inf
+    return best
 
 
 @njit(cache=True)
@@ -376,16 +388,16 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     difference pA - pB of the translations enters.
     """
     # X_WB(m) c_B - pA (world, relative to A's origin)
-    qb = np.empty(3)
-    for r in range(3):
-        qb[r] = RB[r, 0] * cB[0] + RB[r, 1] * cB[1] + RB[r, 2] * cB[2] + (pB[r] - pA[r])
+    qb0 = RB[0, 0] * cB[0] + RB[0, 1] * cB[1] + RB[0, 2] * cB[2] + (pB[0] - pA[0])
+    qb1 = RB[1, 0] * cB[0] + RB[1, 1] * cB[1] + RB[1, 2] * cB[2] + (pB[1] - pA[1])
+    qb2 = RB[2, 0] * cB[0] + RB[2, 1] * cB[1] + RB[2, 2] * cB[2] + (pB[2] - pA[2])
     acc = 0.0
     for i in range(P.shape[0]):
         x0, x1, x2 = P[i, 0], P[i, 1], P[i, 2]
         dA = _norm3(x0 - cA[0], x1 - cA[1], x2 - cA[2])
-        y0 = RA[0, 0] * x0 + RA[0, 1] * x1 + RA[0, 2] * x2 - qb[0]
-        y1 = RA[1, 0] * x0 + RA[1, 1] * x1 + RA[1, 2] * x2 - qb[1]
-        y2 = RA[2, 0] * x0 + RA[2, 1] * x1 + RA[2, 2] * x2 - qb[2]
+        y0 = RA[0, 0] * x0 + RA[0, 1] * x1 + RA[0, 2] * x2 - qb0
+        y1 = RA[1, 0] * x0 + RA[1, 1] * x1 + RA[1, 2] * x2 - qb1
+        y2 = RA[2, 0] * x0 + RA[2, 1] * x1 + RA[2, 2] * x2 - qb2
         d = TA + chA * dA + TB + chB * _norm3(y0, y1, y2)
         if weighted:
             acc += w[i] * d * d
@@ -520,6 +532,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     lam = np.zeros(4)
     v = np.empty(3)
     vn = np.empty(3)
+    X = np.empty((4, 3))
     spent = 0
     sp = int(res[R_SP])
     # poses of bodies the motion does not move: constant, set once (see interval_bound)
@@ -574,29 +587,43 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             # core distance > margin + radii + bound (+ the subtraction pad) excludes I
             target = margin + rsum + bound
             target += rel_pad * (abs(target) + bound + margin) + abs_pad
-            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, rel_pad, abs_pad, VA, VB, W, IA, IB,
-                                  lam, v, vn)
+            # (no witness possible at m when the cores' lower bound exceeds floor: see below)
+            floor = margin + rsum + approx
+            floor += 2.0 * rel_pad * (abs(floor) + margin) + abs_pad
+            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, floor, rel_pad, abs_pad, VA, VB, W, IA,
+                                  IB, lam, v, vn, X)
             if lb > target:
                 slack = lb - (target - margin)      # > margin: proven clearance over I
                 if slack < res[R_CLEAR]:
                     res[R_CLEAR] = slack
                 continue
-        lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
-        if up + approx < margin:
-            res[R_WTIME] = m
-            for r in range(3):
-                res[R_WPOINT + r] = w[r]
-            res[R_WUPPER] = up + approx
-            # everything on the stack is later than m: search [a, m] only
-            sp = 0
-            if depth < max_depth and a < m and bound >= epsilon:
-                sp = _push(stack, 0, a, m, depth + 1.0)
-            continue
-        slack = lo - bound - (rel_pad * (abs(lo) + bound + margin) + abs_pad)
-        if slack > margin:
-            if slack < res[R_CLEAR]:
-                res[R_CLEAR] = slack
-            continue
+            # No witness at m when the cores' lower bound already clears margin + radii +
+            # the polytope error (+ rounding pads): posed_distance's upper bound ``up`` (of
+            # the polytope cores, which lie within ``approx`` of the exact geoms) is
+            # >= lb - rsum - approx, so ``up + approx < margin`` cannot hold, and its
+            # exclusion test ``lo - bound > margin`` needs lo >~ target, which lb <= target
+            # (GJK found a point closer than target) leaves to rounding. The full distance
+            # is skipped: the interval is split (this never certifies anything).
+            no_witness = lb > floor
+        else:
+            no_witness = False
+        if not no_witness:
+            lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+            if up + approx < margin:
+                res[R_WTIME] = m
+                for r in range(3):
+                    res[R_WPOINT + r] = w[r]
+                res[R_WUPPER] = up + approx
+                # everything on the stack is later than m: search [a, m] only
+                sp = 0
+                if depth < max_depth and a < m and bound >= epsilon:
+                    sp = _push(stack, 0, a, m, depth + 1.0)
+                continue
+            slack = lo - bound - (rel_pad * (abs(lo) + bound + margin) + abs_pad)
+            if slack > margin:
+                if slack < res[R_CLEAR]:
+                    res[R_CLEAR] = slack
+                continue
         if not (bound >= epsilon) or depth >= max_depth or not (a < m < b):
             if wt == wt:               # refining an earlier witness: contact may start here
                 if not (res[R_FIRST_UNRES] <= a):
