@@ -182,17 +182,22 @@ def label(
         heapq.heappush(heap, (a, m))
         heapq.heappush(heap, (m, b))
     lp = lp_overlap(case, margin) if _lp_applies(case) else None
-    if hit is not None:
-        out = OracleLabel("collide", -np.inf, upper, hit, evals, lp)
-    elif unresolved:
-        out = OracleLabel("near", lower, upper, None, evals, lp)
-    else:
-        out = OracleLabel("clear", lower, upper, None, evals, lp)
-    if lp is True and out.label != "collide":
-        out.label = "collide"
-    elif lp is False and out.label == "collide":
-        out.label = "near"  # sampling and LP disagree: never score such a case as clear
-    return out
+    low = -np.inf if hit is not None else lower
+    return OracleLabel(_label(hit, unresolved, lp), low, upper, hit, evals, lp)
+
+
+def _label(hit: object, unresolved: bool, lp: bool | None) -> str:
+    """The oracle's label from sampling (``hit``, ``unresolved``) and the exact LP (``lp``, or None).
+
+    "collide" (a sampled hit, or the LP says overlap), "near" (unresolved, or sampling and the
+    LP disagree: never scored as clear) or "clear".
+    """
+    label = "collide" if hit is not None else "near" if unresolved else "clear"
+    if lp is True:
+        return "collide"
+    if lp is False and label == "collide":
+        return "near"
+    return label
 
 
 def _lp_applies(case: PairCase) -> bool:
@@ -313,17 +318,8 @@ def translating_label(case, *, resolution: float = 1e-7, cap: int = 20_000) -> T
         a, b, L, m = a[bad], b[bad], L[bad], m[bad]
         a, b, L = np.concatenate([a, m]), np.concatenate([m, b]), np.concatenate([L, L])
     lp = translating_lp(case) if case.margin == 0.0 and _translating_lp_applies(case) else None
-    if hit is not None:
-        out = TranslatingLabel("collide", -np.inf, best_up, hit, lp, evals)
-    elif unresolved:
-        out = TranslatingLabel("near", lower, best_up, None, lp, evals)
-    else:
-        out = TranslatingLabel("clear", lower, best_up, None, lp, evals)
-    if lp is True and out.label != "collide":
-        out.label = "collide"
-    elif lp is False and out.label == "collide":
-        out.label = "near"  # sampling and LP disagree: never score such a case as clear
-    return out
+    low = -np.inf if hit is not None else lower
+    return TranslatingLabel(_label(hit, unresolved, lp), low, best_up, hit, lp, evals)
 
 
 def _translating_lp_applies(case) -> bool:

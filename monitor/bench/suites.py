@@ -219,10 +219,10 @@ def jit_warmup(cfg: BenchConfig) -> dict[str, Any]:
     also runs the targets suite (``cfg.shared["planned_suites"]``), the cold mode is left
     to that suite's start-up measurement (one full compilation per quick run, not two).
     """
-    import json
     import os
-    import subprocess
     import tempfile
+
+    from monitor.bench.targets import run_marked_script
 
     root = Path(__file__).resolve().parents[2]
     out: dict[str, Any] = {}
@@ -236,19 +236,7 @@ def jit_warmup(cfg: BenchConfig) -> dict[str, Any]:
         with tempfile.TemporaryDirectory() as tmp:
             if mode == "cold":
                 env["NUMBA_CACHE_DIR"] = tmp
-            try:
-                p = subprocess.run(
-                    [sys.executable, "-c", _WARM_SCRIPT],
-                    capture_output=True,
-                    text=True,
-                    timeout=600,
-                    env=env,
-                    cwd=tmp,
-                )
-                line = [x for x in p.stdout.splitlines() if x.startswith("WARMUP ")]
-                out[mode] = json.loads(line[-1][7:]) if line else {"error": p.stderr[-400:]}
-            except subprocess.TimeoutExpired:
-                out[mode] = {"error": "timeout (600 s)"}
+            out[mode] = run_marked_script(_WARM_SCRIPT, [], "WARMUP ", env, tmp, 600)
     return out
 
 

@@ -649,6 +649,21 @@ print("START " + json.dumps(res))
 """
 
 
+def run_marked_script(script: str, args: list[str], marker: str, env: dict, cwd: str,
+                      timeout: float) -> dict[str, Any]:
+    """Run ``python -c script *args`` in a fresh process; the JSON after ``marker`` on its last marked line.
+
+    Returns ``{"error": ...}`` (the end of stderr, or the timeout) when no such line was printed.
+    """
+    try:
+        p = subprocess.run([sys.executable, "-c", script, *args], capture_output=True, text=True,
+                           timeout=timeout, env=env, cwd=cwd)
+    except subprocess.TimeoutExpired:
+        return {"error": f"timeout ({timeout:g} s)"}
+    line = [x for x in p.stdout.splitlines() if x.startswith(marker)]
+    return json.loads(line[-1][len(marker):]) if line else {"error": p.stderr[-400:]}
+
+
 def start_up(cfg: Any) -> dict[str, Any]:
     """First ``monitor.certify`` (arm scene, one 10 ms window) in fresh processes.
 
@@ -668,19 +683,7 @@ def start_up(cfg: Any) -> dict[str, Any]:
             if mode == "cold":
                 env["NUMBA_CACHE_DIR"] = tmp
             launched = time.time()
-            try:
-                p = subprocess.run(
-                    [sys.executable, "-c", _START_SCRIPT, repr(launched)],
-                    capture_output=True,
-                    text=True,
-                    timeout=900,
-                    env=env,
-                    cwd=tmp,
-                )
-                line = [x for x in p.stdout.splitlines() if x.startswith("START ")]
-                res = json.loads(line[-1][6:]) if line else {"error": p.stderr[-400:]}
-            except subprocess.TimeoutExpired:
-                res = {"error": "timeout (900 s)"}
+            res = run_marked_script(_START_SCRIPT, [repr(launched)], "START ", env, tmp, 900)
             res["process_wall_s"] = time.time() - launched
         out[mode] = res
     return out
