@@ -482,6 +482,21 @@ def _random_quat(rng: np.random.Generator) -> np.ndarray:
     return Rotation.random(random_state=rng).as_quat(scalar_first=True)
 
 
+def _random_start(rng: np.random.Generator, ka: str, kb: str) -> tuple:
+    """A case's random start, drawn from ``rng`` in this order (seeded case sets depend on it).
+
+    Returns shapes of kinds ka, kb, a travel direction u (3,), a unit w (3,) normal to it, a
+    travel length (m) and two start orientations qa, qb (wxyz quaternions).
+    """
+    shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
+    u = _unit(rng)
+    w = np.cross(u, _unit(rng))
+    w /= np.linalg.norm(w)
+    travel = rng.uniform(0.5, 0.9)
+    qa, qb = _random_quat(rng), _random_quat(rng)
+    return shapes, u, w, travel, qa, qb
+
+
 def min_distance(case: PairCase, dist: Callable[[PairCase, float], float], samples: int = 40) -> float:
     """Approximate minimum over the window of ``dist(case, t)`` (m): sampling + local refinement."""
     ts = np.linspace(0.0, case.duration, samples)
@@ -578,15 +593,10 @@ def make_cases(seed: int = 7, quick: bool = False, dist=None) -> list[PairCase]:
             )
             for k, (intent, c) in enumerate(intents):
                 both = bool(k % 2)
-                shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
-                u = _unit(rng)
-                w = np.cross(u, _unit(rng))
-                w /= np.linalg.norm(w)
-                travel = rng.uniform(0.5, 0.9)
+                shapes, u, w, travel, qa, qb = _random_start(rng, ka, kb)
                 pos = np.zeros((2, 2, 3))
                 pos[0, 0], pos[0, 1] = -travel * u, travel * u
                 quat = np.zeros((2, 2, 4))
-                qa, qb = _random_quat(rng), _random_quat(rng)
                 quat[0, :] = qa
                 quat[1, :] = qb
                 if group == "rotating":
@@ -663,14 +673,9 @@ def _motion_cases(rng: np.random.Generator, quick: bool, dist,
         for ka, kb in ([combos[0]] if interp == "screw" else [combos[1]]) if quick else combos:
             for k, (intent, c) in enumerate(intents):
                 both = interp == "screw" and bool(k % 2)
-                shapes = (_random_shape(rng, ka), _random_shape(rng, kb))
-                u = _unit(rng)
-                w = np.cross(u, _unit(rng))
-                w /= np.linalg.norm(w)
-                travel = rng.uniform(0.5, 0.9)
+                shapes, u, w, travel, qa, qb = _random_start(rng, ka, kb)
                 pos = np.zeros((2, 2, 3))
                 quat = np.zeros((2, 2, 4))
-                qa, qb = _random_quat(rng), _random_quat(rng)
                 quat[0, :], quat[1, :] = qa, qb
                 bez = None
                 if interp == "screw":
