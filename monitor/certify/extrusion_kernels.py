@@ -279,34 +279,36 @@ def min_norm_kernel(P, rel_pad, abs_pad, lam_out, n_out):
             lower = lb
             n_out[0], n_out[1], n_out[2] = n0, n1, n2
         if k >= 3:  # a (coplanar) face of the hull: the normal of the corral's best triangle
-            bc = np.zeros(3)
+            b0 = b1 = b2 = 0.0
             bn2 = -1.0
             for i in range(k):
                 for j in range(i + 1, k):
                     for kk in range(j + 1, k):
-                        e0 = P[S[j]] - P[S[i]]
-                        e1 = P[S[kk]] - P[S[i]]
-                        c0 = e0[1] * e1[2] - e0[2] * e1[1]
-                        c1 = e0[2] * e1[0] - e0[0] * e1[2]
-                        c2 = e0[0] * e1[1] - e0[1] * e1[0]
+                        si, sj, sk = S[i], S[j], S[kk]
+                        x0, x1, x2 = P[sj, 0] - P[si, 0], P[sj, 1] - P[si, 1], P[sj, 2] - P[si, 2]
+                        y0, y1, y2 = P[sk, 0] - P[si, 0], P[sk, 1] - P[si, 1], P[sk, 2] - P[si, 2]
+                        c0 = x1 * y2 - x2 * y1
+                        c1 = x2 * y0 - x0 * y2
+                        c2 = x0 * y1 - x1 * y0
                         n2 = c0 * c0 + c1 * c1 + c2 * c2
                         if n2 > bn2:
                             bn2 = n2
-                            bc[0], bc[1], bc[2] = c0, c1, c2
-            lb, n0, n1, n2 = _dir_lower(P, bc[0], bc[1], bc[2], q, pad)
+                            b0, b1, b2 = c0, c1, c2
+            lb, n0, n1, n2 = _dir_lower(P, b0, b1, b2, q, pad)
             if lb > lower:
                 lower = lb
                 n_out[0], n_out[1], n_out[2] = n0, n1, n2
         elif k == 2:  # an edge: the component of its first point normal to it
-            a = P[S[0]]
-            e = P[S[1]] - a
+            s0, s1 = S[0], S[1]
+            a0, a1, a2 = P[s0, 0], P[s0, 1], P[s0, 2]
+            e0, e1, e2 = P[s1, 0] - a0, P[s1, 1] - a1, P[s1, 2] - a2
             # e x (a x e)
-            t0 = a[1] * e[2] - a[2] * e[1]
-            t1 = a[2] * e[0] - a[0] * e[2]
-            t2 = a[0] * e[1] - a[1] * e[0]
-            c0 = e[1] * t2 - e[2] * t1
-            c1 = e[2] * t0 - e[0] * t2
-            c2 = e[0] * t1 - e[1] * t0
+            t0 = a1 * e2 - a2 * e1
+            t1 = a2 * e0 - a0 * e2
+            t2 = a0 * e1 - a1 * e0
+            c0 = e1 * t2 - e2 * t1
+            c1 = e2 * t0 - e0 * t2
+            c2 = e0 * t1 - e1 * t0
             lb, n0, n1, n2 = _dir_lower(P, c0, c1, c2, q, pad)
             if lb > lower:
                 lower = lb
