@@ -644,16 +644,20 @@ class _Search:
         else:
             (oa, va), (ob, vb) = A.state(s0, s1), B.state(s0, s1)
         c = 0.5 * (oa + ob)
-        la = _leaf(A.shapes[p.ga], A.R, oa, va, c)
-        lb = _leaf(B.shapes[p.gb], B.R, ob, vb, c)
-        rr = la.radius + lb.radius
+        sa, sb = A.shapes[p.ga], B.shapes[p.gb]
+        rr = float(sa.radius) + float(sb.radius)
         if p.mode == "halfspace":
+            la = _leaf(sa, A.R, oa, va, c)
+            lb = _leaf(sb, B.R, ob, vb, c)
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
             res, _ = halfspace_null_test(plane, other, 0.0, 0.0, s1 - s0, self.tol, self.data_pad)
             low = res.lower - rr
         else:
-            D = (la.V[:, None, :] - lb.V[None, :, :]).reshape(-1, 3)
-            w = la.v - lb.v
+            # the leaves' core vertices (as _leaf builds them; no H-rep needed here)
+            Va = sa.points @ A.R.T + (oa - c)
+            Vb = sb.points @ B.R.T + (ob - c)
+            D = (Va[:, None, :] - Vb[None, :, :]).reshape(-1, 3)
+            w = va - vb
             low, _, _ = min_norm(np.vstack([D, D + w * (s1 - s0)]), self.tol)
             self.stats["nnls"] += 1
             low -= rr + self.data_pad
