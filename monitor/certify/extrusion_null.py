@@ -51,11 +51,14 @@ Three exact tests, chosen per pair by the *inflation* ``r = radius_a + radius_b 
     tau = 0, ``w`` = relative velocity), so ``min d`` over the span is the distance
     from the origin to the convex hull of the *swept* difference
     ``conv(K + w tau_lo, K + w tau_hi)``: a least-distance problem solved by
-    Lawson-Hanson NNLS (``scipy.optimize.nnls``). The result is verified: the
-    NNLS weights give a point of the hull (an upper bound on the distance) and
-    its direction a separating plane (a lower bound). Violation iff upper < r;
-    certified iff lower >= r - extrusion_slack. ``d`` is convex in tau, so the
-    first-contact time is found by bisection.
+    Wolfe's min-norm-point method, compiled
+    (:func:`~monitor.certify.extrusion_kernels.min_norm_kernel`). The result is
+    verified: the weights give a point of the hull (an upper bound on the
+    distance) and its direction a separating plane (a lower bound). Violation iff
+    upper < r; certified iff lower >= r - extrusion_slack. ``d`` is convex in tau,
+    so the first-contact time (the earliest witness, Cameron §4.2 / §6) is found by
+    proved conservative advancement with the linear bound ``min_i (D_i + w tau).n``
+    and a short bisection of the rest (:func:`quadratic_first_time`).
 
 ``halfspace`` (one side a plane)
     ``d(tau) = min_i n.(p_i + w tau) - o`` is concave piecewise linear: its
