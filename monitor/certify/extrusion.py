@@ -184,6 +184,9 @@ class SearchResult:
 
 # ----------------------------------------------------------------------------- validation
 
+_EYE3 = np.eye(3)
+
+
 def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float, float]
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Validate and convert one body's motion; raises InvalidInputError naming ``name``."""
@@ -192,14 +195,16 @@ def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float
     origins = np.asarray(origins, dtype=np.float64)
     if R.shape != (3, 3) or not np.all(np.isfinite(R)):
         raise InvalidInputError(f"{name}: R must be a finite (3, 3) rotation, got shape {R.shape}")
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
+    det = r00 * (r11 * r22 - r12 * r21) - r01 * (r10 * r22 - r12 * r20) + r02 * (r10 * r21 - r11 * r20)
+    if float(np.abs(R.T @ R - _EYE3).max()) > 1e-9 or det < 0:
         raise InvalidInputError(f"{name}: R is not a proper rotation (|R^T R - I| > 1e-9 or det < 0)")
     if times.ndim != 1 or len(times) < 2 or origins.shape != (len(times), 3):
         raise InvalidInputError(f"{name}: need times (k+1,) with k >= 1 and origins (k+1, 3); "
                                 f"got {times.shape} and {origins.shape}")
-    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(origins))):
+    if not (np.isfinite(times).all() and np.isfinite(origins).all()):
         raise InvalidInputError(f"{name}: times/origins contain NaN or inf")
-    if np.any(np.diff(times) <= 0):
+    if (times[1:] <= times[:-1]).any():
         raise InvalidInputError(f"{name}: times must be strictly increasing")
     if times[0] > window[0] or times[-1] < window[1]:
         raise InvalidInputError(f"{name}: motion covers [{times[0]}, {times[-1]}] s, "
@@ -560,7 +565,7 @@ class _Search:
         self.stats["spans"].append(span_stats)
         self._exact_stage(s0, s1, stw, work, span_stats)
         for p in live:
-            self._clearance(p, s0, s1)
+            self._clearance(p, s0, s1, st)
 
     def _pruned_in_own_frame(self, p: _PairState, rb: RootBound, st: dict) -> bool:
         """§4.1 region test of a leaf pair on its own S-bound region (scheme 1 of §6.3).
@@ -625,23 +630,34 @@ class _Search:
             self._divide_and_conquer(s0, s1, st, lp_work, span_stats)
 
     # -- clearance
-    def _clearance(self, p: _PairState, s0: float, s1: float) -> None:
-        """Exact lower bound of the core distance minus radii over the span (when wanted)."""
+    def _clearance(self, p: _PairState, s0: float, s1: float, st: dict | None = None) -> None:
+        """Exact lower bound of the core distance minus radii over the span (when wanted).
+
+        ``st`` (body index -> (origin at s0, velocity)) is the span's state when the caller
+        has it (the same ``_Body.state(s0, s1)`` values).
+        """
         if not self.want_clearance or p.done:
             return
         A, B = self.bodies[p.ia], self.bodies[p.ib]
-        (oa, va), (ob, vb) = A.state(s0, s1), B.state(s0, s1)
+        if st is not None and p.ia in st and p.ib in st:
+            (oa, va), (ob, vb) = st[p.ia], st[p.ib]
+        else:
+            (oa, va), (ob, vb) = A.state(s0, s1), B.state(s0, s1)
         c = 0.5 * (oa + ob)
-        la = _leaf(A.shapes[p.ga], A.R, oa, va, c)
-        lb = _leaf(B.shapes[p.gb], B.R, ob, vb, c)
-        rr = la.radius + lb.radius
+        sa, sb = A.shapes[p.ga], B.shapes[p.gb]
+        rr = float(sa.radius) + float(sb.radius)
         if p.mode == "halfspace":
+            la = _leaf(sa, A.R, oa, va, c)
+            lb = _leaf(sb, B.R, ob, vb, c)
             plane, other = (la, lb) if la.kind == "halfspace" else (lb, la)
             res, _ = halfspace_null_test(plane, other, 0.0, 0.0, s1 - s0, self.tol, self.data_pad)
             low = res.lower - rr
         else:
-            D = (la.V[:, None, :] - lb.V[None, :, :]).reshape(-1, 3)
-            w = la.v - lb.v
+            # the leaves' core vertices (as _leaf builds them; no H-rep needed here)
+            Va = sa.points @ A.R.T + (oa - c)
+            Vb = sb.points @ B.R.T + (ob - c)
+            D = (Va[:, None, :] - Vb[None, :, :]).reshape(-1, 3)
+            w = va - vb
             low, _, _ = min_norm(np.vstack([D, D + w * (s1 - s0)]), self.tol)
             self.stats["nnls"] += 1
             low -= rr + self.data_pad

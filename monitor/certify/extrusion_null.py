@@ -51,11 +51,14 @@ Three exact tests, chosen per pair by the *inflation* ``r = radius_a + radius_b 
     tau = 0, ``w`` = relative velocity), so ``min d`` over the span is the distance
     from the origin to the convex hull of the *swept* difference
     ``conv(K + w tau_lo, K + w tau_hi)``: a least-distance problem solved by
-    Lawson-Hanson NNLS (``scipy.optimize.nnls``). The result is verified: the
-    NNLS weights give a point of the hull (an upper bound on the distance) and
-    its direction a separating plane (a lower bound). Violation iff upper < r;
-    certified iff lower >= r - extrusion_slack. ``d`` is convex in tau, so the
-    first-contact time is found by bisection.
+    Wolfe's min-norm-point method, compiled
+    (:func:`~monitor.certify.extrusion_kernels.min_norm_kernel`). The result is
+    verified: the weights give a point of the hull (an upper bound on the
+    distance) and its direction a separating plane (a lower bound). Violation iff
+    upper < r; certified iff lower >= r - extrusion_slack. ``d`` is convex in tau,
+    so the first-contact time (the earliest witness, Cameron §4.2 / §6) is found by
+    proved conservative advancement with the linear bound ``min_i (D_i + w tau).n``
+    and a short bisection of the rest (:func:`quadratic_first_time`).
 
 ``halfspace`` (one side a plane)
     ``d(tau) = min_i n.(p_i + w tau) - o`` is concave piecewise linear: its
@@ -71,6 +74,8 @@ from numba import njit
 from scipy.optimize import linprog, nnls
 
 from monitor.certify.common import Outcome
+from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
+from monitor.certify.extrusion_kernels import warm as _warm_kernels
 from monitor.tolerances import Tolerances
 
 _HIGHS_OPTIONS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10,
@@ -289,9 +294,14 @@ def small_slack_lp(G: np.ndarray, h: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 
 def warm_small_lp() -> None:
-    """Compile (or load from the numba cache) :func:`small_slack_lp`'s kernel: for ``monitor.warmup``."""
+    """Compile (or load from the numba cache) the null-set stage's kernels: for ``monitor.warmup``.
+
+    :func:`small_slack_lp`'s simplex and the exact swept stage's min-norm and
+    first-contact kernels (:mod:`monitor.certify.extrusion_kernels`).
+    """
     G = np.array([[1.0, 0, 0, 0], [-1.0, 0, 0, 0], [0, 1.0, 0, 0]])
     _dual_simplex_kernel(G, np.ones(3), -np.ones(4), np.ones(4), 10)
+    _warm_kernels()
 
 
 def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) -> float:
@@ -439,8 +449,8 @@ def _nnls_start(P: np.ndarray) -> tuple[list[int], np.ndarray]:
     return S, lam
 
 
-def min_norm(P: np.ndarray, tol: Tolerances) -> tuple[float, float, np.ndarray]:
-    """Distance from the origin to ``conv(P)`` with rigorous bounds (Wolfe's min-norm-point method).
+def min_norm_reference(P: np.ndarray, tol: Tolerances) -> tuple[float, float, np.ndarray]:
+    """Former (pure Python) :func:`min_norm`, kept as a test oracle for the compiled one.
 
     Wolfe (1976): keep a corral of at most 4 affinely independent points and
     barycentric weights; add the point most violating ``p . x >= |x|^2`` and
@@ -517,6 +527,28 @@ def min_norm(P: np.ndarray, tol: Tolerances) -> tuple[float, float, np.ndarray]:
     return max(lower, -pad), upper, full
 
 
+def min_norm(P: np.ndarray, tol: Tolerances) -> tuple[float, float, np.ndarray]:
+    """Distance from the origin to ``conv(P)`` with rigorous bounds (compiled Wolfe, verified).
+
+    The compiled :func:`~monitor.certify.extrusion_kernels.min_norm_kernel`: Wolfe's
+    min-norm-point method, then a verified upper bound (a hull point) and lower bound
+    (``min_p p . n`` over a few unit directions), each with the pad
+    ``16 rel_pad max|P| + abs_pad``, exactly as :func:`min_norm_reference` (the former
+    Python implementation, kept as a test oracle).
+
+    Args:
+        P: (m, 3) points (m), m >= 1.
+        tol: tolerances (rounding pads).
+
+    Returns:
+        ``(lower, upper, lam)``: ``lower <= dist(0, conv P) <= upper`` (m), weights (m,).
+    """
+    P = np.ascontiguousarray(P, dtype=np.float64)
+    lam = np.empty(len(P))
+    lower, upper = min_norm_kernel(P, float(tol.rel_pad), float(tol.abs_pad), lam, np.empty(3))
+    return float(lower), float(upper), lam
+
+
 def static_distance(a: Leaf, b: Leaf, tau: float, tol: Tolerances) -> tuple[float, float, np.ndarray]:
     """Bounds ``(lower, upper)`` on the core distance at ``tau`` and a midpoint (3,) between the cores."""
     A = a.V + a.v * tau
@@ -552,14 +584,47 @@ def quadratic_null_test(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float
 
 def quadratic_first_time(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float, level: float,
                          tol: Tolerances) -> tuple[float, np.ndarray, int]:
-    """Earliest ``tau`` in ``[tau_lo, tau_hi]`` with core distance ``< level`` (convexity + bisection).
+    """Earliest ``tau`` in ``[tau_lo, tau_hi]`` with core distance ``< level`` (Cameron §4.2, §6 witness).
+
+    Compiled (:func:`~monitor.certify.extrusion_kernels.first_time_kernel`): conservative
+    advancement from ``tau_lo`` with the linear lower bound ``min_i (D_i + w tau) . n``
+    (Newton's method on the convex core distance from the left: it never passes the
+    first contact, and every step is proved in float64 with a pad), then the former
+    bisection rule on the remaining bracket of about ``pad / |w|`` seconds.
 
     Precondition: the distance at ``tau_hi`` is below ``level`` (upper bound).
-    Bisection keeps ``d(hi) < level`` proved by an upper bound, and stops after
-    the interval is below ``2^-52`` of the span (about 60 static NNLS solves).
+
+    Contract (unchanged): the returned ``tau`` has a proved upper bound ``< level`` (or is
+    ``tau_lo`` when the distance there is already proved below ``level``), and the
+    interval ``{d < level}`` does not reach left of ``tau - 2^-52 max(|tau_lo|, |tau_hi|,
+    tau_hi - tau_lo)`` except within the rounding pad; on ``[tau_lo, lo]`` of the
+    advancement phase it is excluded by proof.
+
+    Args:
+        a, b: the leaves (cores ``V + v tau``); ``r`` is unused (kept for the callers).
+        tau_lo, tau_hi: the interval (s from span start).
+        level: the distance threshold (m).
+        tol: tolerances (rounding pads).
 
     Returns:
-        ``(tau, point, solves)``: tau (s from span start), a point between the cores.
+        ``(tau, point, solves)``: tau (s from span start), a point (3,) between the cores
+        at tau, and the number of min-norm solves.
+    """
+    point = np.empty(3)
+    f64 = np.float64
+    tau, solves, _steps = first_time_kernel(
+        np.ascontiguousarray(a.V, f64), np.ascontiguousarray(a.v, f64),
+        np.ascontiguousarray(b.V, f64), np.ascontiguousarray(b.v, f64),
+        float(tau_lo), float(tau_hi), float(level), float(tol.rel_pad), float(tol.abs_pad), point)
+    return float(tau), point, int(solves)
+
+
+def quadratic_first_time_bisection(a: Leaf, b: Leaf, r: float, tau_lo: float, tau_hi: float, level: float,
+                                   tol: Tolerances) -> tuple[float, np.ndarray, int]:
+    """The former :func:`quadratic_first_time` (bisection to ``2^-52`` of the span): a test oracle.
+
+    Bisection keeps ``d(hi) < level`` proved by an upper bound, and stops after the
+    interval is below ``2^-52`` of the span (about 60 static solves).
     """
     lo_, up_, point = static_distance(a, b, tau_lo, tol)
     if up_ < level:
@@ -622,5 +687,6 @@ def halfspace_null_test(plane: Leaf, other: Leaf, r: float, tau_lo: float, tau_h
 
 
 __all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "warm_small_lp", "lp_null_test",
-           "dual_certificate", "lp_earliest", "min_norm", "static_distance", "quadratic_null_test",
-           "quadratic_first_time", "halfspace_null_test"]
+           "dual_certificate", "lp_earliest", "min_norm", "min_norm_reference", "static_distance",
+           "quadratic_null_test", "quadratic_first_time", "quadratic_first_time_bisection",
+           "halfspace_null_test"]

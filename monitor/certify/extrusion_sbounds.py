@@ -198,8 +198,8 @@ def _max_change(old: np.ndarray, new: np.ndarray, alive: np.ndarray) -> float:
 def swept_box(lo: np.ndarray, hi: np.ndarray, v: np.ndarray, ta: float, tb: float
               ) -> tuple[np.ndarray, np.ndarray]:
     """Static AABB of a box (at tau = 0, moving with v) over ``tau in [ta, tb]``."""
-    e = np.stack([v * ta, v * tb])
-    return lo + e.min(axis=0), hi + e.max(axis=0)
+    ea, eb = v * ta, v * tb
+    return lo + np.minimum(ea, eb), hi + np.maximum(ea, eb)
 
 
 __all__ = ["RootBound", "root_operator", "join", "PairSBounds", "pair_sbounds", "swept_box"]
