@@ -46,6 +46,7 @@ This module imports mujoco and monitor only (no gymnasium, no mcap).
 
 from __future__ import annotations
 
+import copy
 import logging
 import math
 import os
@@ -435,6 +436,18 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
 
 
 # --------------------------------------------------------------------------- the gate
+def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> Certificate:
+    """``cert`` (certified over ``span``) as the certificate of the sub-window ``window``.
+
+    A shallow copy (the pair results, possibly not built yet, are shared); ``window`` and
+    ``stats`` are its own.
+    """
+    out = copy.copy(cert)
+    object.__setattr__(out, "window", window)
+    object.__setattr__(out, "stats", {**cert.stats, "joint_window": span})
+    return out
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -645,6 +658,8 @@ class Gate:
         self.brake_steps = max(1, int(math.ceil(float(brake_horizon) / model.opt.timestep)))
         self.brake_vel_tol = float(brake_vel_tol)
         self._committed: np.ndarray | None = None
+        self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
+        self._joint_hint = True  # try the joint window + tail call (see decide)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
@@ -660,7 +675,7 @@ class Gate:
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0, "committed": 0}
+                      "reused_pairs": 0, "pairs": 0, "committed": 0, "joint": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -771,6 +786,57 @@ class Gate:
         self.stats["reused_pairs"] += len(reused)
         self.stats["pairs"] += len(cert.pairs)
         return cert, us
+
+    def _certify_joint(self, plan: Any, tail: Any) -> tuple[Certificate, Certificate, float] | None:
+        """Certify the window and its braking tail with ONE call; None unless that settles both.
+
+        The joint plan is the window's waypoints followed by the tail's (the tail starts at
+        the window's last waypoint, checked bit for bit: time, qpos, mocap). Both plans
+        interpolate piecewise between consecutive waypoints, so the joint plan's motion on
+        [t0, t1] is the window's and on [t1, t_end] the tail's, exactly.
+
+        When is one call as strong as two? A certificate of the joint plan bounds the
+        clearance over [t0, t_end], hence over each part. Under ``ongoing="violation"`` that
+        is all. Under ``ongoing="deepen"`` a pair judged by the ongoing-contact rule would be
+        judged against its depth at t0, while the separate tail call judges it against its
+        depth at the window's end t1 (and a pair clear at t1 keeps the full margin there):
+        the joint call could be weaker. So the joint result is used only when it is
+        ``certified`` and no freshly certified pair went through the rule
+        (``stats["ongoing"]`` absent or 0): then every fresh pair has clearance > margin over
+        [t0, t_end], which the two separate calls would accept under either rule (the rule
+        only re-judges pairs the plain check did not certify). Pairs answered from the reuse
+        cache are fixed over the whole joint window at unchanged poses, so their result is
+        the same for the window, the tail and the joint plan.
+
+        Anything else (uncertain, violation, an ongoing contact, a plan that does not join)
+        returns None and the caller runs today's two calls, so verdicts, witnesses and the
+        brake verdict of those windows are exactly today's.
+
+        Returns:
+            (window certificate, tail certificate, µs) or None. The two certificates are the
+            joint one with ``window`` set to the part's span (its clearance, a lower bound
+            over [t0, t_end], bounds each part too) and ``stats["joint_window"] = [t0, t_end]``.
+        """
+        from monitor.motion.plan import Plan
+
+        t_w, q_w = plan.times, plan.qpos
+        t_b, q_b = tail.times, tail.qpos
+        if (t_w[-1] != t_b[0] or not np.array_equal(q_w[-1], q_b[0])
+                or not np.array_equal(plan._mocap_pos, tail._mocap_pos)
+                or not np.array_equal(plan._mocap_quat, tail._mocap_quat)):
+            return None
+        if len(t_b) < 2:
+            return None
+        joint = Plan._trusted(np.concatenate((t_w, t_b[1:])), np.concatenate((q_w, q_b[1:])),
+                              model=self.model, mocap_pos=plan._mocap_pos.copy(),
+                              mocap_quat=plan._mocap_quat.copy(), tolerances=plan._tol)
+        cert, us = self._certify(joint)
+        if not cert.certified or cert.stats.get("ongoing", 0):
+            return None
+        self.stats["joint"] += 1
+        t0, t1, t_end = float(t_w[0]), float(t_w[-1]), float(t_b[-1])
+        span = [t0, t_end]
+        return _part(cert, (t0, t1), span), _part(cert, (t1, t_end), span), us
 
     def _split_reuse(self, scene: Any, plan: Any) -> tuple[list[int] | None, dict[int, PairResult],
                                                              dict[int, bytes]]:
@@ -944,6 +1010,7 @@ class Gate:
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
+        own_predictor = predict is None and not callable(self.predictor)  # the rollout's window
         if predict is None:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
@@ -951,22 +1018,44 @@ class Gate:
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             self.reference_qpos = np.array(data.qpos)
         plan = predict(ctrl)
-        cert, us = self._certify(plan)
-        unsafe = self.is_unsafe(cert.verdict)
-        brake_verdict, brake_next = "", None
-        if not unsafe and self._brake_active(fallback) and not self.scene.candidate_pairs:
-            # No candidate pairs: every window (the tail's too) certifies trivially and
-            # no proposal can ever be rejected, so the tail and its brake are never used.
-            brake_verdict = "certified"
-        elif not unsafe and self._brake_active(fallback):
+        brake_on = self._brake_active(fallback)
+        tail = joint = None
+        if (brake_on and self._joint_tail and self._joint_hint and own_predictor
+                and self.scene.candidate_pairs):
+            # Common path: window + braking tail certified by ONE call (see _certify_joint).
             tail, brake_next, tail_qvel = self._rollout.brake_tail(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
-            tail_cert, tail_us = self._certify(tail)
-            us += tail_us
-            brake_verdict = tail_cert.verdict
-            if self.is_unsafe(brake_verdict):
-                unsafe = True
-                self.stats["brake_rejected"] += 1
+            joint = self._certify_joint(plan, tail)
+        if joint is not None:
+            cert, tail_cert, us = joint
+            unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
+        else:  # today's two calls (also after a joint call that did not certify)
+            cert, us = self._certify(plan)
+            unsafe = self.is_unsafe(cert.verdict)
+            brake_verdict = ""
+            if tail is None:
+                brake_next = None
+            if not unsafe and brake_on and not self.scene.candidate_pairs:
+                # No candidate pairs: every window (the tail's too) certifies trivially and
+                # no proposal can ever be rejected, so the tail and its brake are never used.
+                brake_verdict = "certified"
+            elif not unsafe and brake_on:
+                if tail is None:
+                    tail, brake_next, tail_qvel = self._rollout.brake_tail(
+                        data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
+                        self.brake_vel_tol)
+                tail_cert, tail_us = self._certify(tail)
+                us += tail_us
+                brake_verdict = tail_cert.verdict
+                if self.is_unsafe(brake_verdict):
+                    unsafe = True
+                    self.stats["brake_rejected"] += 1
+            # Try the joint call next step only when this step's two calls would have allowed it
+            # (both certified, no ongoing contact): a streak of rejected or in-contact windows
+            # then costs two calls per step, not three.
+            self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
+                                    and tail is not None and brake_verdict == "certified"
+                                    and not tail_cert.stats.get("ongoing", 0))
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
