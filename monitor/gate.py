@@ -942,6 +942,7 @@ class Gate:
         """Forget the committed brake; the log starts a new episode (call when the state is reset)."""
         self._committed = None
         self._tail = None
+        self._joint_hint = True  # a step's reports depend on its episode only, not on the last one
         if self._log is not None and not getattr(self._log, "closed", False):
             new_episode = getattr(self._log, "new_episode", None)
             if callable(new_episode):
