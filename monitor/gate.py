@@ -118,6 +118,8 @@ class Rollout:
         self._end_state = np.empty(size)
         self._key_ctrl = np.empty(model.nu)
         self._key_nstep = 0  # 0: the scratch holds no complete window
+        self.window_rows: np.ndarray | None = None
+        """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
@@ -168,6 +170,8 @@ class Rollout:
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
+        rows[:, 1:] = qpos
+        self.window_rows = rows  # (time, qpos) rows exactly as returned (the Plan normalises its copy)
         return times, qpos
 
     def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
@@ -220,6 +224,21 @@ class Rollout:
         """
         from monitor.motion.plan import Plan
 
+        rows, brake = self.brake_rows(data, ctrl, nstep, brake_fn, max_steps, vel_tol)
+        nq = self.model.nq
+        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=self.model,
+                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
+        return plan, brake, rows[:, 1 + nq:].copy()
+
+    def brake_rows(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
+                   brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
+                   vel_tol: float) -> tuple[np.ndarray, np.ndarray]:
+        """The braking tail of :meth:`brake_tail` as raw rows, without building its Plan.
+
+        Returns:
+            rows (K, 1 + nq + nv): time, qpos, qvel at the tail's waypoints (the first is the
+            window's end), and the brake control (nu,).
+        """
         m = self.model
         if not self.window_matches(data, ctrl, nstep):
             self.states(data, ctrl, nstep)
@@ -257,10 +276,7 @@ class Rollout:
                 end = k + 1 + int(stop[0])
                 break
             k = hi
-        rows = rows[:end + 1]
-        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=m,
-                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
-        return plan, brake, rows[:, 1 + nq:].copy()
+        return rows[:end + 1], brake
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
@@ -436,6 +452,36 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
 
 
 # --------------------------------------------------------------------------- the gate
+class _Tail:
+    """A braking tail's rows (from :meth:`Rollout.brake_rows`); its Plan is built on first use.
+
+    The joint call certifies the tail without its own Plan; only the two-call path and
+    :meth:`Gate._tail_covers` (a later rejected proposal) read :attr:`plan`, the same Plan
+    :meth:`Rollout.brake_tail` builds (same rows, mocap copied from the live data).
+    """
+
+    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan")
+
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        nq = model.nq
+        self.rows = rows[:, :1 + nq]  # (K, 1 + nq) time, qpos
+        self.qvel = rows[:, 1 + nq:].copy()  # (K, nv)
+        self.mocap_pos = np.array(data.mocap_pos)  # held over the window and the tail
+        self.mocap_quat = np.array(data.mocap_quat)
+        self._model = model
+        self._plan: Any = None
+
+    @property
+    def plan(self) -> Any:
+        """The tail's :class:`monitor.Plan`."""
+        if self._plan is None:
+            from monitor.motion.plan import Plan
+
+            self._plan = Plan._trusted(self.rows[:, 0].copy(), self.rows[:, 1:].copy(), model=self._model,
+                                       mocap_pos=self.mocap_pos.copy(), mocap_quat=self.mocap_quat.copy())
+        return self._plan
+
+
 def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> Certificate:
     """``cert`` (certified over ``span``) as the certificate of the sub-window ``window``.
 
@@ -787,13 +833,25 @@ class Gate:
         self.stats["pairs"] += len(cert.pairs)
         return cert, us
 
-    def _certify_joint(self, plan: Any, tail: Any) -> tuple[Certificate, Certificate, float] | None:
+    def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,
+                       mocap_pos: np.ndarray, mocap_quat: np.ndarray
+                       ) -> tuple[Certificate, Certificate, float] | None:
         """Certify the window and its braking tail with ONE call; None unless that settles both.
 
-        The joint plan is the window's waypoints followed by the tail's (the tail starts at
-        the window's last waypoint, checked bit for bit: time, qpos, mocap). Both plans
-        interpolate piecewise between consecutive waypoints, so the joint plan's motion on
-        [t0, t1] is the window's and on [t1, t_end] the tail's, exactly.
+        Args:
+            plan: the window's Plan, built from ``window_rows``.
+            window_rows: (n + 1, 1 + nq) rows (time, qpos) ``plan`` was built from
+                (:attr:`Rollout.window_rows`), or None.
+            tail_rows: (K, 1 + nq) rows (time, qpos) of the braking tail (the tail's Plan would
+                be built from them).
+            mocap_pos, mocap_quat: (nmocap, 3), (nmocap, 4) mocap poses held over both parts (the
+                live data's, as both parts' Plans got them).
+
+        The joint plan is built from the window's rows followed by the tail's (the tail starts
+        at the window's last row, checked bit for bit), so each waypoint is normalised exactly
+        as in the window's or the tail's own Plan. Plans interpolate piecewise between
+        consecutive waypoints, so the joint plan's motion on [t0, t1] is the window's and on
+        [t1, t_end] the tail's, exactly.
 
         When is one call as strong as two? A certificate of the joint plan bounds the
         clearance over [t0, t_end], hence over each part. Under ``ongoing="violation"`` that
@@ -819,22 +877,18 @@ class Gate:
         """
         from monitor.motion.plan import Plan
 
-        t_w, q_w = plan.times, plan.qpos
-        t_b, q_b = tail.times, tail.qpos
-        if (t_w[-1] != t_b[0] or not np.array_equal(q_w[-1], q_b[0])
-                or not np.array_equal(plan._mocap_pos, tail._mocap_pos)
-                or not np.array_equal(plan._mocap_quat, tail._mocap_quat)):
+        if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
+                or not np.array_equal(window_rows[:, 0], plan.times)
+                or not np.array_equal(window_rows[-1], tail_rows[0])):
             return None
-        if len(t_b) < 2:
-            return None
-        joint = Plan._trusted(np.concatenate((t_w, t_b[1:])), np.concatenate((q_w, q_b[1:])),
-                              model=self.model, mocap_pos=plan._mocap_pos.copy(),
-                              mocap_quat=plan._mocap_quat.copy(), tolerances=plan._tol)
+        rows = np.concatenate((window_rows, tail_rows[1:]))
+        joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
+                              mocap_pos=mocap_pos.copy(), mocap_quat=mocap_quat.copy())
         cert, us = self._certify(joint)
         if not cert.certified or cert.stats.get("ongoing", 0):
             return None
         self.stats["joint"] += 1
-        t0, t1, t_end = float(t_w[0]), float(t_w[-1]), float(t_b[-1])
+        t0, t1, t_end = float(rows[0, 0]), float(tail_rows[0, 0]), float(rows[-1, 0])
         span = [t0, t_end]
         return _part(cert, (t0, t1), span), _part(cert, (t1, t_end), span), us
 
@@ -960,6 +1014,8 @@ class Gate:
         if self._tail is None or self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
         plan, cert, qvel = self._tail
+        if isinstance(plan, _Tail):
+            plan = plan.plan  # built now, on the rare path that reads it
         if not cert.certified:
             return None
         hits = np.flatnonzero(plan.times == data.time)
@@ -1024,9 +1080,12 @@ class Gate:
         if (brake_on and self._joint_tail and self._joint_hint and own_predictor
                 and self.scene.candidate_pairs):
             # Common path: window + braking tail certified by ONE call (see _certify_joint).
-            tail, brake_next, tail_qvel = self._rollout.brake_tail(
+            rows, brake_next = self._rollout.brake_rows(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
-            joint = self._certify_joint(plan, tail)
+            tail = _Tail(rows, self.model, data)
+            tail_qvel = tail.qvel
+            joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
+                                        tail.mocap_quat)
         if joint is not None:
             cert, tail_cert, us = joint
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
@@ -1045,6 +1104,8 @@ class Gate:
                     tail, brake_next, tail_qvel = self._rollout.brake_tail(
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
+                else:  # simulated for the joint call
+                    tail = tail.plan
                 tail_cert, tail_us = self._certify(tail)
                 us += tail_us
                 brake_verdict = tail_cert.verdict

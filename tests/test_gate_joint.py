@@ -115,6 +115,11 @@ def _slider_plans(gaps_window, gaps_tail):
     return m, Plan(tw, x(gaps_window), m), Plan(tb, x(gaps_tail), m)
 
 
+def _joint(gate, plan, tail):
+    return gate._certify_joint(plan, np.c_[plan.times, plan.qpos], np.c_[tail.times, tail.qpos],
+                               plan.mocap_pos, plan.mocap_quat)
+
+
 def test_joint_call_refuses_an_ongoing_contact_judged_at_the_window_start():
     # Within the margin at t0 (ongoing, may not close by more than penetration_tol), clear at
     # t1, then the tail comes back to 4 cm < margin. The tail alone (clear at its start, so the
@@ -125,7 +130,7 @@ def test_joint_call_refuses_an_ongoing_contact_judged_at_the_window_start():
                                           np.r_[plan.qpos, tail.qpos[1:]], m))[0]
     assert joint_cert.certified and joint_cert.stats.get("ongoing", 0) == 1  # the weaker joint answer
     assert gate._certify(tail)[0].verdict == "violation"  # what two calls say
-    assert gate._certify_joint(plan, tail) is None  # so the gate falls back to two calls
+    assert _joint(gate, plan, tail) is None  # so the gate falls back to two calls
     assert gate.stats["joint"] == 0
 
 
@@ -133,7 +138,7 @@ def test_joint_call_settles_both_parts_when_every_pair_keeps_the_margin():
     m, plan, tail = _slider_plans([0.03, 0.1], [0.1, 0.04])
     for ongoing in ("deepen", "violation"):
         gate = Gate(m, pairs="all", allowed=None, margin=0.02, ongoing=ongoing)
-        out = gate._certify_joint(plan, tail)
+        out = _joint(gate, plan, tail)
         assert out is not None
         w, b, _ = out
         assert w.certified and b.certified
@@ -142,8 +147,8 @@ def test_joint_call_settles_both_parts_when_every_pair_keeps_the_margin():
         assert 0.02 < w.clearance <= 0.03 + 1e-9  # a lower bound over both parts
     # a part that does not start where the window ends is never joined
     m, plan, tail = _slider_plans([0.03, 0.1], [0.09, 0.04])
-    assert Gate(m, pairs="all", allowed=None, margin=0.02)._certify_joint(plan, tail) is None
+    assert _joint(Gate(m, pairs="all", allowed=None, margin=0.02), plan, tail) is None
     # nor a tail that violates the margin (the joint call is not certified)
     m, plan, tail = _slider_plans([0.03, 0.1], [0.1, 0.01])
     gate = Gate(m, pairs="all", allowed=None, margin=0.02)
-    assert gate._certify_joint(plan, tail) is None and gate.stats["joint"] == 0
+    assert _joint(gate, plan, tail) is None and gate.stats["joint"] == 0
