@@ -54,7 +54,7 @@ import time
 import warnings
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -326,6 +326,63 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- reports
+class _WindowRows:
+    """The rollout's window (times, qpos from :meth:`Rollout.states`); its Plan built on first use.
+
+    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (same arrays, the live data's mocap
+    copied when the window was predicted). The joint call certifies the window without it;
+    the two-call path, a log and :attr:`StepReport.plan` build it.
+    """
+
+    __slots__ = ("times", "_qpos", "_model", "_mocap_pos", "_mocap_quat", "_plan")
+
+    def __init__(self, times: np.ndarray, qpos: np.ndarray, model: mujoco.MjModel,
+                 data: mujoco.MjData) -> None:
+        self.times = times  # (K,) s
+        self._qpos = qpos  # (K, nq), owned (the Plan normalises it in place)
+        self._model = model
+        self._mocap_pos = np.array(data.mocap_pos)
+        self._mocap_quat = np.array(data.mocap_quat)
+        self._plan: Any = None
+
+    @property
+    def plan(self) -> Any:
+        """The window's :class:`monitor.Plan`."""
+        if self._plan is None:
+            from monitor.motion.plan import Plan
+
+            self._plan = Plan._trusted(self.times, self._qpos, model=self._model, mocap_pos=self._mocap_pos,
+                                       mocap_quat=self._mocap_quat)
+        return self._plan
+
+
+def _plan_of(p: Any) -> Any:
+    """A Plan from a Plan or a :class:`_WindowRows`."""
+    return p.plan if isinstance(p, _WindowRows) else p
+
+
+class _LazyPlanField:
+    """Descriptor of :attr:`StepReport.plan`: a :class:`_WindowRows` becomes its Plan on first read.
+
+    The Plan is then kept. The dataclass sees a field with default None;
+    ``report.plan = x`` still raises ``FrozenInstanceError``.
+    """
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._slot = f"_{name}_store"
+
+    def __get__(self, obj: Any, objtype: type | None = None) -> Any:
+        if obj is None:
+            return None
+        v = obj.__dict__.get(self._slot)
+        if isinstance(v, _WindowRows):
+            v = obj.__dict__[self._slot] = v.plan
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self._slot] = value
+
+
 @dataclass(frozen=True)
 class StepReport:
     """What the gate decided for one window.
@@ -364,7 +421,7 @@ class StepReport:
     fallback_certified: bool
     certify_us: float
     time: float
-    plan: Any = None
+    plan: Any = _LazyPlanField()  # type: ignore[assignment]  # a Plan (built on first read)
     stepped: bool = False
     brake_verdict: str = ""
 
@@ -1074,7 +1131,10 @@ class Gate:
         t_win = float(data.time)
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             self.reference_qpos = np.array(data.qpos)
-        plan = predict(ctrl)
+        if own_predictor:  # the rollout's window; its Plan is built only when something reads it
+            plan: Any = _WindowRows(*self._rollout.states(data, ctrl, n), self.model, data)
+        else:
+            plan = predict(ctrl)
         brake_on = self._brake_active(fallback)
         tail = joint = None
         if (brake_on and self._joint_tail and self._joint_hint and own_predictor
@@ -1090,7 +1150,7 @@ class Gate:
             cert, tail_cert, us = joint
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
         else:  # today's two calls (also after a joint call that did not certify)
-            cert, us = self._certify(plan)
+            cert, us = self._certify(_plan_of(plan))
             unsafe = self.is_unsafe(cert.verdict)
             brake_verdict = ""
             if tail is None:
@@ -1194,7 +1254,8 @@ class Gate:
         else:
             data.ctrl[:] = report.applied_ctrl
             mujoco.mj_step(self.model, data, nstep=n)
-        report = replace(report, stepped=True)
+        report = copy.copy(report)  # as dataclasses.replace(report, stepped=True), without building the plan
+        object.__setattr__(report, "stepped", True)
         self.last_report = report
         return report
 

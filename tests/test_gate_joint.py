@@ -152,3 +152,28 @@ def test_joint_call_settles_both_parts_when_every_pair_keeps_the_margin():
     m, plan, tail = _slider_plans([0.03, 0.1], [0.1, 0.01])
     gate = Gate(m, pairs="all", allowed=None, margin=0.02)
     assert _joint(gate, plan, tail) is None and gate.stats["joint"] == 0
+
+
+def test_report_plan_is_the_rollout_plan_built_on_first_read():
+    import dataclasses
+
+    from monitor.motion.plan import Plan
+
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    ref = Gate(m).predict(d, np.array([2.0]))  # Rollout.plan of the same window
+    gate = Gate(m)
+    r = gate.decide(d, np.array([2.0]))
+    assert gate.stats["joint"] == 1
+    assert "_plan_store" in r.__dict__ and not isinstance(r.__dict__["_plan_store"], Plan)  # not built yet
+    p = r.plan
+    assert isinstance(p, Plan) and r.plan is p  # built once, then kept
+    assert np.array_equal(p.times, ref.times) and np.array_equal(p.qpos, ref.qpos)
+    assert np.array_equal(p.mocap_pos, ref.mocap_pos) and np.array_equal(p.mocap_quat, ref.mocap_quat)
+    assert dataclasses.replace(r, stepped=True).plan is p
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.plan = None
+    # Gate.step's report carries the same lazily built plan
+    r2 = gate.step(d, np.array([2.0]))
+    assert r2.stepped and isinstance(r2.plan, Plan) and r2.plan.t0 == r.time
