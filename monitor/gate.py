@@ -271,9 +271,9 @@ class Rollout:
             if m.nv == 0:
                 end = k + 1
                 break
-            stop = np.flatnonzero(np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol)
-            if stop.size:
-                end = k + 1 + int(stop[0])
+            stop = np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol
+            if stop.any():
+                end = k + 1 + int(stop.argmax())  # the first substep that passes
                 break
             k = hi
         return rows[:end + 1], brake
