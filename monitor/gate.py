@@ -76,7 +76,7 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
 _WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
-_TAIL_CHUNK = 8  # braking-tail substeps between two (vectorised) stop tests
+_TAIL_CHUNK = 32  # longest run of braking-tail substeps between two (vectorised) stop tests
 
 
 # --------------------------------------------------------------------------- predictors
@@ -253,7 +253,7 @@ class Rollout:
         nq = m.nq
         # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
         # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
-        # 1, 2, 4, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
+        # 1, 2, 4, 8, 16, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
         # tail ends at the first substep that passes it, exactly as a per-substep test
         # would (substeps simulated beyond it in the same chunk only touch the private
         # scratch).
