@@ -1124,7 +1124,9 @@ class Gate:
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
-        own_predictor = predict is None and not callable(self.predictor)  # the rollout's window
+        # the rollout's window (not a callable predictor, an adapter's, or an overridden Gate.predict)
+        own_predictor = (predict is None and not callable(self.predictor)
+                         and type(self).predict is Gate.predict)
         if predict is None:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)

@@ -177,3 +177,25 @@ def test_report_plan_is_the_rollout_plan_built_on_first_read():
     # Gate.step's report carries the same lazily built plan
     r2 = gate.step(d, np.array([2.0]))
     assert r2.stepped and isinstance(r2.plan, Plan) and r2.plan.t0 == r.time
+
+
+def test_a_custom_predictor_is_used_and_never_joined():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    calls = []
+
+    class Mine(Gate):
+        def predict(self, data, ctrl, nstep=None):
+            calls.append(nstep)
+            return super().predict(data, ctrl, nstep)
+
+    def pred(data, ctrl, nstep):
+        calls.append(-nstep)
+        return Gate(m).predict(data, ctrl, nstep)
+
+    for gate in (Mine(m), Gate(m, predictor=pred)):
+        d = mujoco.MjData(m)
+        mujoco.mj_resetDataKeyframe(m, d, 0)
+        calls.clear()
+        r = gate.decide(d, np.array([2.0]))
+        assert calls and r.verdict == "certified" and r.brake_verdict == "certified"
+        assert gate.stats["joint"] == 0  # its window may not be the rollout's: two calls
