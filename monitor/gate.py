@@ -46,6 +46,7 @@ This module imports mujoco and monitor only (no gymnasium, no mcap).
 
 from __future__ import annotations
 
+import copy
 import logging
 import math
 import os
@@ -53,7 +54,7 @@ import time
 import warnings
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -75,7 +76,7 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
 _WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
-_TAIL_CHUNK = 8  # braking-tail substeps between two (vectorised) stop tests
+_TAIL_CHUNK = 32  # longest run of braking-tail substeps between two (vectorised) stop tests
 
 
 # --------------------------------------------------------------------------- predictors
@@ -117,6 +118,8 @@ class Rollout:
         self._end_state = np.empty(size)
         self._key_ctrl = np.empty(model.nu)
         self._key_nstep = 0  # 0: the scratch holds no complete window
+        self.window_rows: np.ndarray | None = None
+        """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
@@ -167,6 +170,8 @@ class Rollout:
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
+        rows[:, 1:] = qpos
+        self.window_rows = rows  # (time, qpos) rows exactly as returned (the Plan normalises its copy)
         return times, qpos
 
     def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
@@ -219,6 +224,21 @@ class Rollout:
         """
         from monitor.motion.plan import Plan
 
+        rows, brake = self.brake_rows(data, ctrl, nstep, brake_fn, max_steps, vel_tol)
+        nq = self.model.nq
+        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=self.model,
+                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
+        return plan, brake, rows[:, 1 + nq:].copy()
+
+    def brake_rows(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
+                   brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
+                   vel_tol: float) -> tuple[np.ndarray, np.ndarray]:
+        """The braking tail of :meth:`brake_tail` as raw rows, without building its Plan.
+
+        Returns:
+            rows (K, 1 + nq + nv): time, qpos, qvel at the tail's waypoints (the first is the
+            window's end), and the brake control (nu,).
+        """
         m = self.model
         if not self.window_matches(data, ctrl, nstep):
             self.states(data, ctrl, nstep)
@@ -233,7 +253,7 @@ class Rollout:
         nq = m.nq
         # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
         # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
-        # 1, 2, 4, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
+        # 1, 2, 4, 8, 16, then _TAIL_CHUNK: a tail at rest stops after one substep as before); the
         # tail ends at the first substep that passes it, exactly as a per-substep test
         # would (substeps simulated beyond it in the same chunk only touch the private
         # scratch).
@@ -251,15 +271,12 @@ class Rollout:
             if m.nv == 0:
                 end = k + 1
                 break
-            stop = np.flatnonzero(np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol)
-            if stop.size:
-                end = k + 1 + int(stop[0])
+            stop = np.abs(rows[k + 1:hi + 1, 1 + nq:]).max(axis=1) <= vel_tol
+            if stop.any():
+                end = k + 1 + int(stop.argmax())  # the first substep that passes
                 break
             k = hi
-        rows = rows[:end + 1]
-        plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:1 + nq].copy(), model=m,
-                             mocap_pos=np.array(data.mocap_pos), mocap_quat=np.array(data.mocap_quat))
-        return plan, brake, rows[:, 1 + nq:].copy()
+        return rows[:end + 1], brake
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
@@ -309,6 +326,63 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- reports
+class _WindowRows:
+    """The rollout's window (times, qpos from :meth:`Rollout.states`); its Plan built on first use.
+
+    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (same arrays, the live data's mocap
+    copied when the window was predicted). The joint call certifies the window without it;
+    the two-call path, a log and :attr:`StepReport.plan` build it.
+    """
+
+    __slots__ = ("times", "_qpos", "_model", "_mocap_pos", "_mocap_quat", "_plan")
+
+    def __init__(self, times: np.ndarray, qpos: np.ndarray, model: mujoco.MjModel,
+                 data: mujoco.MjData) -> None:
+        self.times = times  # (K,) s
+        self._qpos = qpos  # (K, nq), owned (the Plan normalises it in place)
+        self._model = model
+        self._mocap_pos = np.array(data.mocap_pos)
+        self._mocap_quat = np.array(data.mocap_quat)
+        self._plan: Any = None
+
+    @property
+    def plan(self) -> Any:
+        """The window's :class:`monitor.Plan`."""
+        if self._plan is None:
+            from monitor.motion.plan import Plan
+
+            self._plan = Plan._trusted(self.times, self._qpos, model=self._model, mocap_pos=self._mocap_pos,
+                                       mocap_quat=self._mocap_quat)
+        return self._plan
+
+
+def _plan_of(p: Any) -> Any:
+    """A Plan from a Plan or a :class:`_WindowRows`."""
+    return p.plan if isinstance(p, _WindowRows) else p
+
+
+class _LazyPlanField:
+    """Descriptor of :attr:`StepReport.plan`: a :class:`_WindowRows` becomes its Plan on first read.
+
+    The Plan is then kept. The dataclass sees a field with default None;
+    ``report.plan = x`` still raises ``FrozenInstanceError``.
+    """
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._slot = f"_{name}_store"
+
+    def __get__(self, obj: Any, objtype: type | None = None) -> Any:
+        if obj is None:
+            return None
+        v = obj.__dict__.get(self._slot)
+        if isinstance(v, _WindowRows):
+            v = obj.__dict__[self._slot] = v.plan
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self._slot] = value
+
+
 @dataclass(frozen=True)
 class StepReport:
     """What the gate decided for one window.
@@ -347,7 +421,7 @@ class StepReport:
     fallback_certified: bool
     certify_us: float
     time: float
-    plan: Any = None
+    plan: Any = _LazyPlanField()  # type: ignore[assignment]  # a Plan (built on first read)
     stepped: bool = False
     brake_verdict: str = ""
 
@@ -435,6 +509,48 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
 
 
 # --------------------------------------------------------------------------- the gate
+class _Tail:
+    """A braking tail's rows (from :meth:`Rollout.brake_rows`); its Plan is built on first use.
+
+    The joint call certifies the tail without its own Plan; only the two-call path and
+    :meth:`Gate._tail_covers` (a later rejected proposal) read :attr:`plan`, the same Plan
+    :meth:`Rollout.brake_tail` builds (same rows, mocap copied from the live data).
+    """
+
+    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan")
+
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        nq = model.nq
+        self.rows = rows[:, :1 + nq]  # (K, 1 + nq) time, qpos
+        self.qvel = rows[:, 1 + nq:].copy()  # (K, nv)
+        self.mocap_pos = np.array(data.mocap_pos)  # held over the window and the tail
+        self.mocap_quat = np.array(data.mocap_quat)
+        self._model = model
+        self._plan: Any = None
+
+    @property
+    def plan(self) -> Any:
+        """The tail's :class:`monitor.Plan`."""
+        if self._plan is None:
+            from monitor.motion.plan import Plan
+
+            self._plan = Plan._trusted(self.rows[:, 0].copy(), self.rows[:, 1:].copy(), model=self._model,
+                                       mocap_pos=self.mocap_pos.copy(), mocap_quat=self.mocap_quat.copy())
+        return self._plan
+
+
+def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> Certificate:
+    """``cert`` (certified over ``span``) as the certificate of the sub-window ``window``.
+
+    A shallow copy (the pair results, possibly not built yet, are shared); ``window`` and
+    ``stats`` are its own.
+    """
+    out = copy.copy(cert)
+    object.__setattr__(out, "window", window)
+    object.__setattr__(out, "stats", {**cert.stats, "joint_window": span})
+    return out
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -645,6 +761,8 @@ class Gate:
         self.brake_steps = max(1, int(math.ceil(float(brake_horizon) / model.opt.timestep)))
         self.brake_vel_tol = float(brake_vel_tol)
         self._committed: np.ndarray | None = None
+        self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
+        self._joint_hint = True  # try the joint window + tail call (see decide)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
@@ -660,7 +778,7 @@ class Gate:
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0, "committed": 0}
+                      "reused_pairs": 0, "pairs": 0, "committed": 0, "joint": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -772,6 +890,65 @@ class Gate:
         self.stats["pairs"] += len(cert.pairs)
         return cert, us
 
+    def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,
+                       mocap_pos: np.ndarray, mocap_quat: np.ndarray
+                       ) -> tuple[Certificate, Certificate, float] | None:
+        """Certify the window and its braking tail with ONE call; None unless that settles both.
+
+        Args:
+            plan: the window's Plan, built from ``window_rows``.
+            window_rows: (n + 1, 1 + nq) rows (time, qpos) ``plan`` was built from
+                (:attr:`Rollout.window_rows`), or None.
+            tail_rows: (K, 1 + nq) rows (time, qpos) of the braking tail (the tail's Plan would
+                be built from them).
+            mocap_pos, mocap_quat: (nmocap, 3), (nmocap, 4) mocap poses held over both parts (the
+                live data's, as both parts' Plans got them).
+
+        The joint plan is built from the window's rows followed by the tail's (the tail starts
+        at the window's last row, checked bit for bit), so each waypoint is normalised exactly
+        as in the window's or the tail's own Plan. Plans interpolate piecewise between
+        consecutive waypoints, so the joint plan's motion on [t0, t1] is the window's and on
+        [t1, t_end] the tail's, exactly.
+
+        When is one call as strong as two? A certificate of the joint plan bounds the
+        clearance over [t0, t_end], hence over each part. Under ``ongoing="violation"`` that
+        is all. Under ``ongoing="deepen"`` a pair judged by the ongoing-contact rule would be
+        judged against its depth at t0, while the separate tail call judges it against its
+        depth at the window's end t1 (and a pair clear at t1 keeps the full margin there):
+        the joint call could be weaker. So the joint result is used only when it is
+        ``certified`` and no freshly certified pair went through the rule
+        (``stats["ongoing"]`` absent or 0): then every fresh pair has clearance > margin over
+        [t0, t_end], which the two separate calls would accept under either rule (the rule
+        only re-judges pairs the plain check did not certify). Pairs answered from the reuse
+        cache are fixed over the whole joint window at unchanged poses, so their result is
+        the same for the window, the tail and the joint plan.
+
+        Anything else (uncertain, violation, an ongoing contact, a plan that does not join)
+        returns None and the caller runs today's two calls, so verdicts, witnesses and the
+        brake verdict of those windows are exactly today's.
+
+        Returns:
+            (window certificate, tail certificate, µs) or None. The two certificates are the
+            joint one with ``window`` set to the part's span (its clearance, a lower bound
+            over [t0, t_end], bounds each part too) and ``stats["joint_window"] = [t0, t_end]``.
+        """
+        from monitor.motion.plan import Plan
+
+        if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
+                or not np.array_equal(window_rows[:, 0], plan.times)
+                or not np.array_equal(window_rows[-1], tail_rows[0])):
+            return None
+        rows = np.concatenate((window_rows, tail_rows[1:]))
+        joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
+                              mocap_pos=mocap_pos.copy(), mocap_quat=mocap_quat.copy())
+        cert, us = self._certify(joint)
+        if not cert.certified or cert.stats.get("ongoing", 0):
+            return None
+        self.stats["joint"] += 1
+        t0, t1, t_end = float(rows[0, 0]), float(tail_rows[0, 0]), float(rows[-1, 0])
+        span = [t0, t_end]
+        return _part(cert, (t0, t1), span), _part(cert, (t1, t_end), span), us
+
     def _split_reuse(self, scene: Any, plan: Any) -> tuple[list[int] | None, dict[int, PairResult],
                                                              dict[int, bytes]]:
         """Indices of pairs to certify (None = all), reusable results, cache keys of fixed pairs."""
@@ -876,6 +1053,7 @@ class Gate:
         """Forget the committed brake; the log starts a new episode (call when the state is reset)."""
         self._committed = None
         self._tail = None
+        self._joint_hint = True  # a step's reports depend on its episode only, not on the last one
         if self._log is not None and not getattr(self._log, "closed", False):
             new_episode = getattr(self._log, "new_episode", None)
             if callable(new_episode):
@@ -893,6 +1071,8 @@ class Gate:
         if self._tail is None or self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
         plan, cert, qvel = self._tail
+        if isinstance(plan, _Tail):
+            plan = plan.plan  # built now, on the rare path that reads it
         if not cert.certified:
             return None
         hits = np.flatnonzero(plan.times == data.time)
@@ -944,29 +1124,62 @@ class Gate:
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
+        # the rollout's window (not a callable predictor, an adapter's, or an overridden Gate.predict)
+        own_predictor = (predict is None and not callable(self.predictor)
+                         and type(self).predict is Gate.predict)
         if predict is None:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
         t_win = float(data.time)
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             self.reference_qpos = np.array(data.qpos)
-        plan = predict(ctrl)
-        cert, us = self._certify(plan)
-        unsafe = self.is_unsafe(cert.verdict)
-        brake_verdict, brake_next = "", None
-        if not unsafe and self._brake_active(fallback) and not self.scene.candidate_pairs:
-            # No candidate pairs: every window (the tail's too) certifies trivially and
-            # no proposal can ever be rejected, so the tail and its brake are never used.
-            brake_verdict = "certified"
-        elif not unsafe and self._brake_active(fallback):
-            tail, brake_next, tail_qvel = self._rollout.brake_tail(
+        if own_predictor:  # the rollout's window; its Plan is built only when something reads it
+            plan: Any = _WindowRows(*self._rollout.states(data, ctrl, n), self.model, data)
+        else:
+            plan = predict(ctrl)
+        brake_on = self._brake_active(fallback)
+        tail = joint = None
+        if (brake_on and self._joint_tail and self._joint_hint and own_predictor
+                and self.scene.candidate_pairs):
+            # Common path: window + braking tail certified by ONE call (see _certify_joint).
+            rows, brake_next = self._rollout.brake_rows(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
-            tail_cert, tail_us = self._certify(tail)
-            us += tail_us
-            brake_verdict = tail_cert.verdict
-            if self.is_unsafe(brake_verdict):
-                unsafe = True
-                self.stats["brake_rejected"] += 1
+            tail = _Tail(rows, self.model, data)
+            tail_qvel = tail.qvel
+            joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
+                                        tail.mocap_quat)
+        if joint is not None:
+            cert, tail_cert, us = joint
+            unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
+        else:  # today's two calls (also after a joint call that did not certify)
+            cert, us = self._certify(_plan_of(plan))
+            unsafe = self.is_unsafe(cert.verdict)
+            brake_verdict = ""
+            if tail is None:
+                brake_next = None
+            if not unsafe and brake_on and not self.scene.candidate_pairs:
+                # No candidate pairs: every window (the tail's too) certifies trivially and
+                # no proposal can ever be rejected, so the tail and its brake are never used.
+                brake_verdict = "certified"
+            elif not unsafe and brake_on:
+                if tail is None:
+                    tail, brake_next, tail_qvel = self._rollout.brake_tail(
+                        data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
+                        self.brake_vel_tol)
+                else:  # simulated for the joint call
+                    tail = tail.plan
+                tail_cert, tail_us = self._certify(tail)
+                us += tail_us
+                brake_verdict = tail_cert.verdict
+                if self.is_unsafe(brake_verdict):
+                    unsafe = True
+                    self.stats["brake_rejected"] += 1
+            # Try the joint call next step only when this step's two calls would have allowed it
+            # (both certified, no ongoing contact): a streak of rejected or in-contact windows
+            # then costs two calls per step, not three.
+            self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
+                                    and tail is not None and brake_verdict == "certified"
+                                    and not tail_cert.stats.get("ongoing", 0))
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
@@ -1043,7 +1256,8 @@ class Gate:
         else:
             data.ctrl[:] = report.applied_ctrl
             mujoco.mj_step(self.model, data, nstep=n)
-        report = replace(report, stepped=True)
+        report = copy.copy(report)  # as dataclasses.replace(report, stepped=True), without building the plan
+        object.__setattr__(report, "stepped", True)
         self.last_report = report
         return report
 

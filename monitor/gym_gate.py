@@ -117,6 +117,21 @@ def action_wrappers(env: gymnasium.Env) -> list[gymnasium.ActionWrapper]:
     return chain
 
 
+def _steps_like_mujoco_env(u: Any) -> bool:
+    """True when ``u`` simulates with gymnasium's own ``MujocoEnv._step_mujoco_simulation``.
+
+    That method is ``data.ctrl[:] = ctrl; mj_step(model, data, nstep=n); mj_rnePostConstraint``;
+    an env overriding it (or not a ``MujocoEnv``) is never committed into.
+    """
+    try:
+        from gymnasium.envs.mujoco.mujoco_env import MujocoEnv
+    except ImportError:  # pragma: no cover - gymnasium without its mujoco envs
+        return False
+    return (isinstance(u, MujocoEnv)
+            and type(u)._step_mujoco_simulation is MujocoEnv._step_mujoco_simulation
+            and "_step_mujoco_simulation" not in u.__dict__)
+
+
 class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     """Certify-then-step wrapper for MuJoCo gymnasium environments.
 
@@ -215,6 +230,10 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          ongoing=ongoing, penetration_tol=penetration_tol)
         self._unwrapped = u
         self._obs: Any = None
+        self._commit_ok = predictor == "rollout" and _steps_like_mujoco_env(u)
+        self.commit = True
+        """Commit the gate's own integration of the applied window instead of simulating it
+        again when the env steps (see :meth:`_commit_sim`); False: the env always simulates."""
 
     def describe(self) -> str:
         """What the gate monitors (pairs, allowed pairs by reason, ongoing-contact rule)."""
@@ -296,6 +315,27 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             return u.planned_trajectory
         return lambda a: mode(self.env, self._obs, a)
 
+    def _commit_sim(self, ctrl: Any, n_frames: int) -> None:
+        """``MujocoEnv._step_mujoco_simulation`` that reuses the gate's scratch window when it is exact.
+
+        The gate's rollout integrated ``n_frames`` substeps under the certified control from a
+        full copy of the env's ``MjData`` (:meth:`monitor.gate.Rollout.states`). When the env's
+        data still has exactly that integration state and ``ctrl`` is exactly that control
+        (both compared bit for bit by :meth:`monitor.gate.Rollout.commit`), the scratch's end
+        state is copied into the env's data instead of stepping again: the same result as
+        ``data.ctrl[:] = ctrl; mj_step(model, data, nstep=n_frames)`` (``mj_step`` is a
+        deterministic function of the integration state; tested field by field against an
+        ungated env). Then ``mj_rnePostConstraint`` as gymnasium does. Anything else (a
+        window inside the committed braking tail, a changed state, another control or
+        ``n_frames``): gymnasium's own simulation.
+        """
+        u = self._unwrapped
+        if u.model is self.gate.model and self.gate._rollout.commit(u.data, ctrl, int(n_frames)):
+            mujoco.mj_rnePostConstraint(u.model, u.data)
+            self.gate.stats["committed"] += 1
+        else:
+            type(u)._step_mujoco_simulation(u, ctrl, n_frames)
+
     def _check_applied_ctrl(self, applied: Any) -> None:
         """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
         if self.predictor_mode != "rollout":
@@ -341,7 +381,15 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
         report: StepReport = self.gate.decide(self._unwrapped.data, action, predict=self._predict_fn(),
                                               fallback=self._fallback_fn(), cast=self._as_inner)
-        obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
+        u = self._unwrapped
+        hook = self._commit_ok and self.commit and "_step_mujoco_simulation" not in u.__dict__
+        if hook:  # instance attribute: shadows MujocoEnv._step_mujoco_simulation for this call only
+            u._step_mujoco_simulation = self._commit_sim
+        try:
+            obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
+        finally:
+            if hook:
+                del u._step_mujoco_simulation
         self._check_applied_ctrl(report.applied_ctrl)
         self._obs = obs
         info = dict(info)

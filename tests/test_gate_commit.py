@@ -153,3 +153,60 @@ def test_brake_tail_from_the_snapshot_equals_a_fresh_simulation(scene, vel_tol):
         mujoco.mj_step(m, d, nstep=4)
     if vel_tol == 1e3:
         assert lengths == {2}  # stops after the first substep
+
+
+def _gym_against_oracle(env_id, steps, **kw):
+    """SafetyGate (committing its scratch window) vs an ungated env given the applied actions."""
+    import gymnasium as gym
+
+    import monitor.envs  # noqa: F401  (registers monitor/Arm-v0)
+    from monitor.gym_gate import SafetyGate
+
+    env, oracle = SafetyGate(gym.make(env_id), **kw), gym.make(env_id)
+    env.action_space.seed(0)
+    acts = [env.action_space.sample() for _ in range(steps)]
+    o1, _ = env.reset(seed=0)
+    o2, _ = oracle.reset(seed=0)
+    u, uo = env.unwrapped, oracle.unwrapped
+    fields = _compared_fields(u.model, u.data)
+    for k, a in enumerate(acts):
+        o1, r1, te1, tr1, _ = env.step(a)
+        o2, r2, te2, tr2, _ = oracle.step(env.gate.last_report.applied_ctrl)
+        assert np.array_equal(o1, o2) and r1 == r2 and (te1, tr1) == (te2, tr2), f"step {k}"
+        _assert_same(u.model, u.data, uo.data, fields, k)
+        if te1 or tr1:
+            env.reset(seed=k)
+            oracle.reset(seed=k)
+    s = env.gate.summary()
+    env.close()
+    oracle.close()
+    return s
+
+
+@pytest.mark.parametrize("env_id, kw", [("Pusher-v5", {"pairs": "mujoco"}), ("monitor/Arm-v0", {})])
+def test_safety_gate_commit_is_bit_identical_to_an_ungated_env(env_id, kw):
+    s = _gym_against_oracle(env_id, 30, **kw)
+    assert s["committed"] > 0
+    if env_id == "monitor/Arm-v0":  # rejections too: fallbacks predicted, or inside the committed tail
+        assert s["replaced"] > 0 and s["committed"] + s["tail_reused"] == s["windows"]
+    else:
+        assert s["committed"] == s["windows"]
+
+
+def test_safety_gate_never_commits_into_an_env_with_its_own_simulation():
+    import gymnasium as gym
+
+    from monitor.gym_gate import SafetyGate
+
+    class OwnSim(gym.Wrapper):
+        pass
+
+    env = SafetyGate(OwnSim(gym.make("Pusher-v5")), pairs="mujoco")
+    assert env._commit_ok
+    u = env.unwrapped
+    calls = []
+    u._step_mujoco_simulation = lambda ctrl, n: calls.append(n)  # an env simulating its own way
+    env.reset(seed=0)
+    env.step(env.action_space.sample() * 0)
+    assert calls == [u.frame_skip] and env.gate.stats["committed"] == 0
+    env.close()
