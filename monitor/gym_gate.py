@@ -233,7 +233,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self._commit_ok = predictor == "rollout" and _steps_like_mujoco_env(u)
         self.commit = True
         """Commit the gate's own integration of the applied window instead of simulating it
-        again when the env steps (see :meth:`_commit_sim`); False: the env always simulates."""
+        again when the env steps (see :meth:`_commit_sim`); False: the env always simulates.
+        Set it False for an env whose ``step`` edits the model's dynamics (masses, gains,
+        friction) after the gate decided and before it simulates: the scratch window was
+        integrated with the model as it was at the decision, and the commit compares the
+        integration state and control, not the model."""
 
     def describe(self) -> str:
         """What the gate monitors (pairs, allowed pairs by reason, ongoing-contact rule)."""
