@@ -302,6 +302,94 @@ def _pack_plan(plan: object) -> MotionPack:
                    getattr(plan, "_tol", DEFAULT))
 
 
+STATIC_FIELDS = ("qpos0", "jnt_type", "jnt_qposadr", "jnt_pos", "jnt_axis", "jnt_axis_norm", "jnt_track",
+                 "body_parent", "body_jntadr", "body_jntnum", "body_pos", "body_quat", "body_mocap",
+                 "ref_points", "qt_adr")
+"""The :class:`MotionPack` fields that depend on the model alone (for a Plan; mocap rows of
+``body_pos`` / ``body_quat`` are the plan's held poses and are excluded by :func:`static_key`)."""
+
+
+def static_key(mp: MotionPack) -> bytes:
+    """Bytes of the model-only part of a pack (its kinematic tree), mocap pose rows zeroed.
+
+    Two packs with equal keys compute the same forward kinematics for the same joint
+    positions and mocap poses (the compiled FK reads nothing else of the model).
+    """
+    mocap = mp.body_mocap != 0
+    mocap[0] = False   # the world's row (body 0, absolute, identity for a Plan) is part of the key
+    parts = []
+    for f in STATIC_FIELDS:
+        a = getattr(mp, f)
+        if f in ("body_pos", "body_quat") and mocap.any():
+            a = a.copy()
+            a[mocap] = 0.0
+        parts.append(repr(a.shape).encode())
+        parts.append(a.tobytes())
+    return b"|".join(parts)
+
+
+def probe_plan(plan: object, seed: int = 0, n: int = 4) -> object:
+    """A Plan of ``plan``'s model through ``n`` random configurations, with random held mocap poses.
+
+    The layout (joint types, qpos columns) comes from the plan's model structure snapshot
+    (``plan._st``), not from a pack. Hinges: angles uniform in [-pi, pi]; slides and free
+    positions: uniform in [-1, 1] m; ball / free quaternions and mocap orientations:
+    uniform random unit quaternions; mocap positions uniform in [-1, 1] m. Seeded.
+    """
+    st = plan._st
+    rng = np.random.default_rng(seed)
+    q = np.empty((n, st.nq))
+    for typ, a in zip(st.jtype_list, st.jadr_list, strict=True):
+        if typ == _HINGE:
+            q[:, a] = rng.uniform(-np.pi, np.pi, n)
+        elif typ == _SLIDE:
+            q[:, a] = rng.uniform(-1.0, 1.0, n)
+        else:
+            if typ == _FREE:
+                q[:, a:a + 3] = rng.uniform(-1.0, 1.0, (n, 3))
+                a += 3
+            u = rng.normal(size=(n, 4))
+            q[:, a:a + 4] = u / np.linalg.norm(u, axis=1, keepdims=True)
+    u = rng.normal(size=(st.nmocap, 4))
+    mq = u / np.linalg.norm(u, axis=1, keepdims=True) if st.nmocap else np.zeros((0, 4))
+    mpos = rng.uniform(-1.0, 1.0, (st.nmocap, 3))
+    return type(plan)(np.linspace(0.0, 1.0, n), q, plan.model, mocap_pos=mpos, mocap_quat=mq,
+                      tolerances=getattr(plan, "_tol", DEFAULT))
+
+
+def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
+    """The per-plan part of ``mp`` is the plan's own data, bit for bit.
+
+    Checks: waypoint times and qpos; the quaternion tracks (segment targets, half angles,
+    angles, cumulative path, same-flags: the plan's own ``QuatTrack`` objects, in joint
+    order); the held mocap poses in the mocap rows of ``body_pos`` / ``body_quat``; and the
+    moving / rotating flags against the plan's own (derived independently by ``Plan._setup``
+    and by the compiled ``derive``). A few microseconds for a small tree.
+    """
+    st = plan._st
+    if not (np.array_equal(mp.times, plan.times) and np.array_equal(mp.qpos, plan.qpos)):
+        return False
+    if not (np.array_equal(mp.body_moving != 0, plan._moving)
+            and np.array_equal(mp.body_rotating != 0, plan._rotating)):
+        return False
+    tracks = plan._quat_tracks
+    if mp.qt_adr.shape[0] != len(st.quat_joints):
+        return False
+    for k, (j, a, _) in enumerate(st.quat_joints):
+        tr = tracks[j]
+        if not (int(mp.qt_adr[k]) == a and np.array_equal(mp.qt_target[k], tr.target)
+                and np.array_equal(mp.qt_half[k], tr.half) and np.array_equal(mp.qt_phi[k], tr.phi)
+                and np.array_equal(mp.qt_cum[k], tr.cum) and np.array_equal(mp.qt_same[k] != 0, tr.same)):
+            return False
+    if st.nmocap:
+        mocap = [b for b in range(1, st.nbody) if st.mocap[b]]
+        mid = np.asarray(plan.model.body_mocapid)[mocap]
+        if not (np.array_equal(mp.body_pos[mocap], plan._mocap_pos[mid])
+                and np.array_equal(mp.body_quat[mocap], plan._mocap_quat[mid])):
+            return False
+    return True
+
+
 def pack_trajectory(traj: object) -> MotionPack:
     """Pack a :class:`monitor.Plan` or :class:`monitor.BodyMotion` for the compiled kernels.
 
@@ -359,4 +447,5 @@ def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
     return pos, rot
 
 
-__all__ = ["MotionPack", "body_poses", "pack_trajectory", "poses_and_bounds"]
+__all__ = ["MotionPack", "body_poses", "pack_trajectory", "plan_data_agrees", "poses_and_bounds",
+           "probe_plan", "static_key"]
