@@ -363,6 +363,28 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     return sp, mp
 
 
+_NAMES: dict[int, tuple] = {}
+_NAMES_MAX = 16
+
+
+def _geom_names(geoms: tuple) -> tuple[list[str], list[str]]:
+    """(geom names, body names) of a scene's geoms tuple, cached per tuple object.
+
+    ``Scene.sync`` replaces the tuple (never edits it) and GeomInfo is frozen, so the
+    names of one tuple object never change; the cache holds the tuple itself, so its
+    ``id`` is not reused while cached. The lists are shared: callers do not modify them.
+    """
+    hit = _NAMES.get(id(geoms))
+    if hit is not None and hit[0] is geoms:
+        return hit[1], hit[2]
+    names = [g.name for g in geoms]
+    bnames = [g.body for g in geoms]
+    if len(_NAMES) >= _NAMES_MAX:
+        _NAMES.pop(next(iter(_NAMES)))
+    _NAMES[id(geoms)] = (geoms, names, bnames)
+    return names, bnames
+
+
 class _WindowPairs:
     """Per-pair results of the compiled window as arrays; :meth:`build_pairs` makes the PairResults.
 
@@ -385,8 +407,7 @@ class _WindowPairs:
 
     def _names(self) -> None:
         if self.names is None:
-            self.names = [g.name for g in self.geoms]
-            self.bnames = [g.body for g in self.geoms]
+            self.names, self.bnames = _geom_names(self.geoms)
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
@@ -413,21 +434,26 @@ class _WindowPairs:
     def build_pairs(self) -> tuple:
         from monitor.certify import kernels as KS
 
-        code, gap = self.code, self.gap.copy()
-        miss = np.nonzero((code == KS.WK_CULLED) & np.isnan(gap))[0]
+        code, gap = self.code, self.gap
+        miss = np.flatnonzero((code == KS.WK_CULLED) & np.isnan(gap))
+        if miss.size:
+            gap = gap.copy()
         for s in range(0, len(miss), 1 << 15):  # their exact sphere gaps (skipped by the AABB test)
             k = miss[s:s + (1 << 15)]
             a, b = self.pid[k, 0], self.pid[k, 1]
-            d = np.linalg.norm(self.sc[:, a] - self.sc[:, b], axis=2) - self.sr[:, a] - self.sr[:, b]
+            dv = self.sc[:, a] - self.sc[:, b]
+            # = np.linalg.norm(dv, axis=2) (same arithmetic: sqrt of the summed squares), fewer calls
+            d = np.sqrt(np.add.reduce(dv * dv, axis=2)) - self.sr[:, a] - self.sr[:, b]
             g = d.min(axis=0) - self.pad
             g[~np.isfinite(d).all(axis=0)] = -np.inf
             gap[k] = g
-        slot = {int(k): s for s, k in enumerate(self.surv.tolist())}
-        decided = (KS.WK_STATIC_VIOL, KS.WK_STATIC_CERT, KS.WK_CERT, KS.WK_VIOL)
         results = dict(self.results)
-        for k, s in slot.items():
-            if int(code[k]) in decided:
-                results[int(self.sel[k])] = self.kernel_result(k, s)
+        if self.surv.size:
+            decided = (KS.WK_STATIC_VIOL, KS.WK_STATIC_CERT, KS.WK_CERT, KS.WK_VIOL)
+            slot = {int(k): s for s, k in enumerate(self.surv.tolist())}
+            for k, s in slot.items():
+                if int(code[k]) in decided:
+                    results[int(self.sel[k])] = self.kernel_result(k, s)
         cull = np.where((code == KS.WK_CULLED) | (code == KS.WK_SS), gap, np.nan)
         self._names()
         return _build_ordered(self.sel.tolist(), cull.tolist(), self.unfin.tolist(), self.window,
