@@ -54,7 +54,7 @@ from monitor.certify.common import (
 )
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
 from monitor.certify.types import Method
-from monitor.errors import InvalidInputError, ModelMismatchError
+from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
 from monitor.tolerances import DEFAULT, Tolerances
 
 _METHODS = ("auto", "toleranced", "extrusion")
@@ -69,7 +69,20 @@ _NSUB = 8
 """Sub-intervals of the broad phase's swept spheres (one pose / bound call for all geoms)."""
 
 
+_KS: list = []
+
+
+def _kernels() -> Any:
+    """The :mod:`monitor.certify.kernels` module (imported on first use: it imports numba)."""
+    if not _KS:
+        from monitor.certify import kernels
+        _KS.append(kernels)
+    return _KS[0]
+
+
 def _finite(name: str, x: Any) -> float:
+    if type(x) is float and x - x == 0.0:  # a finite float (inf - inf and nan - nan are nan)
+        return x
     try:
         v = float(x)
     except (TypeError, ValueError) as exc:
@@ -348,9 +361,7 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     :func:`~monitor.certify.kernels.trajectory_pack` per trajectory object, checked once
     against the trajectory's own poses).
     """
-    from monitor.certify import kernels as KS
-    from monitor.errors import MonitorError
-
+    KS = _kernels()
     mp = KS.trajectory_pack(plan)
     if mp is None:
         return None
@@ -411,7 +422,7 @@ class _WindowPairs:
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
-        from monitor.certify import kernels as KS
+        KS = _kernels()
 
         self._names()
         a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
@@ -432,7 +443,7 @@ class _WindowPairs:
                           int(row[KS.R_DEPTH]), ((float(row[KS.R_FIRST_UNRES]), w.time),), float("-inf"), w)
 
     def build_pairs(self) -> tuple:
-        from monitor.certify import kernels as KS
+        KS = _kernels()
 
         code, gap = self.code, self.gap
         miss = np.flatnonzero((code == KS.WK_CULLED) & np.isnan(gap))
@@ -475,7 +486,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     through the Python stages 3-5 exactly as in :func:`_certify`. Results stay arrays;
     ``cert.pairs`` is built on first read (:class:`_WindowPairs`).
     """
-    from monitor.certify import kernels as KS
+    KS = _kernels()
 
     sp, mp = fast
     moving = np.asarray(plan.moving_bodies(), bool)

@@ -1078,6 +1078,8 @@ def _tree_verified(traj, mp, key) -> bool:
     if hit is not None:
         return hit
     probe = probe_plan(traj, PROBE_SEED, PROBE_WAYPOINTS)
+    if getattr(probe._st, "key", None) != key[0]:
+        return False    # the live model is no longer the one the plan was built on: no verdict to keep
     pm = pack_trajectory(probe)
     ok = static_key(pm) == key[1] and _poses_match(probe, pm)
     if len(_VERIFIED_TREES) >= _VERIFIED_TREES_MAX:
