@@ -451,12 +451,16 @@ class _WindowPairs:
             gap = gap.copy()
         for s in range(0, len(miss), 1 << 15):  # their exact sphere gaps (skipped by the AABB test)
             k = miss[s:s + (1 << 15)]
-            a, b = self.pid[k, 0], self.pid[k, 1]
-            dv = self.sc[:, a] - self.sc[:, b]
-            # = np.linalg.norm(dv, axis=2) (same arithmetic: sqrt of the summed squares), fewer calls
-            d = np.sqrt(np.add.reduce(dv * dv, axis=2)) - self.sr[:, a] - self.sr[:, b]
+            ab = self.pid.take(k, axis=0)       # (m, 2) geoms of each pair: one gather per array
+            c = self.sc.take(ab, axis=1)        # (T, m, 2, 3) sphere centres
+            r = self.sr.take(ab, axis=1)        # (T, m, 2) radii
+            dv = c[:, :, 0] - c[:, :, 1]
+            # = np.linalg.norm(dv, axis=2) - r_a - r_b (same arithmetic, same order), fewer calls
+            d = np.sqrt(np.add.reduce(dv * dv, axis=2)) - r[:, :, 0] - r[:, :, 1]
             g = d.min(axis=0) - self.pad
-            g[~np.isfinite(d).all(axis=0)] = -np.inf
+            fin = np.isfinite(d).all(axis=0)
+            if not fin.all():
+                g[~fin] = -np.inf
             gap[k] = g
         results = dict(self.results)
         if self.surv.size:
