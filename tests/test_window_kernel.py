@@ -287,3 +287,26 @@ def test_verified_packs_give_the_same_certificates_as_the_full_check(monkeypatch
     for a, b in zip(fast, full):
         assert a.verdict == b.verdict and a.stats["checker_mix"] == b.stats["checker_mix"]
         assert a.clearance == b.clearance
+
+
+def test_a_key_whose_first_plan_failed_its_own_check_checks_every_later_plan(monkeypatch):
+    """If a plan's own full pose check fails after its tree passed the probes, later plans of
+    the same tree are not trusted on the tree check alone: each gets its own full check."""
+    m = mujoco.MjModel.from_xml_string(_ARM_XML.replace('pos="0.8 0 0"', 'pos="0.85 0 0"'))  # a fresh key
+    bad, later = _arm_plan(m, 40), _arm_plan(m, 41)
+    real = K._poses_match
+    calls = []
+
+    def spy(traj, mp):
+        calls.append(traj)
+        return False if traj is bad else real(traj, mp)
+
+    monkeypatch.setattr(K, "_poses_match", spy)
+    assert K.trajectory_pack(bad) is None
+    calls.clear()
+    assert K.trajectory_pack(later) is not None
+    assert any(c is later for c in calls)
+    calls.clear()
+    third = _arm_plan(m, 42)
+    assert K.trajectory_pack(third) is not None
+    assert any(c is third for c in calls)

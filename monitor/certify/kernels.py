@@ -1064,7 +1064,8 @@ def _poses_match(traj, mp) -> bool:
 
 _VERIFIED_TREES: dict = {}
 """(model structure key, :func:`monitor.motion.pack.static_key`) -> True (the packed tree was
-checked against the model's own FK at random configurations) or False (it failed)."""
+checked against the model's own FK at random configurations), False (it failed: refuse), or
+"full" (the tree passed but a plan's own full pose check failed: check every plan in full)."""
 _VERIFIED_TREES_MAX = 64
 PROBE_SEED = 20261124
 PROBE_WAYPOINTS = 4
@@ -1076,7 +1077,7 @@ def _tree_verified(traj, mp, key) -> bool:
 
     hit = _VERIFIED_TREES.get(key)
     if hit is not None:
-        return hit
+        return hit is not False
     probe = probe_plan(traj, PROBE_SEED, PROBE_WAYPOINTS)
     if getattr(probe._st, "key", None) != key[0]:
         return False    # the live model is no longer the one the plan was built on: no verdict to keep
@@ -1138,12 +1139,18 @@ def _pack_agrees(traj, mp) -> bool:
     if skey is None or not hasattr(traj, "_quat_tracks"):
         return _poses_match(traj, mp)
     key = (skey, static_key(mp))
-    first = key not in _VERIFIED_TREES
+    state = _VERIFIED_TREES.get(key)
     if not _tree_verified(traj, mp, key):
         return False
     if not plan_data_agrees(traj, mp):
         return False
-    return _poses_match(traj, mp) if first else True
+    if state is None or state == "full":     # the key's first plan, or a key already caught once
+        if not _poses_match(traj, mp):
+            # the tree passed its probes but this plan's own poses disagree: every later plan
+            # of this key gets its own full check (the former per-plan behaviour)
+            _VERIFIED_TREES[key] = "full"
+            return False
+    return True
 
 
 def trajectory_pack(traj):
