@@ -420,10 +420,18 @@ class _WindowPairs:
         if self.names is None:
             self.names, self.bnames = _geom_names(self.geoms)
 
+    def kernel_witness(self, k: int, s: int) -> Witness:
+        """The Witness of pair k, a violation decided by the kernel (survivor slot s)."""
+        KS = _kernels()
+        self._names()
+        a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
+        row = self.res[s]
+        return Witness(float(row[KS.R_WTIME]), (self.names[a], self.names[b]),
+                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), float(row[KS.R_WUPPER]))
+
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
         KS = _kernels()
-
         self._names()
         a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
         geoms, bodies = (self.names[a], self.names[b]), (self.bnames[a], self.bnames[b])
@@ -434,8 +442,7 @@ class _WindowPairs:
         if c == KS.WK_CERT:
             return PairResult(geoms, bodies, "certified", "toleranced", int(row[KS.R_TESTS]),
                               int(row[KS.R_DEPTH]), (), float(row[KS.R_CLEAR]))
-        w = Witness(float(row[KS.R_WTIME]), geoms, row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(),
-                    float(row[KS.R_WUPPER]))
+        w = self.kernel_witness(k, s)
         if c == KS.WK_STATIC_VIOL:
             t0 = float(self.window[0])
             return PairResult(geoms, bodies, "violation", "static", intervals=((t0, t0),), witness=w)
@@ -624,7 +631,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     witness = None
     if cand:
         best = min(cand, key=lambda c: (c[0], c[1]))
-        witness = best[2] if best[2] is not None else lazy.kernel_result(best[3], best[4]).witness
+        witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
     if verdict != "certified":
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
