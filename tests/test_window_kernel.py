@@ -166,3 +166,147 @@ def test_window_kernel_is_the_path_taken():
     plan = monitor.Plan([0.0, 0.1], [[-1.0], [1.0]], m)
     assert engine._fast_inputs(scene, plan) is not None
     assert K.trajectory_pack(plan) is K.trajectory_pack(plan)
+
+
+# -- the pack check (kernels._pack_agrees): tree verified once per key, data every plan ----------
+
+_ARM_XML = """<mujoco><worldbody>
+  <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.8 0 0"/>
+  <body name="upper"><joint name="shoulder" type="hinge" axis="0 0 1"/>
+    <geom name="ua" type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+    <body name="fore" pos="0.3 0 0"><joint name="elbow" type="hinge" axis="0 1 0" pos="0 0 0.01"/>
+      <geom name="fa" type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+      <body name="hand" pos="0.3 0 0"><joint name="wrist" type="ball"/>
+        <geom name="h" type="box" size="0.04 0.02 0.01" pos="0.05 0 0"/></body></body></body>
+  <body name="target" mocap="true" pos="0.5 0.5 0"><geom name="t" type="sphere" size="0.05"/></body>
+</worldbody></mujoco>"""
+
+
+def _arm_plan(m, seed):
+    """A plan that moves only the shoulder (elbow and wrist held at nonzero constant values)."""
+    rng = np.random.default_rng(seed)
+    q = np.zeros((3, m.nq))
+    q[:, 0] = [0.0, 0.3 + 0.1 * rng.random(), 0.7]
+    q[:, 1] = 0.4
+    q[:, 2:6] = np.array([0.9, 0.1, 0.3, 0.2]) / np.sqrt(0.95)
+    return monitor.Plan([0.0, 0.05, 0.1], q, m)
+
+
+def _corrupt(field, fn):
+    """A replacement for pack.pack_trajectory whose packs have ``field`` changed by ``fn`` (new arrays)."""
+    from monitor.motion import pack as PK
+
+    real = PK.pack_trajectory
+
+    def bad(traj):
+        mp = real(traj)
+        return mp._replace(**{field: fn(getattr(mp, field).copy())})
+    return bad
+
+
+def _set(idx, val):
+    def fn(a):
+        a[idx] = val
+        return a
+    return fn
+
+
+@pytest.mark.parametrize("field, fn", [
+    ("jnt_axis", _set(1, (0.0, 0.0, 1.0))),          # elbow axis y -> z (the plan holds the elbow at 0.4)
+    ("body_parent", _set(3, 1)),                       # hand hung from the upper arm instead of the forearm
+    ("jnt_pos", _set(0, (0.0, 0.01, 0.0))),            # shoulder anchor off by 1 cm
+    ("body_mocap", _set(4, 0)),                        # the mocap target treated as a fixed body
+])
+def test_a_corrupted_tree_is_refused_on_first_use_even_after_a_good_one(monkeypatch, field, fn):
+    """A pack with a wrong joint axis / parent / anchor / mocap flag is never used: the engine
+    falls back to the Python pipeline for it, although a correct pack of the same model (and
+    the same moving joints) was verified just before."""
+    from monitor.motion import pack as PK
+
+    m = mujoco.MjModel.from_xml_string(_ARM_XML)
+    good = K.trajectory_pack(_arm_plan(m, 0))
+    assert good is not None
+    monkeypatch.setattr(PK, "pack_trajectory", _corrupt(field, fn))
+    for seed in (1, 2):
+        plan = _arm_plan(m, seed)
+        assert K.trajectory_pack(plan) is None, (field, seed)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    assert engine._fast_inputs(scene, _arm_plan(m, 3)) is None
+
+
+def test_an_in_place_edit_of_the_shared_tree_is_refused():
+    """Packs of one model share their tree arrays; editing them in place (after they were
+    verified) changes the tree key, so the next pack is checked again and refused."""
+    m = mujoco.MjModel.from_xml_string(_ARM_XML)
+    mp = K.trajectory_pack(_arm_plan(m, 10))
+    assert mp is not None
+    old = mp.jnt_axis.copy()
+    try:
+        mp.jnt_axis[1] = (0.0, 0.0, 1.0)
+        assert K.trajectory_pack(_arm_plan(m, 11)) is None
+    finally:
+        mp.jnt_axis[:] = old
+    assert K.trajectory_pack(_arm_plan(m, 12)) is not None
+
+
+def test_the_per_plan_data_is_checked_on_every_plan(monkeypatch):
+    """After the tree is verified, a pack whose qpos or mocap pose is not the plan's own is refused."""
+    from monitor.motion import pack as PK
+
+    m = mujoco.MjModel.from_xml_string(_ARM_XML)
+    assert K.trajectory_pack(_arm_plan(m, 20)) is not None
+    real = PK.pack_trajectory
+
+    def shifted_qpos(traj):
+        mp = real(traj)
+        q = mp.qpos.copy()
+        q[1, 1] += 1e-6
+        return mp._replace(qpos=q)
+
+    def moved_target(traj):
+        mp = real(traj)
+        bp = mp.body_pos.copy()
+        bp[4, 0] += 1e-6
+        return mp._replace(body_pos=bp)
+
+    for bad in (shifted_qpos, moved_target):
+        monkeypatch.setattr(PK, "pack_trajectory", bad)
+        assert K.trajectory_pack(_arm_plan(m, 21)) is None, bad.__name__
+
+
+def test_verified_packs_give_the_same_certificates_as_the_full_check(monkeypatch):
+    """Plans after the first of a model (tree check skipped) certify exactly as with the full
+    per-plan pose check (the former behaviour)."""
+    m = mujoco.MjModel.from_xml_string(_ARM_XML)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    plans = [_arm_plan(m, s) for s in range(30, 34)]
+    fast = [monitor.certify(scene, p, margin=0.01, epsilon=1e-3) for p in plans]
+    monkeypatch.setattr(K, "_pack_agrees", K._poses_match)
+    K._MOTION_PACKS.clear()
+    full = [monitor.certify(scene, p, margin=0.01, epsilon=1e-3) for p in plans]
+    for a, b in zip(fast, full):
+        assert a.verdict == b.verdict and a.stats["checker_mix"] == b.stats["checker_mix"]
+        assert a.clearance == b.clearance
+
+
+def test_a_key_whose_first_plan_failed_its_own_check_checks_every_later_plan(monkeypatch):
+    """If a plan's own full pose check fails after its tree passed the probes, later plans of
+    the same tree are not trusted on the tree check alone: each gets its own full check."""
+    m = mujoco.MjModel.from_xml_string(_ARM_XML.replace('pos="0.8 0 0"', 'pos="0.85 0 0"'))  # a fresh key
+    bad, later = _arm_plan(m, 40), _arm_plan(m, 41)
+    real = K._poses_match
+    calls = []
+
+    def spy(traj, mp):
+        calls.append(traj)
+        return False if traj is bad else real(traj, mp)
+
+    monkeypatch.setattr(K, "_poses_match", spy)
+    assert K.trajectory_pack(bad) is None
+    calls.clear()
+    assert K.trajectory_pack(later) is not None
+    assert any(c is later for c in calls)
+    calls.clear()
+    third = _arm_plan(m, 42)
+    assert K.trajectory_pack(third) is not None
+    assert any(c is third for c in calls)

@@ -54,7 +54,7 @@ from monitor.certify.common import (
 )
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
 from monitor.certify.types import Method
-from monitor.errors import InvalidInputError, ModelMismatchError
+from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
 from monitor.tolerances import DEFAULT, Tolerances
 
 _METHODS = ("auto", "toleranced", "extrusion")
@@ -69,7 +69,20 @@ _NSUB = 8
 """Sub-intervals of the broad phase's swept spheres (one pose / bound call for all geoms)."""
 
 
+_KS: list = []
+
+
+def _kernels() -> Any:
+    """The :mod:`monitor.certify.kernels` module (imported on first use: it imports numba)."""
+    if not _KS:
+        from monitor.certify import kernels
+        _KS.append(kernels)
+    return _KS[0]
+
+
 def _finite(name: str, x: Any) -> float:
+    if type(x) is float and x - x == 0.0:  # a finite float (inf - inf and nan - nan are nan)
+        return x
     try:
         v = float(x)
     except (TypeError, ValueError) as exc:
@@ -348,9 +361,7 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     :func:`~monitor.certify.kernels.trajectory_pack` per trajectory object, checked once
     against the trajectory's own poses).
     """
-    from monitor.certify import kernels as KS
-    from monitor.errors import MonitorError
-
+    KS = _kernels()
     mp = KS.trajectory_pack(plan)
     if mp is None:
         return None
@@ -361,6 +372,28 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     if sp.geoms.body.shape[0] != len(scene.geoms) or int(plan.nbody) != mp.nbody:
         return None
     return sp, mp
+
+
+_NAMES: dict[int, tuple] = {}
+_NAMES_MAX = 16
+
+
+def _geom_names(geoms: tuple) -> tuple[list[str], list[str]]:
+    """(geom names, body names) of a scene's geoms tuple, cached per tuple object.
+
+    ``Scene.sync`` replaces the tuple (never edits it) and GeomInfo is frozen, so the
+    names of one tuple object never change; the cache holds the tuple itself, so its
+    ``id`` is not reused while cached. The lists are shared: callers do not modify them.
+    """
+    hit = _NAMES.get(id(geoms))
+    if hit is not None and hit[0] is geoms:
+        return hit[1], hit[2]
+    names = [g.name for g in geoms]
+    bnames = [g.body for g in geoms]
+    if len(_NAMES) >= _NAMES_MAX:
+        _NAMES.pop(next(iter(_NAMES)))
+    _NAMES[id(geoms)] = (geoms, names, bnames)
+    return names, bnames
 
 
 class _WindowPairs:
@@ -385,13 +418,20 @@ class _WindowPairs:
 
     def _names(self) -> None:
         if self.names is None:
-            self.names = [g.name for g in self.geoms]
-            self.bnames = [g.body for g in self.geoms]
+            self.names, self.bnames = _geom_names(self.geoms)
+
+    def kernel_witness(self, k: int, s: int) -> Witness:
+        """The Witness of pair k, a violation decided by the kernel (survivor slot s)."""
+        KS = _kernels()
+        self._names()
+        a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
+        row = self.res[s]
+        return Witness(float(row[KS.R_WTIME]), (self.names[a], self.names[b]),
+                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), float(row[KS.R_WUPPER]))
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
-        from monitor.certify import kernels as KS
-
+        KS = _kernels()
         self._names()
         a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
         geoms, bodies = (self.names[a], self.names[b]), (self.bnames[a], self.bnames[b])
@@ -402,8 +442,7 @@ class _WindowPairs:
         if c == KS.WK_CERT:
             return PairResult(geoms, bodies, "certified", "toleranced", int(row[KS.R_TESTS]),
                               int(row[KS.R_DEPTH]), (), float(row[KS.R_CLEAR]))
-        w = Witness(float(row[KS.R_WTIME]), geoms, row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(),
-                    float(row[KS.R_WUPPER]))
+        w = self.kernel_witness(k, s)
         if c == KS.WK_STATIC_VIOL:
             t0 = float(self.window[0])
             return PairResult(geoms, bodies, "violation", "static", intervals=((t0, t0),), witness=w)
@@ -411,23 +450,32 @@ class _WindowPairs:
                           int(row[KS.R_DEPTH]), ((float(row[KS.R_FIRST_UNRES]), w.time),), float("-inf"), w)
 
     def build_pairs(self) -> tuple:
-        from monitor.certify import kernels as KS
+        KS = _kernels()
 
-        code, gap = self.code, self.gap.copy()
-        miss = np.nonzero((code == KS.WK_CULLED) & np.isnan(gap))[0]
+        code, gap = self.code, self.gap
+        miss = np.flatnonzero((code == KS.WK_CULLED) & np.isnan(gap))
+        if miss.size:
+            gap = gap.copy()
         for s in range(0, len(miss), 1 << 15):  # their exact sphere gaps (skipped by the AABB test)
             k = miss[s:s + (1 << 15)]
-            a, b = self.pid[k, 0], self.pid[k, 1]
-            d = np.linalg.norm(self.sc[:, a] - self.sc[:, b], axis=2) - self.sr[:, a] - self.sr[:, b]
+            ab = self.pid.take(k, axis=0)       # (m, 2) geoms of each pair: one gather per array
+            c = self.sc.take(ab, axis=1)        # (T, m, 2, 3) sphere centres
+            r = self.sr.take(ab, axis=1)        # (T, m, 2) radii
+            dv = c[:, :, 0] - c[:, :, 1]
+            # = np.linalg.norm(dv, axis=2) - r_a - r_b (same arithmetic, same order), fewer calls
+            d = np.sqrt(np.add.reduce(dv * dv, axis=2)) - r[:, :, 0] - r[:, :, 1]
             g = d.min(axis=0) - self.pad
-            g[~np.isfinite(d).all(axis=0)] = -np.inf
+            fin = np.isfinite(d).all(axis=0)
+            if not fin.all():
+                g[~fin] = -np.inf
             gap[k] = g
-        slot = {int(k): s for s, k in enumerate(self.surv.tolist())}
-        decided = (KS.WK_STATIC_VIOL, KS.WK_STATIC_CERT, KS.WK_CERT, KS.WK_VIOL)
         results = dict(self.results)
-        for k, s in slot.items():
-            if int(code[k]) in decided:
-                results[int(self.sel[k])] = self.kernel_result(k, s)
+        if self.surv.size:
+            decided = (KS.WK_STATIC_VIOL, KS.WK_STATIC_CERT, KS.WK_CERT, KS.WK_VIOL)
+            slot = {int(k): s for s, k in enumerate(self.surv.tolist())}
+            for k, s in slot.items():
+                if int(code[k]) in decided:
+                    results[int(self.sel[k])] = self.kernel_result(k, s)
         cull = np.where((code == KS.WK_CULLED) | (code == KS.WK_SS), gap, np.nan)
         self._names()
         return _build_ordered(self.sel.tolist(), cull.tolist(), self.unfin.tolist(), self.window,
@@ -449,7 +497,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     through the Python stages 3-5 exactly as in :func:`_certify`. Results stay arrays;
     ``cert.pairs`` is built on first read (:class:`_WindowPairs`).
     """
-    from monitor.certify import kernels as KS
+    KS = _kernels()
 
     sp, mp = fast
     moving = np.asarray(plan.moving_bodies(), bool)
@@ -583,7 +631,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     witness = None
     if cand:
         best = min(cand, key=lambda c: (c[0], c[1]))
-        witness = best[2] if best[2] is not None else lazy.kernel_result(best[3], best[4]).witness
+        witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
     if verdict != "certified":
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]

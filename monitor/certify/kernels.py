@@ -1044,21 +1044,11 @@ def scene_pack(scene):
 _MOTION_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _pack_agrees(traj, mp) -> bool:
-    """The packed motion reproduces the trajectory's own poses at every waypoint and segment midpoint.
+def _poses_match(traj, mp) -> bool:
+    """Packed poses == the trajectory's own ``body_poses`` at every waypoint and segment midpoint.
 
-    Checked once per pack (the pack is a function of the trajectory object, whose
-    waypoint arrays are read-only copies: :class:`monitor.Plan`, :class:`monitor.BodyMotion`).
-    Why once is enough: :func:`monitor.motion.pack.pack_trajectory` copies the
-    trajectory's own slerp tracks (``QuatTrack``: sign-aligned targets, half angles,
-    bit-identical-ends flags), so every branch of the interpolation (which arc of a
-    half turn, the same-quaternion shortcut) is the trajectory's own decision, for any
-    window; what is left are rounding differences (quaternion FK vs ``mj_kinematics``,
-    ~1e-15 m), far below the 1e-9 tolerance of this check. The check is defence in
-    depth against a packing error (tree, mocap, joint frames): such an error shows at
-    the segment midpoints, where the interpolation is exercised. Tolerance: 1e-9
-    relative (positions), 1e-9 absolute (rotation entries), as the per-call guard it
-    replaces (the former per-call ``_poses_agree``).
+    Tolerance: 1e-9 relative (positions), 1e-9 absolute (rotation entries). Costs one FK of
+    the trajectory (``mj_kinematics`` for a Plan) and one packed FK per point.
     """
     from monitor.motion.pack import body_poses
 
@@ -1070,6 +1060,97 @@ def _pack_agrees(traj, mp) -> bool:
     R_WB = np.asarray(R_WB, np.float64)
     return bool((np.abs(p_k - P_W) <= 1e-9 * (1.0 + np.abs(P_W))).all()
                 and (np.abs(R_k - R_WB) <= 1e-9).all())
+
+
+_VERIFIED_TREES: dict = {}
+"""(model structure key, :func:`monitor.motion.pack.static_key`) -> True (the packed tree was
+checked against the model's own FK at random configurations), False (it failed: refuse), or
+"full" (the tree passed but a plan's own full pose check failed: check every plan in full)."""
+_VERIFIED_TREES_MAX = 64
+PROBE_SEED = 20261124
+PROBE_WAYPOINTS = 4
+
+
+def _tree_verified(traj, mp, key) -> bool:
+    """Check the pack's kinematic tree once against the model's own FK (see :func:`_pack_agrees`)."""
+    from monitor.motion.pack import pack_trajectory, probe_plan, static_key
+
+    hit = _VERIFIED_TREES.get(key)
+    if hit is not None:
+        return hit is not False
+    probe = probe_plan(traj, PROBE_SEED, PROBE_WAYPOINTS)
+    if getattr(probe._st, "key", None) != key[0]:
+        return False    # the live model is no longer the one the plan was built on: no verdict to keep
+    pm = pack_trajectory(probe)
+    ok = static_key(pm) == key[1] and _poses_match(probe, pm)
+    if len(_VERIFIED_TREES) >= _VERIFIED_TREES_MAX:
+        _VERIFIED_TREES.pop(next(iter(_VERIFIED_TREES)))
+    _VERIFIED_TREES[key] = ok
+    return ok
+
+
+def _pack_agrees(traj, mp) -> bool:
+    """The packed motion reproduces the trajectory's own poses (checked once per pack).
+
+    A :class:`monitor.BodyMotion` (or any trajectory without a model structure snapshot):
+    packed poses == ``traj.body_poses`` at every waypoint and segment midpoint
+    (:func:`_poses_match`), for every new object.
+
+    A :class:`monitor.Plan` is a pack of two parts: the **tree** (model-only arrays:
+    parents, joint types, qpos columns, anchors, axes, body offsets, mocap flags, reference
+    points; :func:`monitor.motion.pack.static_key`) and the plan's **data** (times, qpos,
+    quaternion tracks, held mocap poses, moving flags). Instead of a double FK per plan
+    (0.7 ms per gate window on Pusher), the check is split:
+
+    1. **Tree, once per (model structure, tree bytes).** A probe Plan of the same model
+       (:func:`monitor.motion.pack.probe_plan`: 4 seeded random configurations covering
+       every joint, hinge angles in [-pi, pi], random ball / free / mocap orientations,
+       random mocap positions; layout read from the plan's model snapshot, not from the
+       pack) is packed by the same packer; its tree must be byte-equal to this pack's, and
+       its packed poses must equal ``mj_kinematics`` at its waypoints and midpoints
+       (:func:`_poses_match`, 1e-9). The result is remembered by key; the key contains the
+       tree's bytes, so a new or an in-place edited tree is checked again on first use.
+    2. **The first plan of each key** also gets the full :func:`_poses_match` on its own
+       motion (as before this split).
+    3. **Every plan**: :func:`monitor.motion.pack.plan_data_agrees`: the pack's times,
+       qpos, quaternion tracks and mocap rows are the plan's own arrays bit for bit, and the
+       moving / rotating flags equal the plan's own (derived independently). Microseconds.
+
+    Soundness argument. The compiled FK of a pack is a fixed function of (tree, joint
+    positions, mocap poses), and its interpolation a fixed function of (times, qpos,
+    tracks). (3) makes the data the plan's own; (1) makes FK(tree, .) equal to MuJoCo's FK
+    at 4 random configurations with every joint away from zero. A packing error in the tree
+    (wrong joint axis, anchor, parent, body offset, joint type or qpos column, mocap flag)
+    changes the pose of a body by a nonzero analytic function of the configuration; to pass
+    it would have to vanish (below 1e-9) at all 4 random probes, i.e. lie on a measure-zero
+    set or be below the 1e-9 tolerance everywhere (the old per-plan check had the same
+    tolerance). An error in the interpolation would have to differ from the plan's own
+    interpolation only on data other than the probe's random waypoints and the first plan's
+    (branch decisions, e.g. which arc of a half turn, are the plan's own copied track
+    arrays, checked in (3)). An error in the per-plan data would have to leave the arrays
+    bit-identical, i.e. not be an error. Tests: tests/test_window_kernel.py (a corrupted
+    joint axis or parent is refused on its first use, also after a good pack of the same
+    model was verified, and after an in-place edit of the shared tree arrays).
+    """
+    from monitor.motion.pack import plan_data_agrees, static_key
+
+    st = getattr(traj, "_st", None)
+    skey = getattr(st, "key", None)
+    if skey is None or not hasattr(traj, "_quat_tracks"):
+        return _poses_match(traj, mp)
+    key = (skey, static_key(mp))
+    state = _VERIFIED_TREES.get(key)
+    if not _tree_verified(traj, mp, key):
+        return False
+    if not plan_data_agrees(traj, mp):
+        return False
+    if state is None or state == "full":     # the key's first plan, or a key already caught once
+        if not _poses_match(traj, mp):
+            # the tree passed its probes but this plan's own poses disagree: every later plan
+            # of this key gets its own full check (the former per-plan behaviour)
+            _VERIFIED_TREES[key] = "full"
+            return False
+    return True
 
 
 def trajectory_pack(traj):

@@ -148,6 +148,10 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     """
     from monitor.geometry.distance import shape_distance
 
+    if cert.verdict == "certified":
+        # every pair is certified (any other pair verdict makes the combined verdict
+        # "uncertain" or "violation"): no ongoing pair; cert.pairs need not be built here
+        return cert
     cand = [k for k, p in enumerate(cert.pairs) if p.verdict != "certified"]
     if not cand:
         return cert

@@ -18,6 +18,7 @@ The rounding scale (``tol[3]``) is computed once here, by the kernels, as
 
 from __future__ import annotations
 
+import operator
 import sys
 from typing import NamedTuple
 
@@ -132,6 +133,10 @@ class _Static(NamedTuple):
     ref_points: np.ndarray
     qt_adr: np.ndarray
     qpos0_mag: float
+    mocap_rows: np.ndarray | None = None
+    """(M,) bodies whose pack pose is the plan's held mocap pose (``mocapid >= 0``)."""
+    quat_j: np.ndarray | None = None
+    """(nqt,) ball / free joints, in track order."""
 
 
 def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: object, jnt_axis: object,
@@ -166,15 +171,21 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
         body_quat=_f64(np.array(body_quat, dtype=np.float64), (-1, 4)), body_mocap=body_mocap, mocapid=mid,
         ref_points=_f64(np.array(ref_points, dtype=np.float64), (-1, 3)),
         qt_adr=_i64(jadr[quat_j] + np.where(jt[quat_j] == _FREE, 3, 0)),
-        qpos0_mag=float(np.max(np.abs(q0), initial=0.0)))
+        qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=np.flatnonzero(mid >= 0), quat_j=quat_j)
+
+
+_NO_TRACKS: dict[int, tuple[np.ndarray, ...]] = {}
 
 
 def _track_arrays(tracks: list, K: int) -> tuple[np.ndarray, ...]:
     """(target, half, phi, cum, same) stacked from ``QuatTrack`` objects (bit-exact copies)."""
     n = len(tracks)
-    if n == 0:
-        return (np.zeros((0, K - 1, 4)), np.zeros((0, K - 1)), np.zeros((0, K - 1)), np.zeros((0, K)),
-                np.zeros((0, K - 1), dtype=np.int64))
+    if n == 0:   # zero-size arrays hold no data: one set per K, shared
+        hit = _NO_TRACKS.get(K)
+        if hit is None:
+            hit = _NO_TRACKS[K] = (np.zeros((0, K - 1, 4)), np.zeros((0, K - 1)), np.zeros((0, K - 1)),
+                                   np.zeros((0, K)), np.zeros((0, K - 1), dtype=np.int64))
+        return hit
     return (np.ascontiguousarray(np.stack([tr.target for tr in tracks]), dtype=np.float64),
             np.ascontiguousarray(np.stack([tr.half for tr in tracks]), dtype=np.float64),
             np.ascontiguousarray(np.stack([tr.phi for tr in tracks]), dtype=np.float64),
@@ -286,7 +297,7 @@ def _pack_plan(plan: object) -> MotionPack:
     st = _plan_static(plan)
     body_pos = st.body_pos
     body_quat = st.body_quat
-    mocap = np.flatnonzero(st.mocapid >= 0)
+    mocap = st.mocap_rows
     if mocap.size:
         body_pos = body_pos.copy()
         body_quat = body_quat.copy()
@@ -294,12 +305,109 @@ def _pack_plan(plan: object) -> MotionPack:
         body_quat[mocap] = plan.mocap_quat[st.mocapid[mocap]]
     own = getattr(plan, "_quat_tracks", {})
     qpos = plan.qpos
-    quat_j = np.flatnonzero(st.jnt_track >= 0)
+    quat_j = st.quat_j
     # Plan builds each track from the view qpos[:, a:a + 4] of this very array: same arithmetic.
     tracks = [own[j] if j in own else K_.QuatTrack(qpos[:, a:a + 4])
               for j, a in zip(quat_j, st.qt_adr, strict=True)]
     return _finish(st, _f64(plan.times), _f64(qpos), body_pos, body_quat, tracks,
                    getattr(plan, "_tol", DEFAULT))
+
+
+STATIC_FIELDS = ("qpos0", "jnt_type", "jnt_qposadr", "jnt_pos", "jnt_axis", "jnt_axis_norm", "jnt_track",
+                 "body_parent", "body_jntadr", "body_jntnum", "body_pos", "body_quat", "body_mocap",
+                 "ref_points", "qt_adr")
+"""The :class:`MotionPack` fields that depend on the model alone (for a Plan; mocap rows of
+``body_pos`` / ``body_quat`` are the plan's held poses and are excluded by :func:`static_key`)."""
+
+
+_KEY_PLAIN = tuple(f for f in STATIC_FIELDS if f not in ("body_pos", "body_quat"))
+_get_plain = operator.attrgetter(*_KEY_PLAIN)
+
+
+def static_key(mp: MotionPack) -> tuple:
+    """The model-only part of a pack (its kinematic tree) as a hashable key, mocap pose rows zeroed.
+
+    (bytes of every :data:`STATIC_FIELDS` array, their shapes). Two packs with equal keys
+    compute the same forward kinematics for the same joint positions and mocap poses (the
+    compiled FK reads nothing else of the model). The world's row (body 0) is kept.
+    """
+    arrs = _get_plain(mp)
+    parts = [a.tobytes() for a in arrs]
+    bp, bq = mp.body_pos, mp.body_quat
+    mocap = mp.body_mocap[1:] != 0
+    if mocap.any():
+        rows = np.flatnonzero(mocap) + 1
+        bp = bp.copy()
+        bq = bq.copy()
+        bp[rows] = 0.0
+        bq[rows] = 0.0
+    parts.append(bp.tobytes())
+    parts.append(bq.tobytes())
+    return b"|".join(parts), tuple([a.shape for a in arrs]), bp.shape, bq.shape
+
+
+def probe_plan(plan: object, seed: int = 0, n: int = 4) -> object:
+    """A Plan of ``plan``'s model through ``n`` random configurations, with random held mocap poses.
+
+    The layout (joint types, qpos columns) comes from the plan's model structure snapshot
+    (``plan._st``), not from a pack. Hinges: angles uniform in [-pi, pi]; slides and free
+    positions: uniform in [-1, 1] m; ball / free quaternions and mocap orientations:
+    uniform random unit quaternions; mocap positions uniform in [-1, 1] m. Seeded.
+    """
+    st = plan._st
+    rng = np.random.default_rng(seed)
+    q = np.empty((n, st.nq))
+    for typ, a in zip(st.jtype_list, st.jadr_list, strict=True):
+        if typ == _HINGE:
+            q[:, a] = rng.uniform(-np.pi, np.pi, n)
+        elif typ == _SLIDE:
+            q[:, a] = rng.uniform(-1.0, 1.0, n)
+        else:
+            if typ == _FREE:
+                q[:, a:a + 3] = rng.uniform(-1.0, 1.0, (n, 3))
+                a += 3
+            u = rng.normal(size=(n, 4))
+            q[:, a:a + 4] = u / np.linalg.norm(u, axis=1, keepdims=True)
+    u = rng.normal(size=(st.nmocap, 4))
+    mq = u / np.linalg.norm(u, axis=1, keepdims=True) if st.nmocap else np.zeros((0, 4))
+    mpos = rng.uniform(-1.0, 1.0, (st.nmocap, 3))
+    return type(plan)(np.linspace(0.0, 1.0, n), q, plan.model, mocap_pos=mpos, mocap_quat=mq,
+                      tolerances=getattr(plan, "_tol", DEFAULT))
+
+
+def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
+    """The per-plan part of ``mp`` is the plan's own data, bit for bit.
+
+    Checks: waypoint times and qpos; the quaternion tracks (segment targets, half angles,
+    angles, cumulative path, same-flags: the plan's own ``QuatTrack`` objects, in joint
+    order); the held mocap poses in the mocap rows of ``body_pos`` / ``body_quat``; and the
+    moving / rotating flags against the plan's own (derived independently by ``Plan._setup``
+    and by the compiled ``derive``). A few microseconds for a small tree.
+    """
+    st = plan._st
+    if not (mp.times.tobytes() == plan.times.tobytes() and mp.qpos.shape == plan.qpos.shape
+            and mp.qpos.tobytes() == plan.qpos.tobytes()):
+        return False
+    if not ((mp.body_moving != 0).tobytes() == plan._moving.tobytes()
+            and (mp.body_rotating != 0).tobytes() == plan._rotating.tobytes()):
+        return False
+    if mp.qt_adr.shape[0] != len(st.quat_joints):
+        return False
+    if st.quat_joints:
+        tracks = plan._quat_tracks
+        for k, (j, a, _) in enumerate(st.quat_joints):
+            tr = tracks[j]
+            if not (int(mp.qt_adr[k]) == a and np.array_equal(mp.qt_target[k], tr.target)
+                    and np.array_equal(mp.qt_half[k], tr.half) and np.array_equal(mp.qt_phi[k], tr.phi)
+                    and np.array_equal(mp.qt_cum[k], tr.cum) and np.array_equal(mp.qt_same[k] != 0, tr.same)):
+                return False
+    if st.nmocap:
+        mocap = [b for b in range(1, st.nbody) if st.mocap[b]]
+        mid = np.asarray(plan.model.body_mocapid)[mocap]
+        if not (np.array_equal(mp.body_pos[mocap], plan._mocap_pos[mid])
+                and np.array_equal(mp.body_quat[mocap], plan._mocap_quat[mid])):
+            return False
+    return True
 
 
 def pack_trajectory(traj: object) -> MotionPack:
@@ -359,4 +467,5 @@ def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
     return pos, rot
 
 
-__all__ = ["MotionPack", "body_poses", "pack_trajectory", "poses_and_bounds"]
+__all__ = ["MotionPack", "body_poses", "pack_trajectory", "plan_data_agrees", "poses_and_bounds",
+           "probe_plan", "static_key"]

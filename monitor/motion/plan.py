@@ -573,7 +573,9 @@ class Plan(WindowTimes):
         ``geom_pos``, ...) the two disagree. :func:`monitor.certify` then certifies
         :meth:`refreshed` instead.
         """
-        return all(v.tobytes() == b for v, b in zip(_field_views(self._model), self._st.field_bytes))
+        # one join of the field bytes and one compare (the key holds the sizes and every
+        # field's bytes; same answer as comparing field by field, at about half the cost)
+        return _structure_key(self._model) == self._st.key
 
     def refreshed(self) -> Plan:
         """The same waypoints (times, qpos, held mocap poses) rebuilt on the live model."""
