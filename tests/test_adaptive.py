@@ -116,6 +116,15 @@ def _trace(gp, mp, window, margin=0.0, eps=1e-3, max_depth=40, mode=K.MODE_FULL,
     before = None
     for _ in range(max_steps):
         state = (res[K.R_WTIME], res[K.R_UNRES], res[K.R_FIRST_UNRES])
+        tested = None
+        if before is not None and before:
+            # the interval the next test covers: the top stack entry (a sweep entry: its prefix
+            # [a, a + L], extended to e when less than 5 % of L would be left, as the kernel does)
+            a, b, d = (float(x) for x in stack[int(res[K.R_SP]) - 1])
+            if d < 0.0:
+                b = b if not a - d < b + 0.05 * d else a - d
+            tested = (a, b)
+        wt_prev = state[0]
         v = K.pair_window(gp, mp, 1, 2, t0, t1, margin, eps, max_depth, 1, mode, REL, ABS, stack, res)
         after = _pending(stack, int(res[K.R_SP])) if v == K.PAUSED else []
         now = (res[K.R_WTIME], res[K.R_UNRES], res[K.R_FIRST_UNRES])
@@ -124,7 +133,11 @@ def _trace(gp, mp, window, margin=0.0, eps=1e-3, max_depth=40, mode=K.MODE_FULL,
             # while refining a witness, an unresolved interval at or after the first unresolved
             # time changes no state: such pieces are not counted (they may not be excluded)
             fu = state[2]
-            excluded += [p for p in _minus(before, after) if not (state[0] == state[0] and p[0] >= fu)]
+            removed = _minus(before, after)
+            # coverage: a step drops nothing (split, retry) or exactly the interval it tested
+            assert removed == [] or (state[0] == state[0] and tested[0] >= wt_prev) or removed == [tested], \
+                (removed, tested)
+            excluded += [p for p in removed if not (state[0] == state[0] and p[0] >= fu)]
         before = after
         if v != K.PAUSED:
             return v, sorted(excluded), res
