@@ -639,12 +639,13 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 if lb > target:
                     sv = _norm3(v[0], v[1], v[2])
                     gap = (lb if lb > hi else 0.5 * (lb + max(lb, sv))) - rsum - margin
-            if not lb > target:
+            if not lb > target and not lb > floor:
+                # (a bound above floor from the first call already rules out a witness: no second call)
                 lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, floor, rel_pad, abs_pad, VA, VB, W4,
                                       IA, IB, lam, v, vn, X)
-                if not gap == gap:
-                    sv = _norm3(v[0], v[1], v[2])
-                    gap = 0.5 * (lb + max(lb, sv)) - rsum - margin
+            if not gap == gap:
+                sv = _norm3(v[0], v[1], v[2])
+                gap = 0.5 * (lb + max(lb, sv)) - rsum - margin
             if lb > target:
                 slack = lb - (target - margin)      # > margin: proven clearance over I
                 if slack < res[R_CLEAR]:
