@@ -517,8 +517,10 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         max_tests: distance tests this call may spend (PAUSED when reached).
         mode: MODE_FULL or MODE_CERTIFY_ONLY.
         rel_pad, abs_pad: rounding pads.
-        stack: (max_depth + 2, 3) float64 work array (ta, tb, depth); keep it between
-            calls to resume a PAUSED search.
+        stack: (max_depth + 2, 3) float64 work array; keep it between calls to resume a
+            PAUSED search. Rows (ta, tb, depth) are bisection intervals, rows (a, e, -L) the
+            uncovered rest [a, e] of the adaptive sweep with its next step L; the last row is the
+            step controller's memory (midpoint, gap estimate, valid flag).
         res: (R_SIZE,) float64 result row; set ``res[R_STARTED] = 0`` for a fresh search
             (:func:`new_result`), or 2 for a fresh search whose start pose the caller has
             already tested (no start test here; used by :func:`window_kernel`). Holds verdict,
