@@ -35,7 +35,23 @@ stage does not certify).
 **Distance.** :func:`monitor.geometry._gjk.core_distance` (GJK/EPA, rigorous bounds)
 or the closed-form half-space distance, minus the radii: ``lower <= dist <= upper``.
 
-**Algorithm (§6, depth-first, earliest first).** A stack of sub-intervals, left child
+**Algorithm (§6, depth-first, earliest first).** Sub-interval lengths adapt to the
+measured clearance (issue 12, item 2): the window is swept from t0 by conservative
+advancement with a certified bound. The uncovered rest ``[a, e]`` is one stack entry; its
+next sub-interval is the prefix ``[a, a + L]``, tested exactly like a bisection interval
+(the ball of §5 about its midpoint). After an exclusion the rest ``[a + L, e]`` is pushed
+with a step L chosen so that the next bound is about ``_STEP_SAFETY`` x the gap predicted
+at its midpoint (distance estimate and slope from the last two tests, bound per second
+from the last test; at most ``_STEP_GROW`` x, at least half the last step and a bound of
+about ``epsilon``). A prefix that is not excluded is retried shorter while its bound
+stays >= epsilon; once the step would go below the epsilon scale (or at ``max_depth``)
+the whole rest ``[a, e]`` is bisected as before (so witnesses are looked for at the
+midpoints of the open region, and ``uncertain`` keeps its epsilon / depth meaning: only
+an interval with bound < epsilon or at ``max_depth`` is ever unresolved). Coverage: an
+entry is only dropped when excluded, confirmed-later-than-a-witness or unresolved, and
+the sweep pushes exactly the uncovered rest, so the excluded intervals tile the window
+(``tests/test_adaptive.py``). The step control is a heuristic only: no verdict depends
+on its predictions. Bisection entries: a stack of sub-intervals, left child
 popped first. For each: the exact static distance at ``m``; ``upper + approx < margin``
 confirms a violation at m (``approx`` = over-approximation of circumscribed geoms), after
 which only ``[a, m]`` is searched further for an earlier confirmed time (everything
@@ -115,6 +131,13 @@ R_START_LO = 14         # window_kernel: lower bound (m) of the start-pose dista
 R_SIZE = 15
 
 _EPS_REL = 1e-14
+_STEP_SAFETY = 0.85
+"""Adaptive sub-intervals: aim the next interval's bound at this share of the predicted gap."""
+_STEP_GROW = 4.0
+"""Adaptive sub-intervals: at most this growth of the step after an exclusion."""
+_STEP_HEADROOM = 4.0
+"""Adaptive sub-intervals: the early-exit GJK is asked to prove this many bounds of clearance
+(a better distance estimate for the next step; exclusion still needs one bound)."""
 _MAX_ITER = 200
 _MAX_EDGE_PAIRS = 2_000_000
 
@@ -494,8 +517,10 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         max_tests: distance tests this call may spend (PAUSED when reached).
         mode: MODE_FULL or MODE_CERTIFY_ONLY.
         rel_pad, abs_pad: rounding pads.
-        stack: (max_depth + 2, 3) float64 work array (ta, tb, depth); keep it between
-            calls to resume a PAUSED search.
+        stack: (max_depth + 2, 3) float64 work array; keep it between calls to resume a
+            PAUSED search. Rows (ta, tb, depth) are bisection intervals, rows (a, e, -L) the
+            uncovered rest [a, e] of the adaptive sweep with its next step L; the last row is the
+            step controller's memory (midpoint, gap estimate, valid flag).
         res: (R_SIZE,) float64 result row; set ``res[R_STARTED] = 0`` for a fresh search
             (:func:`new_result`), or 2 for a fresh search whose start pose the caller has
             already tested (no start test here; used by :func:`window_kernel`). Holds verdict,
@@ -526,7 +551,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     rsum = gp.radius[ga] + gp.radius[gb]
     VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
     VB = np.empty((max(gp.vstart[gb + 1] - gp.vstart[gb], 1), 3))
-    W = np.zeros((4, 3))
+    W4 = np.zeros((4, 3))
     IA = np.zeros(4, np.int64)
     IB = np.zeros(4, np.int64)
     lam = np.zeros(4)
@@ -535,6 +560,9 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     X = np.empty((4, 3))
     spent = 0
     sp = int(res[R_SP])
+    mem = stack.shape[0] - 1       # last stack row: the step controller's memory (m, gap, valid)
+    W = t1 - t0
+    Lmin = W * 2.0**-max_depth
     # poses of bodies the motion does not move: constant, set once (see interval_bound)
     if mp.body_moving[gp.body[ga]] == 0:
         body_pose(mp, gp.body[ga], t0, pA, RA)
@@ -565,7 +593,8 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 res[R_VERDICT] = VIOLATION
                 res[R_SP] = 0.0
                 return VIOLATION
-        sp = _push(stack, 0, t0, t1, 0.0)
+        stack[mem, 2] = 0.0
+        sp = _push(stack, 0, t0, t1, -W)      # a sweep entry: [t0, t1], first step W
     while sp > 0:
         if spent >= max_tests:
             res[R_SP] = sp
@@ -577,12 +606,24 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         wt = res[R_WTIME]
         if wt == wt and a >= wt:      # a confirmed violation earlier than this interval
             continue
+        sweep = depth < 0.0
+        e = b
+        if sweep:
+            # adaptive sub-interval (see _STEP_*): the prefix [a, a + L] of the uncovered [a, e]
+            b = a + (-depth)
+            if not b < e - 0.05 * (-depth):
+                b = e
+            depth = 0.0
+            if b > a:
+                depth = max(0.0, math.ceil(math.log2(W / (b - a)) - 1e-9))
         m = 0.5 * (a + b)
         bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad)
         spent += 1
         res[R_TESTS] += 1.0
         if depth > res[R_DEPTH]:
             res[R_DEPTH] = depth
+        excluded = False
+        gap = np.nan                   # estimate of the solid distance at m minus margin (step control)
         if lean:
             # core distance > margin + radii + bound (+ the subtraction pad) excludes I
             target = margin + rsum + bound
@@ -590,13 +631,28 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             # (no witness possible at m when the cores' lower bound exceeds floor: see below)
             floor = margin + rsum + approx
             floor += 2.0 * rel_pad * (abs(floor) + margin) + abs_pad
-            lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, floor, rel_pad, abs_pad, VA, VB, W, IA,
-                                  IB, lam, v, vn, X)
+            lb = -np.inf
+            if sweep:
+                # ask for _STEP_HEADROOM x the bound (a distance estimate for the step control);
+                # with floor = target, GJK returns a value > target whenever it can prove one
+                hi = max(margin + rsum + _STEP_HEADROOM * bound, target)
+                lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, hi, target, rel_pad, abs_pad, VA, VB, W4,
+                                      IA, IB, lam, v, vn, X)
+                if lb > target:
+                    sv = _norm3(v[0], v[1], v[2])
+                    gap = (lb if lb > hi else 0.5 * (lb + max(lb, sv))) - rsum - margin
+            if not lb > target and not lb > floor:
+                # (a bound above floor from the first call already rules out a witness: no second call)
+                lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, target, floor, rel_pad, abs_pad, VA, VB, W4,
+                                      IA, IB, lam, v, vn, X)
+            if not gap == gap:
+                sv = _norm3(v[0], v[1], v[2])
+                gap = 0.5 * (lb + max(lb, sv)) - rsum - margin
             if lb > target:
                 slack = lb - (target - margin)      # > margin: proven clearance over I
                 if slack < res[R_CLEAR]:
                     res[R_CLEAR] = slack
-                continue
+                excluded = True
             # No witness at m when the cores' lower bound already clears margin + radii +
             # the polytope error (+ rounding pads): posed_distance's upper bound ``up`` (of
             # the polytope cores, which lie within ``approx`` of the exact geoms) is
@@ -604,25 +660,70 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             # exclusion test ``lo - bound > margin`` needs lo >~ target, which lb <= target
             # (GJK found a point closer than target) leaves to rounding. The full distance
             # is skipped: the interval is split (this never certifies anything).
-            no_witness = lb > floor
+            no_witness = excluded or lb > floor
         else:
             no_witness = False
         if not no_witness:
             lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+            gap = up - margin
             if up + approx < margin:
                 res[R_WTIME] = m
                 for r in range(3):
                     res[R_WPOINT + r] = w[r]
                 res[R_WUPPER] = up + approx
-                # everything on the stack is later than m: search [a, m] only
+                # everything on the stack is later than m: search [a, m] only (a sweep again)
                 sp = 0
                 if depth < max_depth and a < m and bound >= epsilon:
-                    sp = _push(stack, 0, a, m, depth + 1.0)
+                    sp = _push(stack, 0, a, m, -0.5 * (m - a))
+                stack[mem, 2] = 0.0
                 continue
             slack = lo - bound - (rel_pad * (abs(lo) + bound + margin) + abs_pad)
             if slack > margin:
                 if slack < res[R_CLEAR]:
                     res[R_CLEAR] = slack
+                excluded = True
+        # -- step control (heuristic only: coverage and soundness never depend on it) -------
+        slope = 0.0
+        if stack[mem, 2] == 1.0 and m != stack[mem, 0]:
+            slope = (gap - stack[mem, 1]) / (m - stack[mem, 0])
+        if gap == gap and abs(gap) < np.inf:
+            stack[mem, 0] = m
+            stack[mem, 1] = gap
+            stack[mem, 2] = 1.0
+        else:
+            stack[mem, 2] = 0.0
+        if not (abs(slope) < np.inf):
+            slope = 0.0
+        L_old = b - a
+        rate = bound / L_old if L_old > 0.0 else np.inf     # bound per second of interval
+        den = rate - 0.5 * _STEP_SAFETY * slope
+        if excluded:
+            if sweep and b < e:
+                # largest L with rate L <= safety * (predicted gap at b + L / 2)
+                gb_pred = gap + slope * (b - m)
+                L_new = _STEP_GROW * L_old
+                if den > 0.0:
+                    L_new = _STEP_SAFETY * gb_pred / den
+                if not L_new >= 0.5 * L_old:
+                    L_new = 0.5 * L_old
+                L_new = min(L_new, _STEP_GROW * L_old)
+                if rate > 0.0:
+                    L_new = max(L_new, epsilon / rate)      # keep the bound at about epsilon or more
+                L_new = max(L_new, Lmin)
+                sp = _push(stack, sp, b, e, -L_new)
+            continue
+        if sweep:
+            if bound >= epsilon and depth < max_depth and a < m < b:
+                L_new = 0.5 * L_old
+                if den > 0.0 and gap > 0.0:
+                    L_new = _STEP_SAFETY * gap / den
+                L_new = min(max(L_new, 0.125 * L_old), 0.5 * L_old)
+                if rate * L_new >= epsilon and L_new >= Lmin:
+                    sp = _push(stack, sp, a, e, -L_new)     # retry a shorter prefix of [a, e]
+                    continue
+            if b < e:
+                # at the epsilon scale: plain bisection of everything left, [a, e]
+                sp = _push(stack, sp, a, e, max(0.0, math.floor(math.log2(W / (e - a)))))
                 continue
         if not (bound >= epsilon) or depth >= max_depth or not (a < m < b):
             if wt == wt:               # refining an earlier witness: contact may start here
