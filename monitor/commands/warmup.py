@@ -34,6 +34,13 @@ def run(args: argparse.Namespace) -> int:
         ok &= good
         note = "" if good else f"  (expected {_EXPECTED[name]})"
         print(f"  {name:18s} {verdict:10s} {seconds:8.2f} s{note}")
+    comp = rep.get("compiled", {})
+    if comp.get("functions"):
+        print(f"  compiled {comp['functions']} numba functions in {comp['seconds']:.1f} s; entry points:")
+        for name, seconds in sorted(comp["entry_points"].items(), key=lambda kv: -kv[1]):
+            print(f"    {name:58s} {seconds:8.2f} s")
+    else:
+        print("  nothing compiled: every kernel loaded from the on-disk numba cache")
     print(f"monitor warmup: certification kernels ready in {rep['seconds']:.1f} s "
           "(numba machine code cached on disk for later processes)")
     return 0 if ok else 1
