@@ -2,8 +2,9 @@
 
 The checkers' kernels are numba functions compiled on first use (``cache=True`` keeps
 the machine code on disk, so later processes only load it). Compilation is not
-certification work: with an empty cache it takes about 15 s on this project's 2-core
-machine, and inside a budgeted ``certify`` call it would turn the first windows of a
+certification work: with an empty cache it takes about 50 s of CPU on this project's
+2-core machine (docs/notes/issue-12-coldstart.md: the whole-window kernel, the motion
+kernels, GJK, the null-set LP), and inside a budgeted ``certify`` call it would turn the first windows of a
 fresh process ``uncertain`` (the demo's first action was blocked for this reason).
 
 :func:`ensure_warm` certifies a few tiny motions on a built-in scene (a hinged capsule arm

@@ -158,8 +158,10 @@ def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
     EB = gp.edges[gp.estart[gb]:gp.estart[gb + 1]]
     NA = gp.normals[gp.nstart[ga]:gp.nstart[ga + 1]]
     NB = gp.normals[gp.nstart[gb]:gp.nstart[gb + 1]]
+    # np.int64(...): int64, not Literal[int], so this is the specialisation the Python callers
+    # (monitor.geometry.distance) compile too: one compile of core_distance per process
     core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, ka, kb, gp.dpad[ga], gp.dpad[gb], rel_pad, abs_pad,
-                  _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+                  _EPS_REL, np.int64(_MAX_ITER), np.int64(_MAX_EDGE_PAIRS), out)
     for r in range(3):
         w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pa[r]
     if ka == 2 and kb == 2 and out[0] != 0.0 and not out[3] < 0.0:

@@ -1,7 +1,9 @@
 """``monitor warmup``: compile the certification kernels once and say how long it took.
 
-The first ``certify`` of a process compiles the numba kernels (about 15 s with an empty
-on-disk cache, e.g. right after installing; well under a second once cached). ``certify``
+The first ``certify`` of a process compiles the numba kernels (about 50 s of CPU with an
+empty on-disk cache, e.g. right after installing; well under a second once cached). The
+command prints each case, the number of numba functions compiled and the compiled entry
+points with their seconds ("nothing compiled" when everything came from the cache). ``certify``
 does this before starting its default budget, so compilation never makes a window
 "uncertain"; run this command after installing (the quick-start scripts do) so that the
 first gated step of every later process is fast, and so that an explicit ``budget`` is

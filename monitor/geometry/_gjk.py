@@ -945,7 +945,8 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
             r_in = _tetra_inradius(W, pad_coord, rel_pad)
             if any_polytope:
                 lb_epa = np.full(1, -np.inf)
-                r_in = max(r_in, _epa_inradius(VA, VB, W, pad_coord, rel_pad, 32, lb_epa))
+                # np.int64(32): the int64 specialisation Python callers get too (literal 32: another one)
+                r_in = max(r_in, _epa_inradius(VA, VB, W, pad_coord, rel_pad, np.int64(32), lb_epa))
                 if lb_epa[0] > sat:
                     sat = lb_epa[0]
             if r_in > 0.0 and -r_in < upper:
