@@ -142,18 +142,18 @@ _MAX_ITER = 200
 _MAX_EDGE_PAIRS = 2_000_000
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _norm3(x, y, z):
     return math.sqrt(x * x + y * y + z * z)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _chord(angle):
     a = min(angle, math.pi)
     return 2.0 * math.sin(0.5 * a) * (1.0 + 4.0 * 2.0**-52)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
     """Rigorous signed distance bounds of geoms ga, gb of ``gp`` posed by (R, p) (world).
 
@@ -181,8 +181,10 @@ def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
     EB = gp.edges[gp.estart[gb]:gp.estart[gb + 1]]
     NA = gp.normals[gp.nstart[ga]:gp.nstart[ga + 1]]
     NB = gp.normals[gp.nstart[gb]:gp.nstart[gb + 1]]
+    # np.int64(...): int64, not Literal[int], so this is the specialisation the Python callers
+    # (monitor.geometry.distance) compile too: one compile of core_distance per process
     core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, ka, kb, gp.dpad[ga], gp.dpad[gb], rel_pad, abs_pad,
-                  _EPS_REL, _MAX_ITER, _MAX_EDGE_PAIRS, out)
+                  _EPS_REL, np.int64(_MAX_ITER), np.int64(_MAX_EDGE_PAIRS), out)
     for r in range(3):
         w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pa[r]
     if ka == 2 and kb == 2 and out[0] != 0.0 and not out[3] < 0.0:
@@ -190,7 +192,7 @@ def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
     return out[2] - ra - rb, out[3] - ra - rb
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
     """Overlapping polytopes whose GJK/EPA gave no negative upper bound (e.g. containment).
 
@@ -223,32 +225,34 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
                 out[7 + r] = x[r]
 
 
-@njit(cache=True)
-def _curved_support(gp, g, R, off, v, sign, pt):
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     """Max over the exact cylinder / ellipsoid g of (sign v) . x, posed by R and origin ``off``.
 
     Closed-form support functions (issue 12, item 2): cylinder (radius r, half length h,
     axis z of its frame) ``h(d) = r |d_xy| + h |d_z|``, ellipsoid ``h(d) = |diag(radii) d|``,
     with d in the geom frame, plus ``d . centre``. The value is computed in closed form;
-    the extreme point (for GJK's simplex only) goes into ``pt`` (3,).
+    the extreme point (for GJK's simplex only) goes into ``pt`` (3,). The geom g's rows of the
+    pack are passed (``gp.curve[g], gp.cparam[g], gp.cframe[g], gp.ccenter[g]``), not the pack:
+    a compiled function typed on the 22-array pack costs several times more to compile.
     """
     Rg = np.empty((3, 3))
     c = np.empty(3)
     for r in range(3):
         c[r] = off[r]
         for q in range(3):
-            c[r] += R[r, q] * gp.ccenter[g, q]
+            c[r] += R[r, q] * ccenter[q]
             acc = 0.0
             for j in range(3):
-                acc += R[r, j] * gp.cframe[g, j, q]
+                acc += R[r, j] * cframe[j, q]
             Rg[r, q] = acc
     dl = np.empty(3)
     for q in range(3):
         dl[q] = sign * (Rg[0, q] * v[0] + Rg[1, q] * v[1] + Rg[2, q] * v[2])
     val = sign * (c[0] * v[0] + c[1] * v[1] + c[2] * v[2])
     loc = np.empty(3)
-    if gp.curve[g] == 1:
-        rad, hh = gp.cparam[g, 0], gp.cparam[g, 1]
+    if curve == 1:
+        rad, hh = cparam[0], cparam[1]
         rho = math.sqrt(dl[0] * dl[0] + dl[1] * dl[1])
         val += rad * rho + hh * abs(dl[2])
         if rho > 0.0:
@@ -257,21 +261,21 @@ def _curved_support(gp, g, R, off, v, sign, pt):
             loc[0], loc[1] = rad, 0.0
         loc[2] = hh if dl[2] >= 0.0 else -hh
     else:
-        e0, e1, e2 = gp.cparam[g, 0] * dl[0], gp.cparam[g, 1] * dl[1], gp.cparam[g, 2] * dl[2]
+        e0, e1, e2 = cparam[0] * dl[0], cparam[1] * dl[1], cparam[2] * dl[2]
         nrm = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         val += nrm
         if nrm > 0.0:
-            loc[0] = gp.cparam[g, 0] * e0 / nrm
-            loc[1] = gp.cparam[g, 1] * e1 / nrm
-            loc[2] = gp.cparam[g, 2] * e2 / nrm
+            loc[0] = cparam[0] * e0 / nrm
+            loc[1] = cparam[1] * e1 / nrm
+            loc[2] = cparam[2] * e2 / nrm
         else:
-            loc[0], loc[1], loc[2] = gp.cparam[g, 0], 0.0, 0.0
+            loc[0], loc[1], loc[2] = cparam[0], 0.0, 0.0
     for r in range(3):
         pt[r] = c[r] + Rg[r, 0] * loc[0] + Rg[r, 1] * loc[1] + Rg[r, 2] * loc[2]
     return val
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v,
                      vn, X):
     """The best separating-axis lower bound on ``dist(core_a, core_b)`` found (early-exit GJK), or -inf.
@@ -339,7 +343,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
             return best
         sv = math.sqrt(vv)
         if curved_a:
-            ia, sa = -1, -_curved_support(gp, ga, Ra, zero, v, -1.0, xa)
+            ia, sa = -1, -_curved_support(gp.curve[ga], gp.cparam[ga], gp.cframe[ga], gp.ccenter[ga], Ra,
+                                          zero, v, -1.0, xa)
         else:
             ia, sa = 0, np.inf
             for i in range(na):
@@ -349,7 +354,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
             for r in range(3):
                 xa[r] = VA[ia, r]
         if curved_b:
-            ib, sb = -1, _curved_support(gp, gb, Rb, off_b, v, 1.0, xb)
+            ib, sb = -1, _curved_support(gp.curve[gb], gp.cparam[gb], gp.cframe[gb], gp.ccenter[gb], Rb,
+                                         off_b, v, 1.0, xb)
         else:
             ib, sb = 0, -np.inf
             for i in range(nb):
@@ -393,20 +399,25 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
     return best
 
 
-@njit(cache=True)
-def _lever(gp, g, ref):
-    """Max over g's core vertices of |v - ref| (body frame), padded."""
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _lever(P, ref):
+    """Max over the core vertices P (n, 3) of a geom of |v - ref| (body frame), padded.
+
+    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]``, not the pack (compile cost).
+    """
     lv = 0.0
-    for i in range(gp.vstart[g], gp.vstart[g + 1]):
-        lv = max(lv, _norm3(gp.verts[i, 0] - ref[0], gp.verts[i, 1] - ref[1], gp.verts[i, 2] - ref[2]))
+    for i in range(P.shape[0]):
+        lv = max(lv, _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2]))
     return lv * (1.0 + 4.0 * 2.0**-52)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     """Relative displacement bound delta_rel over the rows of P (points of A, body frame).
 
-    Returns max_i delta_rel(P_i) if not ``weighted``, else sqrt(sum_i w_i delta_rel(P_i)^2) (= R).
+    Returns max_i delta_rel(P_i) if ``weighted == 0.0``, else sqrt(sum_i w_i delta_rel(P_i)^2) (= R).
+    ``weighted`` is a float, not a bool: numba compiles a separate copy for each literal
+    ``True`` / ``False`` argument, not for float constants.
     B's reference point c_B is taken to world by (RB, pB), A's points by (RA, pA); only the
     difference pA - pB of the translations enters.
     """
@@ -422,16 +433,21 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
         y1 = RA[1, 0] * x0 + RA[1, 1] * x1 + RA[1, 2] * x2 - qb1
         y2 = RA[2, 0] * x0 + RA[2, 1] * x1 + RA[2, 2] * x2 - qb2
         d = TA + chA * dA + TB + chB * _norm3(y0, y1, y2)
-        if weighted:
+        if weighted != 0.0:
             acc += w[i] * d * d
         else:
             acc = max(acc, d)
-    if weighted:
+    if weighted != 0.0:
         return math.sqrt(acc)
     return acc
 
 
-@njit(cache=True)
+# Compile structure (issue 12 item 7, docs/notes/issue-12-coldstart.md): interval_bound and pair_window
+# have one compiled caller each on the certify path, so numba inlines them there (inline="always"):
+# a separate compile re-optimises and re-emits their whole linked callee tree once more. Python
+# callers still get a compiled pair_window. Small helpers stay separate functions (inlining them
+# per call site costs more compile time), and nothing Python never calls gets a CPython wrapper.
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
 def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
@@ -463,24 +479,24 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
         best = TA + chA * levers[0] + TB + chB * levers[1]
     if not hsA:
         PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
-        d = _rel_terms(PA, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, gp.mw, False)
+        d = _rel_terms(PA, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, gp.mw, 0.0)
         if d < best:
             best = d
         M = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
         W = gp.mw[gp.mstart[ga]:gp.mstart[ga + 1]]
-        d = _rel_terms(M, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, W, True) * gp.rho_max[ga]
+        d = _rel_terms(M, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, W, 1.0) * gp.rho_max[ga]
         if d < best:
             best = d
             paper = True
     if not hsB:
         PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
-        d = _rel_terms(PB, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, gp.mw, False)
+        d = _rel_terms(PB, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, gp.mw, 0.0)
         if d < best:
             best = d
             paper = False
         M = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
         W = gp.mw[gp.mstart[gb]:gp.mstart[gb + 1]]
-        d = _rel_terms(M, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, W, True) * gp.rho_max[gb]
+        d = _rel_terms(M, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, W, 1.0) * gp.rho_max[gb]
         if d < best:
             best = d
             paper = True
@@ -493,7 +509,7 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     return best * (1.0 + 8.0 * rel_pad) + pad
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _push(stack, sp, a, b, depth):
     stack[sp, 0] = a
     stack[sp, 1] = b
@@ -501,7 +517,7 @@ def _push(stack, sp, a, b, depth):
     return sp + 1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
 def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
                 stack, res):
     """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
@@ -544,9 +560,9 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     if gp.kind[ga] != -1:
-        levers[0] = _lever(gp, ga, mp.ref_points[gp.body[ga]])
+        levers[0] = _lever(gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]], mp.ref_points[gp.body[ga]])
     if gp.kind[gb] != -1:
-        levers[1] = _lever(gp, gb, mp.ref_points[gp.body[gb]])
+        levers[1] = _lever(gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]], mp.ref_points[gp.body[gb]])
     lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
     rsum = gp.radius[ga] + gp.radius[gb]
     VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
@@ -751,7 +767,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     return CERTIFIED
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def pairs_window(gp, mp, pairs, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad, res):
     """:func:`pair_window` for every row of ``pairs`` (P, 2) int64; results into ``res`` (P, R_SIZE).
 
@@ -796,7 +812,7 @@ WI_SIZE = 5
 computed (m), tests spent, survivors, deepest level."""
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def sphere_gap(sc, sr, ga, gb, pad):
     """Min over sub-intervals of |c_a - c_b| - r_a - r_b, minus ``pad`` (-inf if not all finite)."""
     g = np.inf
@@ -810,7 +826,7 @@ def sphere_gap(sc, sr, ga, gb, pad):
     return g - pad
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _halfspace_gap(n, q, bh, c, sc, sr, trans, ang, rot, pos, pad):
     """Certified gap of geom c's swept spheres from a half-space (unit normal n, point q, body bh).
 
@@ -837,7 +853,7 @@ def _halfspace_gap(n, q, bh, c, sc, sr, trans, ang, rot, pos, pad):
             g = d
     return g - pad
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr,
                   info):
     """One window of a packed scene and motion: cull, start pose, whole-shape stage (no Python per pair).

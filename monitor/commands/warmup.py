@@ -1,7 +1,9 @@
 """``monitor warmup``: compile the certification kernels once and say how long it took.
 
-The first ``certify`` of a process compiles the numba kernels (about 15 s with an empty
-on-disk cache, e.g. right after installing; well under a second once cached). ``certify``
+The first ``certify`` of a process compiles the numba kernels (about 50 s of CPU with an
+empty on-disk cache, e.g. right after installing; well under a second once cached). The
+command prints each case, the number of numba functions compiled and the compiled entry
+points with their seconds ("nothing compiled" when everything came from the cache). ``certify``
 does this before starting its default budget, so compilation never makes a window
 "uncertain"; run this command after installing (the quick-start scripts do) so that the
 first gated step of every later process is fast, and so that an explicit ``budget`` is
@@ -34,6 +36,13 @@ def run(args: argparse.Namespace) -> int:
         ok &= good
         note = "" if good else f"  (expected {_EXPECTED[name]})"
         print(f"  {name:18s} {verdict:10s} {seconds:8.2f} s{note}")
+    comp = rep.get("compiled", {})
+    if comp.get("functions"):
+        print(f"  compiled {comp['functions']} numba functions in {comp['seconds']:.1f} s; entry points:")
+        for name, seconds in sorted(comp["entry_points"].items(), key=lambda kv: -kv[1]):
+            print(f"    {name:58s} {seconds:8.2f} s")
+    else:
+        print("  nothing compiled: every kernel loaded from the on-disk numba cache")
     print(f"monitor warmup: certification kernels ready in {rep['seconds']:.1f} s "
           "(numba machine code cached on disk for later processes)")
     return 0 if ok else 1

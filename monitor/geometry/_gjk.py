@@ -59,19 +59,19 @@ OUT_SIZE = 12
 """Layout of the output row: status, estimate, lower, upper, p_a (3), p_b (3), pad, iters."""
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _transform(P, R, t, out):
     """out[i] = R @ P[i] + t."""
     for i in range(P.shape[0]):
@@ -79,14 +79,14 @@ def _transform(P, R, t, out):
             out[i, r] = R[r, 0] * P[i, 0] + R[r, 1] * P[i, 1] + R[r, 2] * P[i, 2] + t[r]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rotate(N, R, out):
     for i in range(N.shape[0]):
         for r in range(3):
             out[i, r] = R[r, 0] * N[i, 0] + R[r, 1] * N[i, 1] + R[r, 2] * N[i, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _support_max(V, d):
     """(index, value) of max_i V[i] . d."""
     best = -np.inf
@@ -99,7 +99,7 @@ def _support_max(V, d):
     return bi, best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _support_min(V, d):
     """(index, value) of min_i V[i] . d."""
     best = np.inf
@@ -112,7 +112,7 @@ def _support_min(V, d):
     return bi, best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _axis_bound(VA, VB, n):
     """-h_D(n) / |n| = (min_b n.b - max_a n.a) / |n|: a lower bound on the signed distance.
 
@@ -126,7 +126,7 @@ def _axis_bound(VA, VB, n):
     return (lb - ha) / nn
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _subalgorithm(W, k, lam_out, v_out, tiny_len2, tiny_area2):
     """Min-norm point of conv(W[:k]) (k <= 4) by enumerating faces, edges, vertices.
 
@@ -265,7 +265,7 @@ def _subalgorithm(W, k, lam_out, v_out, tiny_len2, tiny_area2):
     return best_mask, False
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _compact(mask, k, W, IA, IB, lam):
     """Keep the simplex points in ``mask``; returns the new count."""
     m = 0
@@ -283,7 +283,7 @@ def _compact(mask, k, W, IA, IB, lam):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _depth_at(V, N, x):
     """min_i (h_V(N_i) - N_i . x) / |N_i|: the depth of x in the polytope conv(V).
 
@@ -303,7 +303,7 @@ def _depth_at(V, N, x):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _low_dim_depth(V, N, C, x_out):
     """Deepest point of a point / segment core C (1 or 2 rows) inside the polytope (V, N).
 
@@ -358,7 +358,7 @@ def _low_dim_depth(V, N, C, x_out):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _tetra_inradius(W, pad_coord, rel_pad):
     """Certified radius r of a ball B(0, r) inside the tetrahedron W (4, 3), or 0.
 
@@ -396,7 +396,7 @@ def _tetra_inradius(W, pad_coord, rel_pad):
     return max(r_min, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _face_plane(P, i, j, k, pad_coord, rel_pad, nout):
     """Oriented triangle (i, j, k) of P: unit normal (Pj-Pi)x(Pk-Pi) into ``nout``.
 
@@ -424,7 +424,7 @@ def _face_plane(P, i, j, k, pad_coord, rel_pad, nout):
     return dist, dist - pad
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
     """Certified radius r of a ball B(0, r) inside the Minkowski difference, by EPA.
 
@@ -451,7 +451,7 @@ def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
     for q in range(4):
         for r in range(3):
             P[q, r] = W[q, r]
-    nv = 4
+    nv = np.int64(4)   # not the literal 4: numba would compile _face_plane for Literal[int](4) too
     F = np.empty((maxf, 3), np.int64)
     alive = np.zeros(maxf, np.bool_)
     fn = np.empty((maxf, 3))
@@ -564,7 +564,15 @@ def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
             for q in range(3):
                 keys[m] = F[g, q] * maxv + F[g, (q + 1) % 3]
                 m += 1
-    keys.sort()
+    # sort (insertion sort: the same order as np.sort for integers, and no separate compile of
+    # numba's quicksort and searchsorted; the verification runs only on overlapping pairs)
+    for q in range(1, m):
+        key = keys[q]
+        i = q - 1
+        while i >= 0 and keys[i] > key:
+            keys[i + 1] = keys[i]
+            i -= 1
+        keys[i + 1] = key
     # closedness: every directed edge (a, b) exactly once and its reverse (b, a) present
     for q in range(m):
         if q > 0 and keys[q] == keys[q - 1]:
@@ -572,7 +580,14 @@ def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
         a = keys[q] // maxv
         b = keys[q] % maxv
         rk = b * maxv + a
-        pos = np.searchsorted(keys, rk)
+        lo_i, hi_i = 0, m            # np.searchsorted(keys, rk) (side="left"), by bisection
+        while lo_i < hi_i:
+            mid = (lo_i + hi_i) // 2
+            if keys[mid] < rk:
+                lo_i = mid + 1
+            else:
+                hi_i = mid
+        pos = lo_i
         if pos >= m or keys[pos] != rk:
             return 0.0
     r_min = np.inf
@@ -601,7 +616,7 @@ def _epa_inradius(VA, VB, W, pad_coord, rel_pad, max_iter, lb_out):
     return max(r_min, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
     """Max over candidate directions of -h_D(n)/|n| (A-to-B directions).
 
@@ -664,7 +679,7 @@ def _sat_lower(VA, VB, EA, EB, NA, NB, any_polytope, max_edge_pairs, v):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _simplex_directions_bound(VA, VB, W, k):
     """Best axis bound over directions from the sub-simplices of W[:k] (A-to-B sign).
 
@@ -702,7 +717,7 @@ def _simplex_directions_bound(VA, VB, W, k):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _edge_perp_bound(VA, VB, EA, EB, v):
     """Best axis bound over v projected perpendicular to each edge direction of A and B."""
     best = -np.inf
@@ -727,7 +742,7 @@ def _edge_perp_bound(VA, VB, EA, EB, v):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def pose_relative(PA, RA, tA, NA, PB, RB, tB, NB):
     """Both cores posed in the world frame shifted by ``tA`` (A's translation becomes 0).
 
@@ -750,7 +765,7 @@ def pose_relative(PA, RA, tA, NA, PB, RB, tB, NB):
     return VA, VB, WNA, WNB
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a, dpad_b, rel_pad,
                   abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """Signed distance bounds of two cores (point / segment / polytope vertex sets).
@@ -930,7 +945,8 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
             r_in = _tetra_inradius(W, pad_coord, rel_pad)
             if any_polytope:
                 lb_epa = np.full(1, -np.inf)
-                r_in = max(r_in, _epa_inradius(VA, VB, W, pad_coord, rel_pad, 32, lb_epa))
+                # np.int64(32): the int64 specialisation Python callers get too (literal 32: another one)
+                r_in = max(r_in, _epa_inradius(VA, VB, W, pad_coord, rel_pad, np.int64(32), lb_epa))
                 if lb_epa[0] > sat:
                     sat = lb_epa[0]
             if r_in > 0.0 and -r_in < upper:
@@ -969,7 +985,7 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
     out[11] = it
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, kind_a, kind_b, dpad_a, dpad_b,
                         rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out):
     """:func:`core_distance` for T poses: RAs (T, 3, 3), tAs (T, 3), ...; out (T, OUT_SIZE)."""
@@ -978,7 +994,7 @@ def core_distance_batch(PA, RAs, tAs, EA, NA, PB, RBs, tBs, EB, NB, kind_a, kind
                       rel_pad, abs_pad, eps_rel, max_iter, max_edge_pairs, out[t])
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def halfspace_distance(nH, bH, RH, tH, PC, RC, tC, rel_pad, abs_pad, out):
     """Signed distance of a core (vertex set PC posed by RC, tC) from a half-space.
 

@@ -36,6 +36,13 @@ raises (no divisor can be 0 on valid packs; an overflow gives inf/NaN, and NaN b
 returned as inf/pi as above), which also drops the ZeroDivisionError branches from the code.
 Helpers take plain arrays, not the pack: each compiled function taking the 25-array pack
 costs about a second of cold compile, so only the entry points take it.
+Cold-compile structure (issue 12 item 7, ``docs/notes/issue-12-coldstart.md``): no cfunc
+wrapper anywhere and no CPython wrapper on what Python never calls (``no_*_wrapper``);
+the thin wrappers :func:`body_bound` and :func:`tree_bounds` are ``inline="always"``
+(numba inlines them into their compiled callers, so they are not a separate level: numba
+re-optimises and re-emits the whole linked callee tree at every level). Do not inline the
+small helpers: numba inlines per call site at the untyped-IR stage, which costs far more
+compile time than a separate compile (measured 1.66x slower), and LLVM inlines them anyway.
 
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
@@ -72,7 +79,7 @@ TOL_PATHMAG = 5
 
 
 # ------------------------------------------------------------------ small helpers
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _chord(a: float) -> float:
     """2 sin(min(a, pi) / 2)."""
     if a > math.pi:
@@ -80,7 +87,7 @@ def _chord(a: float) -> float:
     return 2.0 * math.sin(0.5 * a)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _sinc(x: float) -> float:
     """sin(x) / x (np.sinc(x / pi))."""
     if x == 0.0:
@@ -88,12 +95,12 @@ def _sinc(x: float) -> float:
     return math.sin(x) / x
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _norm3(x: float, y: float, z: float) -> float:
     return math.sqrt(x * x + y * y + z * z)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _search_right(times: np.ndarray, t: float) -> int:
     """Number of entries <= t (np.searchsorted side='right')."""
     lo = 0
@@ -107,7 +114,7 @@ def _search_right(times: np.ndarray, t: float) -> int:
     return lo
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _search_left(times: np.ndarray, t: float) -> int:
     """Number of entries < t (np.searchsorted side='left')."""
     lo = 0
@@ -121,7 +128,7 @@ def _search_left(times: np.ndarray, t: float) -> int:
     return lo
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _locate(times: np.ndarray, t: float) -> tuple[int, float, bool]:
     """(segment i, parameter s in [0, 1], at_end) as ``Segments.locate``."""
     K = times.shape[0]
@@ -138,7 +145,7 @@ def _locate(times: np.ndarray, t: float) -> tuple[int, float, bool]:
     return i, s, t >= times[K - 1]
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _quat_mul(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
     """Set out = a * b (Hamilton, MuJoCo's mju_mulQuat); out may alias a or b."""
     w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3]
@@ -151,7 +158,7 @@ def _quat_mul(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
     out[3] = z
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _quat_normalize(q: np.ndarray) -> None:
     n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     if n > 0.0:
@@ -166,7 +173,7 @@ def _quat_normalize(q: np.ndarray) -> None:
         q[3] = 0.0
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
     """R (3, 3) of a unit quaternion q (w, x, y, z)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -181,7 +188,7 @@ def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
     R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Set out = R(q) v for a unit quaternion q (v and out (3,), may not alias)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -191,7 +198,7 @@ def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     out[2] = 2.0 * (x * z - w * y) * v0 + 2.0 * (y * z + w * x) * v1 + (1.0 - 2.0 * (x * x + y * y)) * v2
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Rotation angle (rad, [0, pi]) of R(a) R(b)^T, as ``_kinematics.quat_angle``."""
     d = 0.0
@@ -205,7 +212,7 @@ def _quat_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 # ------------------------------------------------------------------ interpolation
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float:
     """Interpolated qpos column c at (segment i, parameter s)."""
     q = qpos
@@ -215,7 +222,7 @@ def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float
     return a + s * (q[i + 1, c] - a)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
            qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
@@ -238,7 +245,7 @@ def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: n
         out[c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
              qt_target: np.ndarray, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
     """Interpolated qpos (nq,) at (segment i, parameter s)."""
@@ -253,13 +260,13 @@ def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half:
             out[adr + c] = tmp[c]
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _track_path(qt_cum: np.ndarray, qt_phi: np.ndarray, k: int, i: int, s: float) -> float:
     return qt_cum[k, i] + s * qt_phi[k, i]
 
 
 # ------------------------------------------------------------------ forward kinematics
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
         body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
         jnt_pos: np.ndarray, jnt_axis: np.ndarray, jnt_axis_norm: np.ndarray, qpos0: np.ndarray,
@@ -351,7 +358,7 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         _quat_to_mat(xquat[b], xmat[b])
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
     """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
     need[:] = 0
@@ -363,7 +370,7 @@ def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
         c = body_parent[c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
     """World pose of ``body`` at time ``t``: origin p_W_out (3,) m and rotation R_WB_out (3, 3)."""
     nbody = mp.body_parent.shape[0]
@@ -388,7 +395,7 @@ def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray
             R_WB_out[r, c] = xmat[body, r, c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
     """World poses of every body at time ``t``: p_W_out (nbody, 3), R_WB_out (nbody, 3, 3)."""
     nbody = mp.body_parent.shape[0]
@@ -407,7 +414,7 @@ def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
 
 
 # ------------------------------------------------------------------ joint deviations
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _col_dev(qpos: np.ndarray, c: int, qm_c: float, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of |q_c(t) - q_c(m)| (scalar_deviation)."""
     va = _lerp_col(qpos, c, la[0], la[1], la[2])
@@ -420,7 +427,7 @@ def _col_dev(qpos: np.ndarray, c: int, qm_c: float, la, lb, lo: int, hi: int) ->
     return dev
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _vec_dev(qpos: np.ndarray, adr: int, qm: np.ndarray, la, lb, lo: int, hi: int) -> float:
     """Maximum over the vertices of ||x(t) - x(m)|| for qpos columns adr..adr+2 (vector_deviation)."""
     da = 0.0
@@ -439,7 +446,7 @@ def _vec_dev(qpos: np.ndarray, adr: int, qm: np.ndarray, la, lb, lo: int, hi: in
     return dev
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np.ndarray, qt_phi: np.ndarray,
              k: int, qm_unit: np.ndarray, ta: float, tb: float, tm: float, lm, lo: int, hi: int) -> float:
     """Bound on the rotation angle of track k from the midpoint over [ta, tb] (rotation_deviation)."""
@@ -470,7 +477,7 @@ def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np
     return min(dev, math.pi)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _track_omega(qpos: np.ndarray, qt_adr: np.ndarray, qt_target: np.ndarray, qt_phi: np.ndarray, k: int,
                  seg: int, out: np.ndarray) -> None:
     """Angular velocity (3,) per unit segment parameter of track k on segment seg.
@@ -491,7 +498,7 @@ def _track_omega(qpos: np.ndarray, qt_adr: np.ndarray, qt_target: np.ndarray, qt
 
 
 # ------------------------------------------------------------------ bounds
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: np.ndarray,
                     r0: np.ndarray, suffix: np.ndarray, rmax: np.ndarray, h: float, rel: float, qmag: float,
                     pathmag: float, scale: float) -> tuple[float, float]:
@@ -568,7 +575,7 @@ def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: 
         Th2 += rel * (4.0 * h * wrot_sum + mag * L)
     return T2, Th2
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
@@ -773,7 +780,7 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
         trans[b] = t_out
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
 def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
                R_WB_out: np.ndarray) -> tuple[float, float]:
     """Pose of ``body`` at m = (ta + tb) / 2 and its certified (trans m, angle rad) over [ta, tb].
@@ -796,7 +803,7 @@ def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
     return trans[body], angle[body]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
 def tree_bounds(mp, ta: float, tb: float, p_W_out: np.ndarray, R_WB_out: np.ndarray,
                 trans_out: np.ndarray, angle_out: np.ndarray) -> None:
     """Poses at m = (ta + tb) / 2 and certified bounds over [ta, tb] of every body, in one pass.
@@ -813,7 +820,7 @@ BATCH_POSES = 1
 BATCH_SCALE = 2
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: np.ndarray,
           trans: np.ndarray, angle: np.ndarray) -> float:
     """Batched entry point of the Python helpers (one compiled function for all three modes).
@@ -858,7 +865,7 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
     return big + ref_norm + whole + 2.0 * ref_norm
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 def derive(qpos: np.ndarray, body_parent: np.ndarray, body_mocap: np.ndarray, body_jntadr: np.ndarray,
            body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray, moving: np.ndarray,
            rotating: np.ndarray, tol: np.ndarray) -> None:
