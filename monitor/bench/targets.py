@@ -81,6 +81,22 @@ TARGETS: tuple[TargetSpec, ...] = (
         "pusher", "SafetyGate(Pusher-v5, pairs='mujoco') step", "ungated Pusher-v5 step", "x", 3.0, 5.0
     ),
     TargetSpec("arm", "SafetyGate(monitor/Arm-v0) step", "ungated monitor/Arm-v0 step", "x", 5.0, 10.0),
+    TargetSpec(
+        "pusher_nobrake",
+        "diagnostic, not a target: SafetyGate(Pusher-v5, pairs='mujoco', brake=False) step",
+        "ungated Pusher-v5 step",
+        "x",
+        None,
+        None,
+    ),
+    TargetSpec(
+        "arm_nobrake",
+        "diagnostic, not a target: SafetyGate(monitor/Arm-v0, brake=False) step",
+        "ungated monitor/Arm-v0 step",
+        "x",
+        None,
+        None,
+    ),
     TargetSpec("tunnel", "Gate.step on models/tunnel", "mj_step loop of the same window", "x", 3.0, 5.0),
     TargetSpec(
         "hand30",
@@ -360,9 +376,10 @@ def _blocks(runs: dict[str, Callable[[int], float]], reps: int) -> dict[str, lis
 
 
 def gym_gate(
-    env_id: str, *, pairs: Any = "mujoco", steps_gated: int, steps_ungated: int, reps: int
+    env_id: str, *, pairs: Any = "mujoco", steps_gated: int, steps_ungated: int, reps: int,
+    brake: bool = True,
 ) -> dict[str, Any]:
-    """Seconds per ``env.step`` of ``SafetyGate(gym.make(env_id), pairs=pairs)`` and of the bare env.
+    """Seconds per ``env.step`` of ``SafetyGate(gym.make(env_id), pairs=pairs, brake=brake)``, bare env.
 
     Both see the same seeded action sequences; one untimed warm-up block each (the gate resolves
     its ACM and loads kernels on its first step). Returns medians over ``reps`` interleaved blocks.
@@ -373,7 +390,7 @@ def gym_gate(
         import monitor.envs  # noqa: F401
     from monitor.gym_gate import SafetyGate
 
-    envs = {"ungated": gym.make(env_id), "gated": SafetyGate(gym.make(env_id), pairs=pairs)}
+    envs = {"ungated": gym.make(env_id), "gated": SafetyGate(gym.make(env_id), pairs=pairs, brake=brake)}
     verdicts: Counter = Counter()
 
     def block(name: str, n: int, rep: int, count: bool = True) -> float:
@@ -411,6 +428,7 @@ def gym_gate(
     return {
         "env": env_id,
         "pairs": pairs,
+        "brake": brake,
         "monitored_pairs": npairs,
         "pair_names": names,
         "candidate_pairs": candidates,
@@ -738,17 +756,22 @@ def suite_targets(cfg: Any) -> dict[str, Any]:
     gsteps, usteps = (2, 10) if smoke else (10, 200) if cfg.quick else (30, 1000)
     reps = 1 if smoke else cfg.reps
     gyms: dict[str, Any] = {}
-    for key, env_id, pairs, what in (
-        ("pusher", "Pusher-v5", "mujoco", "pairs='mujoco': the wrist geoms against the table and the object"),
-        ("arm", "monitor/Arm-v0", "mujoco", "pairs='mujoco' (the gate's default)"),
+    # The *_nobrake rows are diagnostics (no target): the same gate without the recoverability
+    # check, whose braking tail (brake_horizon 0.25 s) is simulated on every accepted step.
+    for key, env_id, pairs, what, brake in (
+        ("pusher", "Pusher-v5", "mujoco", "pairs='mujoco': the wrist geoms against the table and the object",
+         True),
+        ("arm", "monitor/Arm-v0", "mujoco", "pairs='mujoco' (the gate's default)", True),
+        ("pusher_nobrake", "Pusher-v5", "mujoco", "as the Pusher row, without the braking tail", False),
+        ("arm_nobrake", "monitor/Arm-v0", "mujoco", "as the Arm row, without the braking tail", False),
     ):
-        if smoke and key == "pusher":
+        if smoke and key != "arm":
             rows.append(target_row(SPECS[key], None, note="not measured in a smoke run"))
             continue
         r = _guard(
             key,
-            lambda e=env_id, p=pairs: gym_gate(
-                e, pairs=p, steps_gated=gsteps, steps_ungated=usteps, reps=reps
+            lambda e=env_id, p=pairs, b=brake: gym_gate(
+                e, pairs=p, steps_gated=gsteps, steps_ungated=usteps, reps=reps, brake=b
             ),
             errors,
             log,
