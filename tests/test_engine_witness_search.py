@@ -85,3 +85,43 @@ def test_a_test_budget_leaves_the_pair_undecided_not_certified():
     for n in (1, 10, 100, 300):
         cert = monitor.certify(scene, plan, method="toleranced", budget={"tests": n})
         assert cert.verdict in ("violation", "uncertain"), (n, cert.stats)
+
+
+_MIXED_XML = """<mujoco><worldbody>
+  <geom name="floor" type="plane" size="2 2 0.1"/>
+  <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.8 0 0"/>
+  <body name="slider" pos="0 0.5 0.2"><joint name="s" type="slide" axis="1 0 0"/>
+    <geom name="sb" type="box" size="0.05 0.05 0.05"/>
+    <body name="spin" pos="0 0 0.2"><joint name="r" type="hinge" axis="0 0 1"/>
+      <geom name="rb" type="box" size="0.1 0.02 0.02"/></body></body>
+  <body name="free" pos="0 -0.5 0.3"><freejoint/><geom name="fb" type="sphere" size="0.05"/></body>
+  <body name="still" pos="0.3 0.3 0.3"><joint name="z" type="slide" axis="0 0 1"/>
+    <geom name="sg" type="sphere" size="0.05"/></body>
+</worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_route_flags_agree_with_translation_segments(seed):
+    """engine._translates (pack flags) == ``plan.translation_segments(b) is not None`` on every body
+    of plans that slide, spin, fly free (with and without rotating) or hold still."""
+    from monitor.certify import kernels as K
+
+    m = mujoco.MjModel.from_xml_string(_MIXED_XML)
+    rng = np.random.default_rng(seed)
+    q = np.tile(m.qpos0, (3, 1))
+    moves = rng.random(5) < 0.6
+    if moves[0]:
+        q[1:, 0] = [0.1, 0.3]
+    if moves[1]:
+        q[1:, 1] = [0.5, 1.0]
+    if moves[2]:
+        q[1:, 2:5] += [[0.1, 0.0, 0.0], [0.2, 0.1, 0.0]]
+    if moves[3]:
+        q[2, 5:9] = [np.cos(0.2), 0.0, 0.0, np.sin(0.2)]
+    if moves[4]:
+        q[1:, 9] = [0.0, 0.0]
+    plan = monitor.Plan([0.0, 0.05, 0.1], q, m)
+    mp = K.trajectory_pack(plan)
+    assert mp is not None
+    got = [engine._translates(plan, mp, b) for b in range(m.nbody)]
+    assert got == [plan.translation_segments(b) is not None for b in range(m.nbody)], (moves, got)

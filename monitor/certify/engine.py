@@ -540,7 +540,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                 for gi in (int(pid[k, 0]), int(pid[k, 1])):
                     b = int(sp.geoms.body[gi])
                     if b not in trans:
-                        trans[b] = plan.translation_segments(b) is not None
+                        trans[b] = _translates(plan, mp, b)
                 if trans[int(sp.geoms.body[pid[k, 0]])] and trans[int(sp.geoms.body[pid[k, 1]])]:
                     route[s] = 0
         except BudgetExhausted:
@@ -659,6 +659,23 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
                        lazy, stats, allowed)
+
+
+def _translates(plan: Any, mp: Any, b: int) -> bool:
+    """``plan.translation_segments(b) is not None``, from the motion pack's flags where they settle it.
+
+    ``translation_segments`` of a Plan / BodyMotion returns segments for a body that does not
+    move and None for one that moves and rotates; a Plan's first answer needs the FK of every
+    waypoint (~1 ms per window on the Arm). The pack's ``body_moving`` / ``body_rotating`` are
+    the plan's own flags (``pack.plan_data_agrees`` compares them on every Plan). Only a body
+    that moves without rotating asks the trajectory. (Either answer only picks the checker, the
+    extrusion or the toleranced one; both are sound.)
+    """
+    if mp.body_moving[b] == 0:
+        return True
+    if mp.body_rotating[b] != 0:
+        return False
+    return plan.translation_segments(b) is not None
 
 
 _FULL_SEARCH_TESTS = 1024
