@@ -1,8 +1,9 @@
 """Before/after on the recorded windows of a seeded gated Arm episode (same process, same plans).
 
 "before" = engine._full_search switched off (the pairs the whole-shape stage leaves open go straight
-to the Python fat-feature checker, as on the base commit); "after" = this branch.
-Usage: PYTHONPATH=$PWD python docs/notes/issue-12-arm-fallthrough/compare.py [steps] [reps]
+to the Python fat-feature checker) and engine._translates replaced by plan.translation_segments, as on
+the base commit; "after" = this branch.
+Usage: PYTHONPATH=$PWD python docs/notes/issue-12-arm-fallthrough/compare.py [steps] [reps] [seed]
 """
 import statistics
 import sys
@@ -15,19 +16,23 @@ from monitor.certify import engine  # noqa: E402
 
 n = int(sys.argv[1]) if len(sys.argv) > 1 else 150
 reps = int(sys.argv[2]) if len(sys.argv) > 2 else 5
-g, calls = record(n)
+seed = int(sys.argv[3]) if len(sys.argv) > 3 else 0
+g, calls = record(n, seed=seed)
 calls = calls[1:]                      # the first call compiles
 full = engine._full_search
+trans = engine._translates
 
 
 def run(on, scene, plan, a, k):
     engine._full_search = full if on else (lambda *x, **y: 0)
+    engine._translates = trans if on else (lambda plan, mp, b: plan.translation_segments(b) is not None)
     ts = []
     for _ in range(reps):
         t = time.perf_counter()
         c = engine.certify(scene, plan, *a, **k)
         ts.append((time.perf_counter() - t) * 1e3)
     engine._full_search = full
+    engine._translates = trans
     return c, statistics.median(ts)
 
 
