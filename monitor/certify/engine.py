@@ -613,7 +613,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if todo:
         tests_py, depth_max, ext_stats = _python_stages(
             scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo, moving, results, mix, unfinished,
-            whole_shape=not narrow, start_known=start_known)
+            whole_shape=not narrow, start_known=start_known, mp=mp)
         tests_total += tests_py
     n_unfin = int(np.count_nonzero(unfin)) if (todo or done_to < S) else 0
     if n_unfin:
@@ -752,7 +752,8 @@ def _full_search(KS: Any, gp: Any, mp: Any, pid: np.ndarray, surv: np.ndarray, c
 def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
                    bud: Budget, tol: Tolerances, todo: list, moving: np.ndarray, results: dict, mix: dict,
                    unfinished: Any, whole_shape: bool,
-                   start_known: dict[int, bool] | None = None) -> tuple[int, int, dict[str, Any]]:
+                   start_known: dict[int, bool] | None = None,
+                   mp: Any = None) -> tuple[int, int, dict[str, Any]]:
     """Stages 3-5 (start pose, dispatch, checkers, witnesses) on ``todo`` [(i, GeomInfo a, GeomInfo b)].
 
     Fills ``results`` {i: PairResult} and ``mix``; calls ``unfinished(items)`` for pairs the
@@ -761,7 +762,9 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
     (False when :func:`window_kernel` already ran it on these pairs). ``start_known``:
     pairs of moving bodies whose start pose the window kernel has tested exactly
     (``posed_distance``, rigorous bounds; no violation at t0), mapped to "start pose not
-    proven clear"; they skip the start-pose stage here.
+    proven clear"; they skip the start-pose stage here. ``mp``: the trajectory's motion pack
+    on the compiled path: a pair with a rotating moving body is routed without asking the
+    trajectory (:func:`_translates`; same answer, no waypoint FK).
     Returns (tests, deepest level, extrusion stats for ``cert.stats``: :func:`extrusion_stats`).
     """
     tests_total, depth_max = 0, 0
@@ -816,7 +819,11 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
         for i, ga, gb in checked:
             trans = None
             if method in ("auto", "extrusion"):
-                sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
+                if mp is not None and not (_translates(plan, mp, ga.body_id)
+                                           and _translates(plan, mp, gb.body_id)):
+                    sa = sb = None
+                else:
+                    sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
                 if sa is not None and sb is not None:
                     trans = (sa, sb)
                 elif method == "extrusion":
