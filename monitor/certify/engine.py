@@ -533,8 +533,11 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
         route = np.ones(S, np.int64)
         trans: dict[int, bool] = {}
+        # a budget checkpoint where the plan's waypoint FK (first translation_segments) used to
+        # poll it: a budget spent by now stops here, as before (see _translates)
+        stopped = bud.exhausted
         try:
-            for s, k in enumerate(surv[:S].tolist()):
+            for s, k in enumerate([] if stopped else surv[:S].tolist()):
                 if code[k] != KS.WK_OPEN:
                     continue
                 for gi in (int(pid[k, 0]), int(pid[k, 1])):
