@@ -533,14 +533,17 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
         route = np.ones(S, np.int64)
         trans: dict[int, bool] = {}
+        # a budget checkpoint where the plan's waypoint FK (first translation_segments) used to
+        # poll it: a budget spent by now stops here, as before (see _translates)
+        stopped = bud.exhausted
         try:
-            for s, k in enumerate(surv[:S].tolist()):
+            for s, k in enumerate([] if stopped else surv[:S].tolist()):
                 if code[k] != KS.WK_OPEN:
                     continue
                 for gi in (int(pid[k, 0]), int(pid[k, 1])):
                     b = int(sp.geoms.body[gi])
                     if b not in trans:
-                        trans[b] = plan.translation_segments(b) is not None
+                        trans[b] = _translates(plan, mp, b)
                 if trans[int(sp.geoms.body[pid[k, 0]])] and trans[int(sp.geoms.body[pid[k, 1]])]:
                     route[s] = 0
         except BudgetExhausted:
@@ -562,6 +565,11 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         KS.window_kernel(sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code, gap,
                          surv, res, sc, sr, info)
         done_to = S
+    # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
+    full_tests = 0
+    if narrow and done_to and not stopped:
+        full_tests = _full_search(KS, sp.geoms, mp, pid, surv, code, res, done_to, t0, t1, margin, epsilon,
+                                  tol, bud)
     # -- the Python stages on what the kernel left open -------------------------------------
     # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
@@ -604,11 +612,12 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         mix["static"] = n_static
     if wslots:
         mix["toleranced/whole-shape"] = len(wslots)
-    tests_total, depth_max, ext_stats = 0, 0, {}
+    tests_total, depth_max, ext_stats = full_tests, 0, {}
     if todo:
-        tests_total, depth_max, ext_stats = _python_stages(
+        tests_py, depth_max, ext_stats = _python_stages(
             scene, plan, margin, epsilon, method, t0, t1, bud, tol, todo, moving, results, mix, unfinished,
-            whole_shape=not narrow, start_known=start_known)
+            whole_shape=not narrow, start_known=start_known, mp=mp)
+        tests_total += tests_py
     n_unfin = int(np.count_nonzero(unfin)) if (todo or done_to < S) else 0
     if n_unfin:
         mix["budget"] = n_unfin
@@ -655,10 +664,99 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                        lazy, stats, allowed)
 
 
+def _translates(plan: Any, mp: Any, b: int) -> bool:
+    """``plan.translation_segments(b) is not None``, from the motion pack's flags where they settle it.
+
+    ``translation_segments`` of a Plan / BodyMotion returns segments for a body that does not
+    move and None for one that moves and rotates; a Plan's first answer needs the FK of every
+    waypoint (~1 ms per window on the Arm). The pack's ``body_moving`` / ``body_rotating`` are
+    the plan's own flags (``pack.plan_data_agrees`` compares them on every Plan). Only a body
+    that moves without rotating asks the trajectory. (Either answer only picks the checker, the
+    extrusion or the toleranced one; both are sound.)
+    """
+    if mp.body_moving[b] == 0:
+        return True
+    if mp.body_rotating[b] != 0:
+        return False
+    return plan.translation_segments(b) is not None
+
+
+_FULL_SEARCH_TESTS = 1024
+"""Distance tests the full whole-shape search may spend on one pair the first search left open."""
+
+
+def _full_search(KS: Any, gp: Any, mp: Any, pid: np.ndarray, surv: np.ndarray, code: np.ndarray,
+                 res: np.ndarray, n: int, t0: float, t1: float, margin: float, epsilon: float,
+                 tol: Tolerances, bud: Budget) -> int:
+    """Look for a witness on the pairs the window kernel's whole-shape stage left open (issue 12).
+
+    The window kernel runs :func:`~monitor.certify.kernels.pair_window` in
+    ``MODE_CERTIFY_ONLY``: it stops at the first sub-interval it can neither exclude nor
+    convict, which for a colliding pair is usually the one where contact begins, just before
+    the first midpoint that would have given a witness. Those pairs used to fall through to
+    the Python fat-feature checker, which subdivides the whole window to epsilon before any
+    witness is tried (~100 ms on the Arm). Here the same depth-first, earliest-first search
+    runs again in ``MODE_FULL`` (at most ``_FULL_SEARCH_TESTS`` tests, charged to ``bud``):
+    it goes on past the open sub-intervals and, at the first midpoint where the exact static
+    test confirms a violation (``upper + approx < margin``, the kernel's own witness rule),
+    refines only the part before it.
+
+    Only a confirmed violation is taken (the pair becomes ``WK_VIOL``, exactly as when the
+    first search finds the witness itself; ``R_FIRST_UNRES``, the first sub-interval not
+    excluded, bounds the first contact from below). Anything else (no witness, test cap,
+    budget) leaves the pair ``WK_UNRES`` for the Python stages, as before: no verdict is
+    certified here, and a pair that would have ended "violation" still does.
+
+    Args:
+        KS: the kernels module.
+        gp, mp: scene and motion packs.
+        pid: (P, 2) geom pairs; surv: (S,) survivor pair rows; code: (P,) kernel codes
+            (updated); res: (S, R_SIZE) result rows per survivor slot (updated).
+        n: slots [0, n) were run by the kernel.
+        t0, t1, margin, epsilon, tol: as in :func:`certify`.
+        bud: the stage budget (tests charged; checked before every pair).
+
+    Returns:
+        The tests spent on pairs left open (a convicted pair's are in its result row).
+    """
+    slots = [s for s, k in enumerate(surv[:n].tolist()) if code[k] == KS.WK_UNRES]
+    if not slots:
+        return 0
+    spent = 0
+    stack = np.empty((int(tol.max_depth) + 2, 3))
+    for s in slots:
+        if bud.exhausted:
+            break
+        cap = _FULL_SEARCH_TESTS
+        if bud.tests is not None:
+            cap = min(cap, max(1, bud.tests - bud._used_tests))
+        k = int(surv[s])
+        row = KS.new_result()
+        row[KS.R_STARTED] = 2.0        # start pose tested by the window kernel (clear: not a start violation)
+        v = KS.pair_window(gp, mp, int(pid[k, 0]), int(pid[k, 1]), float(t0), float(t1), float(margin),
+                           float(epsilon), int(tol.max_depth), int(cap), KS.MODE_FULL, float(tol.rel_pad),
+                           float(tol.abs_pad), stack, row)
+        used = int(row[KS.R_TESTS])
+        bud.charge(used)
+        if v != KS.VIOLATION:
+            spent += used
+            continue
+        wt, fu = row[KS.R_WTIME], row[KS.R_FIRST_UNRES]
+        if not (fu <= wt):
+            row[KS.R_FIRST_UNRES] = wt
+        row[KS.R_START_LO] = res[s, KS.R_START_LO]
+        row[KS.R_TESTS] += res[s, KS.R_TESTS]     # the first search's tests (incl. the start test)
+        row[KS.R_DEPTH] = max(row[KS.R_DEPTH], res[s, KS.R_DEPTH])
+        res[s] = row
+        code[k] = KS.WK_VIOL
+    return spent
+
+
 def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
                    bud: Budget, tol: Tolerances, todo: list, moving: np.ndarray, results: dict, mix: dict,
                    unfinished: Any, whole_shape: bool,
-                   start_known: dict[int, bool] | None = None) -> tuple[int, int, dict[str, Any]]:
+                   start_known: dict[int, bool] | None = None,
+                   mp: Any = None) -> tuple[int, int, dict[str, Any]]:
     """Stages 3-5 (start pose, dispatch, checkers, witnesses) on ``todo`` [(i, GeomInfo a, GeomInfo b)].
 
     Fills ``results`` {i: PairResult} and ``mix``; calls ``unfinished(items)`` for pairs the
@@ -667,7 +765,9 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
     (False when :func:`window_kernel` already ran it on these pairs). ``start_known``:
     pairs of moving bodies whose start pose the window kernel has tested exactly
     (``posed_distance``, rigorous bounds; no violation at t0), mapped to "start pose not
-    proven clear"; they skip the start-pose stage here.
+    proven clear"; they skip the start-pose stage here. ``mp``: the trajectory's motion pack
+    on the compiled path: a pair with a rotating moving body is routed without asking the
+    trajectory (:func:`_translates`; same answer, no waypoint FK).
     Returns (tests, deepest level, extrusion stats for ``cert.stats``: :func:`extrusion_stats`).
     """
     tests_total, depth_max = 0, 0
@@ -722,7 +822,11 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
         for i, ga, gb in checked:
             trans = None
             if method in ("auto", "extrusion"):
-                sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
+                if mp is not None and not (_translates(plan, mp, ga.body_id)
+                                           and _translates(plan, mp, gb.body_id)):
+                    sa = sb = None
+                else:
+                    sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
                 if sa is not None and sb is not None:
                     trans = (sa, sb)
                 elif method == "extrusion":
