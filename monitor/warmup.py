@@ -137,6 +137,16 @@ def _run_cases() -> dict[str, tuple[str, float]]:
         plan = Plan(np.array([0.0, 0.1]), q0 + q, model)
         cert = certify(scene, plan, margin=0.001, epsilon=1e-3, budget=Budget())
         out[name] = (str(cert.verdict), time.perf_counter() - t)
+    # the per-pair search entry, called from Python by the engine when the window kernel leaves a
+    # colliding pair open (engine._full_search): same argument types, so the same specialisation
+    from monitor.certify import kernels
+
+    t = time.perf_counter()
+    gp, mp = kernels.scene_pack(scene).geoms, kernels.trajectory_pack(plan)
+    if mp is not None:
+        ga, gb = (int(g) for g in scene.pair_ids[0])
+        r = kernels.check_pair_window(gp, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3, max_tests=8)
+        out["pair search entry"] = (str(r["verdict"]), time.perf_counter() - t)
     from monitor.certify.extrusion_null import warm_small_lp  # the null-set test's compiled simplex
 
     t = time.perf_counter()
