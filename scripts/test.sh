@@ -41,9 +41,9 @@ trap finish EXIT
 rm -f "$WARM_LOG.req"
 "$VENV/bin/python" -m ruff check monitor envs tests || exit 1
 if [ "$WORKERS" = 0 ]; then
-    "$VENV/bin/python" -m pytest -q -m "not slow" "$@"
+    "$VENV/bin/python" -m pytest -q -m "not slow" --durations=15 "$@"
 else
-    "$VENV/bin/python" -m pytest -q -m "not slow" -n "$WORKERS" --dist loadgroup --no-loadscope-reorder "$@"
+    "$VENV/bin/python" -m pytest -q -m "not slow" --durations=15 -n "$WORKERS" --dist loadgroup --no-loadscope-reorder "$@"
 fi
 rc=$?
 if [ "$rc" -eq 5 ]; then echo "pytest collected no tests: failing"; exit 1; fi
