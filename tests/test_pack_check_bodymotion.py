@@ -108,3 +108,15 @@ def test_certificates_equal_the_full_check(monkeypatch, motion):
     full = monitor.certify(scene, _fresh(bm), margin=0.05, epsilon=1e-3)
     assert fast.verdict == full.verdict and fast.clearance == full.clearance
     assert fast.stats["checker_mix"] == full.stats["checker_mix"]
+
+
+def test_dense_violations_equal_the_full_check(monkeypatch):
+    """Colliding neighbours: same violation, witness time and geoms as with the former full check."""
+    model, bm = scaling_scene(27, "dense", "translating", seed=6)
+    scene = monitor.Scene.from_model(model, pairs="all")
+    fast = monitor.certify(scene, bm, epsilon=1e-3)
+    monkeypatch.setattr(K, "_pack_agrees", K._poses_match)
+    full = monitor.certify(scene, _fresh(bm), epsilon=1e-3)
+    assert fast.verdict == full.verdict == "violation"
+    assert fast.witness.time == full.witness.time and fast.witness.geoms == full.witness.geoms
+    assert fast.stats["checker_mix"] == full.stats["checker_mix"]
