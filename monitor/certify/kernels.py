@@ -1251,6 +1251,8 @@ def _pack_agrees(traj, mp) -> bool:
     """
     from monitor.motion.pack import plan_data_agrees, static_key
 
+    if _is_plain_body_motion(traj):
+        return _body_motion_agrees(traj, mp)
     st = getattr(traj, "_st", None)
     skey = getattr(st, "key", None)
     if skey is None or not hasattr(traj, "_quat_tracks"):
@@ -1268,6 +1270,161 @@ def _pack_agrees(traj, mp) -> bool:
             _VERIFIED_TREES[key] = "full"
             return False
     return True
+
+
+_BODY_MOTION_PROBE: list = []
+"""[True] / [False] once the compiled FK of BodyMotion packs was checked against
+``BodyMotion.body_poses`` on the seeded probe motions (:func:`_body_motion_probe_ok`)."""
+
+
+def _is_plain_body_motion(traj) -> bool:
+    """``traj`` is exactly a lerp/slerp :class:`monitor.BodyMotion`.
+
+    Not a subclass, which may override ``body_poses``.
+    """
+    from monitor.motion.bodymotion import BodyMotion
+
+    return type(traj) is BodyMotion and traj.interpolation == "lerp_slerp"
+
+
+def _probe_body_motions() -> list:
+    """Seeded BodyMotions covering what the compiled lerp/slerp FK branches on.
+
+    Uneven waypoint times (K = 2 and K = 5), a non-identity constant world pose, random
+    positions and orientations, a body that only translates, one that holds its orientation
+    on one segment (``same``), one with a tiny turn, one with a turn near a half turn on
+    either side of pi (sign-flipped targets) and one antipodal quaternion pair (the same
+    rotation, opposite sign).
+    """
+    from monitor.motion._kinematics import quat_mul
+    from monitor.motion.bodymotion import BodyMotion
+
+    def turn(rotvec):
+        ang = float(np.linalg.norm(rotvec))
+        return np.concatenate([[np.cos(0.5 * ang)], np.sin(0.5 * ang) * np.asarray(rotvec) / ang])
+
+    rng = np.random.default_rng(PROBE_SEED)
+    out = []
+    for K in (2, 5):
+        nbody = 9
+        times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.2, K - 1))]) + 0.3
+        pos = rng.uniform(-2.0, 2.0, (K, nbody, 3))
+        quat = rng.normal(size=(K, nbody, 4))
+        quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
+        pos[:, 0] = pos[0, 0]
+        quat[:, 0] = quat[0, 0]
+        quat[:, 1] = quat[0, 1]                                   # translates only
+        quat[1, 2] = quat[0, 2]                                   # holds orientation on segment 0
+        quat[1, 3] = quat_mul(turn([1e-9, 2e-9, -1e-9]), quat[0, 3])   # tiny turn
+        for b, ang in ((4, np.pi - 1e-6), (5, np.pi + 1e-6), (6, np.pi)):
+            ax = rng.normal(size=3)
+            quat[1, b] = quat_mul(turn(ang * ax / np.linalg.norm(ax)), quat[0, b])
+        quat[1, 7] = -quat[0, 7]                                  # antipodal: no rotation
+        out.append(BodyMotion(times, pos, quat, ref_points=rng.uniform(-0.3, 0.3, (nbody, 3))))
+    return out
+
+
+def _body_motion_probe_ok() -> bool:
+    """The compiled FK of BodyMotion packs equals ``BodyMotion.body_poses`` on the probes (once)."""
+    if not _BODY_MOTION_PROBE:
+        from monitor.motion.pack import pack_trajectory
+
+        ok = True
+        for bm in _probe_body_motions():
+            mp = pack_trajectory(bm)
+            ok = (ok and _body_motion_layout_ok(bm, mp) and _body_motion_data_ok(bm, mp)
+                  and _poses_match(bm, mp))
+        _BODY_MOTION_PROBE.append(bool(ok))
+    return _BODY_MOTION_PROBE[0]
+
+
+def _body_motion_layout_ok(bm, mp) -> bool:
+    """The pack's tree is the fixed BodyMotion layout.
+
+    One free joint per non-world body, child of the world, qpos columns 7 (b - 1) .. 7 b,
+    zero anchors and offsets, the world's row the motion's constant world pose, the motion's
+    reference points. Every body's rows are the same function of its own qpos block and
+    quaternion track.
+    """
+    nbody = bm.nbody
+    nj = nbody - 1
+    ar = np.arange(nj)
+    eq = np.array_equal
+    one = np.concatenate([[0], np.ones(nj, dtype=np.int64)])
+    ident = np.zeros((nj, 4))
+    ident[:, 0] = 1.0
+    return bool(
+        mp.jnt_type.shape == (nj,) and (mp.jnt_type == 0).all() and eq(mp.jnt_qposadr, 7 * ar)
+        and eq(mp.qpos0, np.zeros(7 * nj)) and eq(mp.jnt_pos, np.zeros((nj, 3))) and eq(mp.jnt_track, ar)
+        and eq(mp.jnt_axis_norm, np.ones(nj)) and eq(mp.body_parent, np.zeros(nbody, dtype=np.int64))
+        and eq(mp.body_jntadr, np.concatenate([[0], ar])) and eq(mp.body_jntnum, one)
+        and eq(mp.body_mocap, 1 - one) and eq(mp.body_pos[1:], np.zeros((nj, 3)))
+        and eq(mp.body_quat[1:], ident)
+        and eq(mp.body_pos[0], bm.pos[0, 0]) and eq(mp.body_quat[0], bm.quat[0, 0])
+        and eq(mp.ref_points, bm.ref_points) and eq(mp.qt_adr, 7 * ar + 3))
+
+
+def _body_motion_data_ok(bm, mp) -> bool:
+    """The pack's motion data is the BodyMotion's own, bit for bit.
+
+    Times, the position and
+    quaternion columns of qpos, every quaternion track (target, half, phi, cum, same; the
+    motion's own ``QuatTrack`` objects, whose waypoints are the motion's quaternions), and
+    the moving / rotating flags against the motion's own (derived independently).
+    """
+    times = bm.times
+    K, nbody = bm.pos.shape[0], bm.nbody
+    nj = nbody - 1
+    if not (mp.times.tobytes() == times.tobytes() and mp.qpos.shape == (K, 7 * nj)):
+        return False
+    q = mp.qpos.reshape(K, nj, 7)
+    if not (np.array_equal(q[:, :, :3], bm.pos[:, 1:]) and np.array_equal(q[:, :, 3:], bm.quat[:, 1:])):
+        return False
+    if not (np.array_equal(mp.body_moving[1:] != 0, bm._moving[1:])
+            and np.array_equal(mp.body_rotating[1:] != 0, bm._rotating[1:])):
+        return False
+    tracks = bm._tracks[1:]
+    if len(tracks) != nj or mp.qt_target.shape != (nj, K - 1, 4):
+        return False
+    if nj == 0:
+        return True
+    return bool(np.array_equal(np.stack([tr.q for tr in tracks], axis=1), bm.quat[:, 1:])
+                and np.array_equal(mp.qt_target, np.stack([tr.target for tr in tracks]))
+                and np.array_equal(mp.qt_half, np.stack([tr.half for tr in tracks]))
+                and np.array_equal(mp.qt_phi, np.stack([tr.phi for tr in tracks]))
+                and np.array_equal(mp.qt_cum, np.stack([tr.cum for tr in tracks]))
+                and np.array_equal(mp.qt_same != 0, np.stack([tr.same for tr in tracks])))
+
+
+def _body_motion_agrees(bm, mp) -> bool:
+    """The pack check for a plain lerp/slerp :class:`monitor.BodyMotion` (no per-motion FK).
+
+    The former check evaluated ``bm.body_poses`` (a Python slerp per body: ~45 ms at 1000
+    bodies) at every waypoint and midpoint, per motion. Split as for a Plan
+    (:func:`_pack_agrees`):
+
+    1. **Once per process**: the compiled FK of BodyMotion packs must equal
+       ``BodyMotion.body_poses`` (1e-9, :func:`_poses_match`) on seeded probe motions
+       (:func:`_probe_body_motions`: random poses, a constant non-identity world pose, and
+       the slerp's edge cases) whose packs also pass (2) and (3).
+    2. **Every motion, layout** (:func:`_body_motion_layout_ok`): the tree is the fixed
+       BodyMotion layout, in which every body is an independent free joint on the world,
+       computed by the same compiled code from its own qpos block and track only.
+    3. **Every motion, data** (:func:`_body_motion_data_ok`): times, qpos, tracks and flags
+       are the motion's own arrays, bit for bit.
+
+    Soundness argument. With (2) the compiled pose of body b at time t is one fixed function
+    F(times, qpos block of b, track of b, t) (plus the world's constant pose); ``body_poses``
+    of a plain BodyMotion is one fixed function G of the same data (lerp of ``pos[:, b]``,
+    ``QuatTrack.interp`` of the motion's own track). (3) makes the data the motion's own.
+    F = G on the probes' bodies and times, which exercise every branch either function takes
+    (segment location, translation only, held orientation, tiny turn, half turn on both
+    sides, sign-flipped target); a disagreement elsewhere would need F - G to vanish on
+    the probes yet not on this motion's data, i.e. a packing error that depends on data
+    values the probes do not take. Subclasses and screw motions keep the full per-motion
+    check. Tests: tests/test_pack_check_bodymotion.py.
+    """
+    return _body_motion_probe_ok() and _body_motion_layout_ok(bm, mp) and _body_motion_data_ok(bm, mp)
 
 
 def trajectory_pack(traj):
