@@ -73,31 +73,36 @@ def root_operator(a_lo: np.ndarray, a_hi: np.ndarray, u: np.ndarray,
     with np.errstate(invalid="ignore", divide="ignore"):
         lo_num = b_lo - a_hi  # (u - v) tau >= b - alpha
         hi_num = b_hi - a_lo  # (u - v) tau <= beta - a
-        tl, th = t_lo, t_hi
-        for k in range(3):
-            lo_k, hi_k = lo_num[k], hi_num[k]
-            if np.isnan(lo_k) or np.isnan(hi_k):
-                continue
-            if du[k] == 0.0:
-                if lo_k > 0.0 or hi_k < 0.0:
-                    return None
-                continue
-            x1, x2 = lo_k / du[k], hi_k / du[k]
-            if du[k] < 0:
-                x1, x2 = x2, x1
-            tl = max(tl, x1)
-            th = min(th, x2)
+        # the quotients in numpy (IEEE overflow to inf, as per-axis numpy scalars gave);
+        # entries with du == 0 are never read
+        q_lo = (lo_num / du).tolist()
+        q_hi = (hi_num / du).tolist()
+    tl, th = t_lo, t_hi
+    # per axis on Python floats (the same comparisons as on numpy scalars, cheaper)
+    for lo_k, hi_k, du_k, x1, x2 in zip(lo_num.tolist(), hi_num.tolist(), du.tolist(), q_lo, q_hi):
+        if lo_k != lo_k or hi_k != hi_k:  # NaN (inf - inf of two half-space sides)
+            continue
+        if du_k == 0.0:
+            if lo_k > 0.0 or hi_k < 0.0:
+                return None
+            continue
+        if du_k < 0:
+            x1, x2 = x2, x1
+        tl = max(tl, x1)
+        th = min(th, x2)
     widen = _ULP_WIDEN * max(abs(tl), abs(th), abs(t_hi - t_lo)) if np.isfinite(tl + th) else 0.0
     tl = max(t_lo, tl - widen)
     th = min(t_hi, th + widen)
     if not tl <= th:
         return None
-    ends = np.stack([-du * tl, -du * th])  # (v - u) tau at both ends
+    e_l, e_h = -du * tl, -du * th  # (v - u) tau at both ends
     with np.errstate(invalid="ignore"):
-        na_lo = np.maximum(a_lo, b_lo + ends.min(axis=0))
-        na_hi = np.minimum(a_hi, b_hi + ends.max(axis=0))
-        nb_lo = np.maximum(b_lo, a_lo - ends.max(axis=0))
-        nb_hi = np.minimum(b_hi, a_hi - ends.min(axis=0))
+        e_min = np.minimum(e_l, e_h)  # = np.stack([e_l, e_h]).min(axis=0), bit for bit
+        e_max = np.maximum(e_l, e_h)
+        na_lo = np.maximum(a_lo, b_lo + e_min)
+        na_hi = np.minimum(a_hi, b_hi + e_max)
+        nb_lo = np.maximum(b_lo, a_lo - e_max)
+        nb_hi = np.minimum(b_hi, a_hi - e_min)
     na_lo = np.where(np.isnan(na_lo), a_lo, na_lo)
     na_hi = np.where(np.isnan(na_hi), a_hi, na_hi)
     nb_lo = np.where(np.isnan(nb_lo), b_lo, nb_lo)
@@ -165,7 +170,7 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
         rb = root_operator(ua_lo, ua_hi, u, ub_lo, ub_hi, v, tl, th)
         if rb is None:
             return None
-        old = (a_lo.copy(), a_hi.copy(), b_lo.copy(), b_hi.copy(), tl, th)
+        old = (a_lo, a_hi, b_lo, b_hi, tl, th)  # rebound below, never written in place
         tl, th = rb.t_lo, rb.t_hi
         a_lo = np.maximum(a_lo, rb.a_lo)
         a_hi = np.minimum(a_hi, rb.a_hi)
