@@ -157,6 +157,8 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
     Returns:
         :class:`PairSBounds`, or None when the pair is provably clear in the span.
     """
+    if len(a_lo) == 1 and len(b_lo) == 1 and max_passes >= 1 and a_alive[0] and b_alive[0]:
+        return _pair_sbounds_1x1(a_lo[0], a_hi[0], u, b_lo[0], b_hi[0], v, t_lo, t_hi, max_passes)
     a_lo, a_hi, b_lo, b_hi = a_lo.copy(), a_hi.copy(), b_lo.copy(), b_hi.copy()
     a_alive, b_alive = a_alive.copy(), b_alive.copy()
     tl, th = t_lo, t_hi
@@ -189,6 +191,40 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
     if not a_alive.any() or not b_alive.any():
         return None
     return PairSBounds(tl, th, a_lo, a_hi, a_alive, b_lo, b_hi, b_alive, passes)
+
+
+def _pair_sbounds_1x1(a_lo: np.ndarray, a_hi: np.ndarray, u: np.ndarray, b_lo: np.ndarray,
+                      b_hi: np.ndarray, v: np.ndarray, t_lo: float, t_hi: float,
+                      max_passes: int) -> PairSBounds | None:
+    """:func:`pair_sbounds` for one live leaf per side, (3,) boxes: the same passes and values.
+
+    With one leaf the Upward join is the leaf itself, a dead leaf ends the pair (None),
+    and the four per-side changes are one maximum over the concatenated coordinates.
+    """
+    tl, th = t_lo, t_hi
+    passes = 0
+    while passes < max_passes:
+        passes += 1
+        rb = root_operator(a_lo, a_hi, u, b_lo, b_hi, v, tl, th)
+        if rb is None:
+            return None
+        old = np.concatenate([a_lo, a_hi, b_lo, b_hi])
+        old_tl, old_th = tl, th
+        tl, th = rb.t_lo, rb.t_hi
+        a_lo = np.maximum(a_lo, rb.a_lo)
+        a_hi = np.minimum(a_hi, rb.a_hi)
+        b_lo = np.maximum(b_lo, rb.b_lo)
+        b_hi = np.minimum(b_hi, rb.b_hi)
+        if not ((a_lo <= a_hi).all() and (b_lo <= b_hi).all()):
+            return None
+        with np.errstate(invalid="ignore"):
+            d = np.abs(old - np.concatenate([a_lo, a_hi, b_lo, b_hi]))
+        d = d[np.isfinite(d)]
+        shrink = max(float(d.max()) if d.size else 0.0, abs(old_tl - tl), abs(old_th - th))
+        if shrink <= 1e-9:
+            break
+    one = np.ones(1, bool)
+    return PairSBounds(tl, th, a_lo[None], a_hi[None], one, b_lo[None], b_hi[None], one.copy(), passes)
 
 
 def _max_change(old: np.ndarray, new: np.ndarray, alive: np.ndarray) -> float:
