@@ -54,3 +54,38 @@ def test_one_leaf_fast_path_matches_general_loop(seed: int) -> None:
             assert f[0].tobytes() == r[0].tobytes() == r[1].tobytes()
         assert fast.a_alive.tolist() == [True] and fast.b_alive.tolist() == [True]
     assert n_some > 20  # the comparison ran on surviving pairs, not only on culled ones
+
+
+def _frame_axis_by_axis(rb, va: np.ndarray, vb: np.ndarray) -> np.ndarray:  # noqa: ANN001
+    """The per-axis rule as first written: one overlap box per axis and candidate."""
+    from monitor.certify.extrusion import _pair_box
+
+    w = np.zeros(3)
+    for k in range(3):
+        widths = []
+        for c in (va[k], vb[k]):
+            dv = np.zeros(3)
+            dv[k] = c
+            lo, hi = _pair_box(rb, va - dv, vb - dv)
+            widths.append(hi[k] - lo[k])
+        w[k] = va[k] if widths[0] <= widths[1] else vb[k]
+    return w
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_own_frame_velocity_matches_axis_by_axis(seed: int) -> None:
+    from monitor.certify.extrusion import _own_frame_velocity
+    from monitor.certify.extrusion_sbounds import RootBound
+
+    rng = np.random.default_rng(100 + seed)
+    picked_b = 0
+    for _ in range(300):
+        a_lo, a_hi = _boxes(rng)
+        b_lo, b_hi = _boxes(rng)
+        t_lo = float(rng.uniform(0.0, 0.2))
+        rb = RootBound(t_lo, t_lo + float(rng.uniform(0.0, 0.3)), a_lo, a_hi, b_lo, b_hi)
+        va, vb = _vel(rng), _vel(rng)
+        got, ref = _own_frame_velocity(rb, va, vb), _frame_axis_by_axis(rb, va, vb)
+        assert got.tobytes() == ref.tobytes()
+        picked_b += int(np.sum((ref == vb) & (ref != va)))
+    assert picked_b > 20  # both candidates win on some axes

@@ -341,6 +341,18 @@ def _pair_box(rb: Any, va: np.ndarray, vb: np.ndarray) -> tuple[np.ndarray, np.n
     return np.maximum(sa_lo, sb_lo), np.minimum(sa_hi, sb_hi)
 
 
+def _own_frame_velocity(rb: Any, va: np.ndarray, vb: np.ndarray) -> np.ndarray:
+    """(3,) per axis k the velocity va[k] or vb[k] whose co-moving frame gives the narrower overlap box.
+
+    Ties go to A. Each axis of :func:`_pair_box` depends only on that axis' velocities,
+    so one call per candidate gives all three axes (the same per-axis operations as
+    measuring axis by axis).
+    """
+    lo_a, hi_a = _pair_box(rb, va - va, vb - va)
+    lo_b, hi_b = _pair_box(rb, va - vb, vb - vb)
+    return np.where((hi_a - lo_a) <= (hi_b - lo_b), va, vb)
+
+
 def _empty_in_own_frames(rb: Any, va: np.ndarray, vb: np.ndarray) -> bool:
     """True if the pair's overlap box is empty along some axis measured in A's or B's frame.
 
@@ -583,15 +595,7 @@ class _Search:
         if p.mode not in ("lp", "offset"):
             return False
         va, vb = st[p.ia][1], st[p.ib][1]
-        w = np.zeros(3)
-        for k in range(3):
-            widths = []
-            for c in (va[k], vb[k]):
-                dv = np.zeros(3)
-                dv[k] = c
-                lo, hi = _pair_box(rb, va - dv, vb - dv)
-                widths.append(hi[k] - lo[k])
-            w[k] = va[k] if widths[0] <= widths[1] else vb[k]
+        w = _own_frame_velocity(rb, va, vb)
         lo, hi = _pair_box(rb, va - w, vb - w)
         rlo, rhi = np.r_[lo, rb.t_lo], np.r_[hi, rb.t_hi]
         la, lb = self._leaves(p, {p.ia: (st[p.ia][0], va - w), p.ib: (st[p.ib][0], vb - w)}, np.zeros(3))
