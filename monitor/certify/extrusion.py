@@ -185,6 +185,7 @@ class SearchResult:
 # ----------------------------------------------------------------------------- validation
 
 _EYE3 = np.eye(3)
+_EYE3_BYTES = _EYE3.tobytes()
 
 
 def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float, float]
@@ -193,12 +194,17 @@ def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float
     R = np.asarray(R, dtype=np.float64)
     times = np.asarray(times, dtype=np.float64).reshape(-1)
     origins = np.asarray(origins, dtype=np.float64)
-    if R.shape != (3, 3) or not np.all(np.isfinite(R)):
+    if R.shape != (3, 3):
         raise InvalidInputError(f"{name}: R must be a finite (3, 3) rotation, got shape {R.shape}")
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
-    det = r00 * (r11 * r22 - r12 * r21) - r01 * (r10 * r22 - r12 * r20) + r02 * (r10 * r21 - r11 * r20)
-    if float(np.abs(R.T @ R - _EYE3).max()) > 1e-9 or det < 0:
-        raise InvalidInputError(f"{name}: R is not a proper rotation (|R^T R - I| > 1e-9 or det < 0)")
+    # the identity (bit for bit; the common case of static and translating bodies) is a
+    # proper rotation: only other matrices need the finiteness / orthonormality / det test
+    if R.tobytes() != _EYE3_BYTES:
+        if not np.all(np.isfinite(R)):
+            raise InvalidInputError(f"{name}: R must be a finite (3, 3) rotation, got shape {R.shape}")
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
+        det = r00 * (r11 * r22 - r12 * r21) - r01 * (r10 * r22 - r12 * r20) + r02 * (r10 * r21 - r11 * r20)
+        if float(np.abs(R.T @ R - _EYE3).max()) > 1e-9 or det < 0:
+            raise InvalidInputError(f"{name}: R is not a proper rotation (|R^T R - I| > 1e-9 or det < 0)")
     if times.ndim != 1 or len(times) < 2 or origins.shape != (len(times), 3):
         raise InvalidInputError(f"{name}: need times (k+1,) with k >= 1 and origins (k+1, 3); "
                                 f"got {times.shape} and {origins.shape}")
@@ -250,7 +256,7 @@ class _Body:
 
     def state(self, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
         """Origin (3,) at ``t0`` and velocity (3,) on the span [t0, t1] (inside one segment)."""
-        i = int(np.clip(np.searchsorted(self.times, 0.5 * (t0 + t1)) - 1, 0, len(self.times) - 2))
+        i = min(max(int(np.searchsorted(self.times, 0.5 * (t0 + t1))) - 1, 0), len(self.times) - 2)
         ta, tb = self.times[i], self.times[i + 1]
         v = (self.origins[i + 1] - self.origins[i]) / (tb - ta)
         return self.origins[i] + v * (t0 - ta), v
@@ -333,6 +339,18 @@ def _pair_box(rb: Any, va: np.ndarray, vb: np.ndarray) -> tuple[np.ndarray, np.n
     sa_lo, sa_hi = swept_box(rb.a_lo, rb.a_hi, va, rb.t_lo, rb.t_hi)
     sb_lo, sb_hi = swept_box(rb.b_lo, rb.b_hi, vb, rb.t_lo, rb.t_hi)
     return np.maximum(sa_lo, sb_lo), np.minimum(sa_hi, sb_hi)
+
+
+def _own_frame_velocity(rb: Any, va: np.ndarray, vb: np.ndarray) -> np.ndarray:
+    """(3,) per axis k the velocity va[k] or vb[k] whose co-moving frame gives the narrower overlap box.
+
+    Ties go to A. Each axis of :func:`_pair_box` depends only on that axis' velocities,
+    so one call per candidate gives all three axes (the same per-axis operations as
+    measuring axis by axis).
+    """
+    lo_a, hi_a = _pair_box(rb, va - va, vb - va)
+    lo_b, hi_b = _pair_box(rb, va - vb, vb - vb)
+    return np.where((hi_a - lo_a) <= (hi_b - lo_b), va, vb)
 
 
 def _empty_in_own_frames(rb: Any, va: np.ndarray, vb: np.ndarray) -> bool:
@@ -577,15 +595,7 @@ class _Search:
         if p.mode not in ("lp", "offset"):
             return False
         va, vb = st[p.ia][1], st[p.ib][1]
-        w = np.zeros(3)
-        for k in range(3):
-            widths = []
-            for c in (va[k], vb[k]):
-                dv = np.zeros(3)
-                dv[k] = c
-                lo, hi = _pair_box(rb, va - dv, vb - dv)
-                widths.append(hi[k] - lo[k])
-            w[k] = va[k] if widths[0] <= widths[1] else vb[k]
+        w = _own_frame_velocity(rb, va, vb)
         lo, hi = _pair_box(rb, va - w, vb - w)
         rlo, rhi = np.r_[lo, rb.t_lo], np.r_[hi, rb.t_hi]
         la, lb = self._leaves(p, {p.ia: (st[p.ia][0], va - w), p.ib: (st[p.ib][0], vb - w)}, np.zeros(3))
@@ -1025,7 +1035,10 @@ def _check_pairs_nary(pairs: list[TranslatingPair], w: tuple[float, float], marg
     seen_names = [n for m in members for n in m]
     out: list[PairOutcome | None] = [None] * len(pairs)
     if names and len(seen_names) == len(set(seen_names)):
-        res = search_many(tb, names, w, margin, tol, budget, earliest, clearance, offset=offset)
+        # the pairs were validated above (_bodies_from_pair) and the groups hold the validated
+        # arrays, unique geom names and >= 1 shape each: no second validation pass
+        bl = [_Body(b.name, b.shapes, b.geom_names, b.R, b.times, b.origins) for b in tb]
+        res = _search_validated(bl, names, w, margin, tol, budget, earliest, clearance, offset=offset)
         it = iter(res.outcomes)
         for i, e in enumerate(ends):
             if e is not None:
@@ -1103,7 +1116,15 @@ def search_many(bodies: Sequence[TranslatingBody], allowed_pairs: Iterable[tuple
         :class:`SearchResult` with one outcome per pair (request order) and stats.
     """
     w = _check_window(window, margin)
-    bl = _bodies_many(bodies, w)
+    return _search_validated(_bodies_many(bodies, w), allowed_pairs, w, margin, tolerances, budget,
+                             earliest, clearance, divide, offset, division)
+
+
+def _search_validated(bl: list[_Body], allowed_pairs: Iterable[tuple[str, str]] | None,
+                      w: tuple[float, float], margin: float, tolerances: Tolerances,
+                      budget: Budget | None, earliest: bool, clearance: bool, divide: bool = True,
+                      offset: bool = True, division: str = "bisect") -> SearchResult:
+    """:func:`search_many` on bodies already checked by ``_bodies_many`` / ``_check_body``."""
     idx = _resolve_pairs(bl, allowed_pairs)
     s = _Search(bl, idx, w, float(margin), tolerances, budget, earliest, clearance, divide, offset, division)
     s.run()

@@ -68,6 +68,7 @@ Three exact tests, chosen per pair by the *inflation* ``r = radius_a + radius_b 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -102,9 +103,12 @@ class Leaf:
     v: np.ndarray
     radius: float
 
-    @property
+    @cached_property
     def G(self) -> np.ndarray:
-        """(f, 4) rows ``(n, -(n.v))`` of the extruded half-spaces ``G @ (x, tau) <= h``."""
+        """(f, 4) rows ``(n, -(n.v))`` of the extruded half-spaces ``G @ (x, tau) <= h``.
+
+        Built once per leaf (a leaf's arrays are never written after construction).
+        """
         return np.hstack([self.N, -(self.N @ self.v)[:, None]])
 
 

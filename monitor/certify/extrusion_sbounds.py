@@ -73,31 +73,36 @@ def root_operator(a_lo: np.ndarray, a_hi: np.ndarray, u: np.ndarray,
     with np.errstate(invalid="ignore", divide="ignore"):
         lo_num = b_lo - a_hi  # (u - v) tau >= b - alpha
         hi_num = b_hi - a_lo  # (u - v) tau <= beta - a
-        tl, th = t_lo, t_hi
-        for k in range(3):
-            lo_k, hi_k = lo_num[k], hi_num[k]
-            if np.isnan(lo_k) or np.isnan(hi_k):
-                continue
-            if du[k] == 0.0:
-                if lo_k > 0.0 or hi_k < 0.0:
-                    return None
-                continue
-            x1, x2 = lo_k / du[k], hi_k / du[k]
-            if du[k] < 0:
-                x1, x2 = x2, x1
-            tl = max(tl, x1)
-            th = min(th, x2)
+        # the quotients in numpy (IEEE overflow to inf, as per-axis numpy scalars gave);
+        # entries with du == 0 are never read
+        q_lo = (lo_num / du).tolist()
+        q_hi = (hi_num / du).tolist()
+    tl, th = t_lo, t_hi
+    # per axis on Python floats (the same comparisons as on numpy scalars, cheaper)
+    for lo_k, hi_k, du_k, x1, x2 in zip(lo_num.tolist(), hi_num.tolist(), du.tolist(), q_lo, q_hi):
+        if lo_k != lo_k or hi_k != hi_k:  # NaN (inf - inf of two half-space sides)
+            continue
+        if du_k == 0.0:
+            if lo_k > 0.0 or hi_k < 0.0:
+                return None
+            continue
+        if du_k < 0:
+            x1, x2 = x2, x1
+        tl = max(tl, x1)
+        th = min(th, x2)
     widen = _ULP_WIDEN * max(abs(tl), abs(th), abs(t_hi - t_lo)) if np.isfinite(tl + th) else 0.0
     tl = max(t_lo, tl - widen)
     th = min(t_hi, th + widen)
     if not tl <= th:
         return None
-    ends = np.stack([-du * tl, -du * th])  # (v - u) tau at both ends
+    e_l, e_h = -du * tl, -du * th  # (v - u) tau at both ends
     with np.errstate(invalid="ignore"):
-        na_lo = np.maximum(a_lo, b_lo + ends.min(axis=0))
-        na_hi = np.minimum(a_hi, b_hi + ends.max(axis=0))
-        nb_lo = np.maximum(b_lo, a_lo - ends.max(axis=0))
-        nb_hi = np.minimum(b_hi, a_hi - ends.min(axis=0))
+        e_min = np.minimum(e_l, e_h)  # = np.stack([e_l, e_h]).min(axis=0), bit for bit
+        e_max = np.maximum(e_l, e_h)
+        na_lo = np.maximum(a_lo, b_lo + e_min)
+        na_hi = np.minimum(a_hi, b_hi + e_max)
+        nb_lo = np.maximum(b_lo, a_lo - e_max)
+        nb_hi = np.minimum(b_hi, a_hi - e_min)
     na_lo = np.where(np.isnan(na_lo), a_lo, na_lo)
     na_hi = np.where(np.isnan(na_hi), a_hi, na_hi)
     nb_lo = np.where(np.isnan(nb_lo), b_lo, nb_lo)
@@ -152,6 +157,8 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
     Returns:
         :class:`PairSBounds`, or None when the pair is provably clear in the span.
     """
+    if len(a_lo) == 1 and len(b_lo) == 1 and max_passes >= 1 and a_alive[0] and b_alive[0]:
+        return _pair_sbounds_1x1(a_lo[0], a_hi[0], u, b_lo[0], b_hi[0], v, t_lo, t_hi, max_passes)
     a_lo, a_hi, b_lo, b_hi = a_lo.copy(), a_hi.copy(), b_lo.copy(), b_hi.copy()
     a_alive, b_alive = a_alive.copy(), b_alive.copy()
     tl, th = t_lo, t_hi
@@ -165,7 +172,7 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
         rb = root_operator(ua_lo, ua_hi, u, ub_lo, ub_hi, v, tl, th)
         if rb is None:
             return None
-        old = (a_lo.copy(), a_hi.copy(), b_lo.copy(), b_hi.copy(), tl, th)
+        old = (a_lo, a_hi, b_lo, b_hi, tl, th)  # rebound below, never written in place
         tl, th = rb.t_lo, rb.t_hi
         a_lo = np.maximum(a_lo, rb.a_lo)
         a_hi = np.minimum(a_hi, rb.a_hi)
@@ -184,6 +191,40 @@ def pair_sbounds(a_lo: np.ndarray, a_hi: np.ndarray, a_alive: np.ndarray, u: np.
     if not a_alive.any() or not b_alive.any():
         return None
     return PairSBounds(tl, th, a_lo, a_hi, a_alive, b_lo, b_hi, b_alive, passes)
+
+
+def _pair_sbounds_1x1(a_lo: np.ndarray, a_hi: np.ndarray, u: np.ndarray, b_lo: np.ndarray,
+                      b_hi: np.ndarray, v: np.ndarray, t_lo: float, t_hi: float,
+                      max_passes: int) -> PairSBounds | None:
+    """:func:`pair_sbounds` for one live leaf per side, (3,) boxes: the same passes and values.
+
+    With one leaf the Upward join is the leaf itself, a dead leaf ends the pair (None),
+    and the four per-side changes are one maximum over the concatenated coordinates.
+    """
+    tl, th = t_lo, t_hi
+    passes = 0
+    while passes < max_passes:
+        passes += 1
+        rb = root_operator(a_lo, a_hi, u, b_lo, b_hi, v, tl, th)
+        if rb is None:
+            return None
+        old = np.concatenate([a_lo, a_hi, b_lo, b_hi])
+        old_tl, old_th = tl, th
+        tl, th = rb.t_lo, rb.t_hi
+        a_lo = np.maximum(a_lo, rb.a_lo)
+        a_hi = np.minimum(a_hi, rb.a_hi)
+        b_lo = np.maximum(b_lo, rb.b_lo)
+        b_hi = np.minimum(b_hi, rb.b_hi)
+        if not ((a_lo <= a_hi).all() and (b_lo <= b_hi).all()):
+            return None
+        with np.errstate(invalid="ignore"):
+            d = np.abs(old - np.concatenate([a_lo, a_hi, b_lo, b_hi]))
+        d = d[np.isfinite(d)]
+        shrink = max(float(d.max()) if d.size else 0.0, abs(old_tl - tl), abs(old_th - th))
+        if shrink <= 1e-9:
+            break
+    one = np.ones(1, bool)
+    return PairSBounds(tl, th, a_lo[None], a_hi[None], one, b_lo[None], b_hi[None], one.copy(), passes)
 
 
 def _max_change(old: np.ndarray, new: np.ndarray, alive: np.ndarray) -> float:
