@@ -180,3 +180,31 @@ def test_wall_time_stays_near_the_budget(arm, case):
     wall = time.perf_counter() - t
     assert cert.verdict != "certified" or not cert.stats["budget_exhausted"]
     assert wall <= 2.0 * budget + 0.5, wall
+
+
+def test_float_seconds_are_validated_on_the_fast_path_too():
+    """Budget(seconds=<float>) takes a shortcut for finite floats >= 0: the rest still raise."""
+    import math
+
+    from monitor.certify.common import Budget
+    from monitor.errors import InvalidInputError
+    for bad in (float("nan"), -1.0, -1e-300, math.inf, -math.inf):
+        with pytest.raises(InvalidInputError, match="seconds"):
+            Budget(seconds=bad)
+    with pytest.raises(InvalidInputError, match="tests"):
+        Budget(seconds=1.0, tests=-1)
+    assert Budget(seconds=0.0).seconds == 0.0 and Budget(seconds=2.5, tests=3).tests == 3
+
+
+def test_active_budget_nests_and_is_restored_after_an_exception():
+    from monitor.certify import common
+    from monitor.certify.common import Budget, active_budget
+    outer, inner = Budget(seconds=1.0), Budget(tests=0)
+    assert getattr(common._ACTIVE, "budget", None) is None
+    with active_budget(outer):
+        assert common._ACTIVE.budget is outer
+        with pytest.raises(common.BudgetExhausted):
+            with active_budget(inner):
+                common.check_active_budget()
+        assert common._ACTIVE.budget is outer
+    assert getattr(common._ACTIVE, "budget", None) is None

@@ -11,8 +11,6 @@ import enum
 import math
 import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -184,8 +182,10 @@ class Budget:
     def __post_init__(self) -> None:
         from monitor.errors import InvalidInputError
 
+        s = self.seconds
+        if type(s) is float and 0.0 <= s < math.inf and self.tests is None:
+            return          # the default budget's case: a finite float >= 0, no test limit (as below)
         if self.seconds is not None:
-            s = self.seconds
             if isinstance(s, bool) or not isinstance(s, int | float | np.integer | np.floating):
                 raise InvalidInputError(f"budget seconds must be a number or None, got {s!r}")
             if not math.isfinite(float(s)) or float(s) < 0:
@@ -231,19 +231,27 @@ class Budget:
 _ACTIVE = threading.local()
 
 
-@contextmanager
-def active_budget(budget: Budget | None) -> Iterator[None]:
+class active_budget:  # noqa: N801 - used as a function: ``with active_budget(b): ...``
     """Make ``budget`` the calling thread's active budget inside the ``with`` block.
 
     Work that cannot take a budget argument (``Trajectory.motion_bounds`` /
     ``body_poses`` of the motion protocol) polls it with :func:`check_active_budget`.
+    The previous active budget is restored on exit (also on an exception). A plain class
+    rather than a ``contextmanager`` generator: it is entered on every ``certify`` call.
     """
-    prev = getattr(_ACTIVE, "budget", None)
-    _ACTIVE.budget = budget
-    try:
-        yield
-    finally:
-        _ACTIVE.budget = prev
+
+    __slots__ = ("_budget", "_prev")
+
+    def __init__(self, budget: Budget | None) -> None:
+        self._budget = budget
+        self._prev = None
+
+    def __enter__(self) -> None:
+        self._prev = getattr(_ACTIVE, "budget", None)
+        _ACTIVE.budget = self._budget
+
+    def __exit__(self, *exc: object) -> None:
+        _ACTIVE.budget = self._prev
 
 
 def check_active_budget() -> None:
