@@ -121,6 +121,10 @@ class Rollout:
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
+        self.c_tail = True
+        """Run braking tails in ``mujoco.rollout`` where exact (False: always the ``mj_step`` loop)."""
+        self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
+        self._n_full = self._n_user = 0
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
@@ -232,15 +236,23 @@ class Rollout:
 
     def brake_rows(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
                    brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
-                   vel_tol: float) -> tuple[np.ndarray, np.ndarray]:
+                   vel_tol: float, *, window_fresh: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The braking tail of :meth:`brake_tail` as raw rows, without building its Plan.
+
+        ``window_fresh=True`` is the caller's promise that :meth:`states` just ran on this
+        ``data``, ``ctrl`` and ``nstep`` (the gate's order): the key check is skipped.
+
+        The substeps run in MuJoCo's C rollout (``mujoco.rollout``, no Python per substep)
+        where that is provably the same computation as the ``mj_step`` loop
+        (:meth:`_tail_by_rollout`), else in the loop (:meth:`_tail_by_loop`). Same rows,
+        same stop index, bit for bit (tested against an independent hand-stepped oracle).
 
         Returns:
             rows (K, 1 + nq + nv): time, qpos, qvel at the tail's waypoints (the first is the
             window's end), and the brake control (nu,).
         """
         m = self.model
-        if not self.window_matches(data, ctrl, nstep):
+        if not (window_fresh and self._key_nstep == nstep) and not self.window_matches(data, ctrl, nstep):
             self.states(data, ctrl, nstep)
         s = self._tail_data
         if s is None:
@@ -250,6 +262,22 @@ class Rollout:
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
         n = max(int(max_steps), 1)
+        if self.c_tail and _rollout_is_exact(m):
+            rows = self._tail_by_rollout(n, vel_tol)
+            if rows is not None:
+                return rows, brake
+            # a MuJoCo warning in the tail: redo it in the loop (the rollout stops stepping there)
+            mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
+            s.ctrl[:] = brake
+        return self._tail_by_loop(n, vel_tol), brake
+
+    def _tail_by_loop(self, n: int, vel_tol: float) -> np.ndarray:
+        """Up to ``n`` substeps of the tail scratch (state and brake control set), one ``mj_step`` each.
+
+        Returns:
+            rows (K, 1 + nq + nv): time, qpos, qvel; the first row is the scratch's state on entry.
+        """
+        m, s = self.model, self._tail_data
         nq = m.nq
         # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
         # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
@@ -276,7 +304,85 @@ class Rollout:
                 end = k + 1 + int(stop.argmax())  # the first substep that passes
                 break
             k = hi
-        return rows[:end + 1], brake
+        return rows[:end + 1]
+
+    def _tail_by_rollout(self, n: int, vel_tol: float) -> np.ndarray | None:
+        """The tail of :meth:`_tail_by_loop` by ``mujoco.rollout`` (C, no Python per substep).
+
+        Why it is the same computation: ``rollout`` sets the scratch's full physics state
+        (``mjSTATE_FULLPHYSICS``: time, qpos, qvel, act, history, plugin, plastic), its
+        ``qacc_warmstart`` and, before every substep, the user inputs (``mjSTATE_USER``:
+        ctrl, applied forces, mocap, eq_active, userdata) -- all taken from the scratch
+        itself, so together exactly its integration state -- then calls ``mj_step`` and
+        reads the full physics state, whose first ``1 + nq + nv`` entries are the loop's
+        row (time, qpos, qvel). Re-setting the user inputs each substep writes the values
+        they already have, because ``mj_step`` never writes them when no callback or plugin
+        is installed (:func:`_rollout_is_exact`). Consecutive chunks continue from the
+        last state and warm start exactly. ``rollout`` stops stepping at a MuJoCo warning
+        (and fills the rest with the last state) where the loop goes on: any warning
+        returns None and the caller runs the loop.
+
+        Two calls: the first substep (a tail at rest stops there, as in the loop), then
+        all the others at once (one ``rollout`` call costs ~10-15 µs of fixed overhead
+        here, more than a substep; a tail that stops midway simulates substeps past its
+        end, which only touch the private scratch).
+
+        Returns:
+            rows (K, 1 + nq + nv) as :meth:`_tail_by_loop`, or None after a warning.
+        """
+        m, s = self.model, self._tail_data
+        if self._roll is None:
+            from mujoco import _rollout
+
+            self._roll = _rollout.Rollout(nthread=0)  # runs on the calling thread
+            self._n_full = mujoco.mj_stateSize(m, _FULL)
+            self._n_user = mujoco.mj_stateSize(m, _USER)
+        nq, nv = m.nq, m.nv
+        ncol = 1 + nq + nv
+        rows = np.empty((n + 1, self._n_full))  # full physics state per waypoint
+        mujoco.mj_getState(m, s, rows[0], _FULL)
+        user = np.empty((1, n, self._n_user))  # the user inputs, held over the tail
+        mujoco.mj_getState(m, s, user[0, 0], _USER)
+        user[0, 1:] = user[0, 0]
+        warm = np.array(s.qacc_warmstart).reshape(1, nv)
+        models, datas = [m], [s]
+        counters = s.warning.number  # a view of the scratch's warning counters
+        end = n
+        k = 0
+        chunk = 1
+        while k < n:
+            hi = min(k + chunk, n)
+            chunk = n
+            if k:
+                warm[0] = s.qacc_warmstart  # the scratch holds substep k
+            counters[:] = 0
+            self._roll.rollout(models, datas, hi - k, _USER, rows[k:k + 1], warm, user[:, :hi - k],
+                               rows[None, k + 1:hi + 1], None, None)
+            if counters.any():
+                return None
+            stop = np.abs(rows[k + 1:hi + 1, 1 + nq:ncol]).max(axis=1) <= vel_tol
+            if stop.any():
+                end = k + 1 + int(stop.argmax())  # the first substep that passes
+                break
+            k = hi
+        return rows[:end + 1, :ncol]
+
+
+_FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS
+_USER = mujoco.mjtState.mjSTATE_USER
+_CALLBACK_GETTERS = tuple(getattr(mujoco, f"get_mjcb_{name}") for name in (
+    "control", "passive", "act_dyn", "act_gain", "act_bias", "sensor", "contactfilter", "time"))
+
+
+def _rollout_is_exact(model: mujoco.MjModel) -> bool:
+    """Whether ``mujoco.rollout`` of a held control is exactly the ``mj_step`` loop.
+
+    See :meth:`Rollout._tail_by_rollout`: degrees of freedom to test for the stop rule, no
+    plugin and no global callback (either could write the user inputs inside ``mj_step``,
+    which the rollout re-sets every substep).
+    """
+    return (model.nv > 0 and model.nplugin == 0
+            and all(get() is None for get in _CALLBACK_GETTERS))
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
@@ -1143,7 +1249,8 @@ class Gate:
                 and self.scene.candidate_pairs):
             # Common path: window + braking tail certified by ONE call (see _certify_joint).
             rows, brake_next = self._rollout.brake_rows(
-                data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
+                data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol,
+                window_fresh=True)  # states() ran just above on this data, ctrl and n
             tail = _Tail(rows, self.model, data)
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
