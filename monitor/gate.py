@@ -391,6 +391,45 @@ _TRN_JOINT = int(mujoco.mjtTrn.mjTRN_JOINT)
 _HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
 
 
+_HOLD_STRUCT = ("actuator_trntype", "actuator_biastype", "actuator_gaintype", "actuator_trnid", "jnt_type",
+                "jnt_qposadr", "actuator_ctrllimited")
+_HOLD_VALUES = ("actuator_gainprm", "actuator_biasprm", "actuator_gear", "actuator_ctrlrange")
+_HOLD_CACHE: dict[int, list[Any]] = {}
+_HOLD_CACHE_MAX = 16
+
+
+def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """Which actuators :func:`hold_ctrl` computes, from the model's CURRENT structure arrays.
+
+    Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
+    by structure alone (joint transmission, affine bias, fixed gain; the value conditions
+    ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
+    joint, the ctrl-limited actuators, and views of the value arrays (gainprm, biasprm,
+    gear, ctrlrange: the model's own buffers, so in-place edits are seen). Cached per model
+    object and keyed on the bytes of every structure array read (an in-place edit of one of
+    them recomputes it); MjModel array views never move, so the cached views stay valid.
+    """
+    hit = _HOLD_CACHE.get(id(model))
+    if hit is None or hit[0] is not model:
+        if len(_HOLD_CACHE) >= _HOLD_CACHE_MAX:
+            _HOLD_CACHE.pop(next(iter(_HOLD_CACHE)))
+        hit = [model, [getattr(model, f) for f in _HOLD_STRUCT],
+               tuple(getattr(model, f) for f in _HOLD_VALUES), None, None]
+        _HOLD_CACHE[id(model)] = hit  # the model reference keeps id(model) unique
+    struct = hit[1]
+    key = b"|".join([v.tobytes() for v in struct])
+    if hit[3] != key:
+        trntype, biastype, gaintype, trnid, jnt_type, jnt_qposadr, ctrllimited = struct
+        j = trnid[:, 0]
+        a = np.flatnonzero((trntype == _TRN_JOINT) & (biastype == _AFFINE) & (gaintype == _FIXED))
+        jt = jnt_type[j[a]]
+        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+        hit[4] = (a, jnt_qposadr[j[a]].copy(), np.flatnonzero(ctrllimited.astype(bool)))
+        hit[3] = key
+    a, adr, limited = hit[4]
+    return a, adr, limited, hit[2]
+
+
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     """A control that holds the current position where the actuators allow it.
 
@@ -402,8 +441,9 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     where the control is limited.
 
     Vectorised over the actuators and read from the live model on every call (a model
-    edited in place, e.g. a randomised gain, is used as it is now); the same
-    operations per actuator as the scalar formula, so the same floats.
+    edited in place, e.g. a randomised gain, is used as it is now: the structure arrays
+    are compared byte for byte with the cached selection, the values are read live); the
+    same operations per actuator as the scalar formula, so the same floats.
 
     Returns:
         (nu,) float64 control.
@@ -412,22 +452,18 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     ctrl = np.zeros(nu)
     if nu == 0:
         return ctrl
-    gain = model.actuator_gainprm[:, 0]
-    b0, b1 = model.actuator_biasprm[:, 0], model.actuator_biasprm[:, 1]
-    j = model.actuator_trnid[:, 0]
-    ok = ((model.actuator_trntype == _TRN_JOINT) & (model.actuator_biastype == _AFFINE)
-          & (model.actuator_gaintype == _FIXED) & (gain != 0.0) & (b1 != 0.0))
-    if ok.any():
-        a = np.flatnonzero(ok)
-        ja = j[a]
-        jt = model.jnt_type[ja]
-        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+    a, adr, limited, (gainprm, biasprm, gear, ctrlrange) = _hold_plan(model)
+    if a.size:
+        gain = gainprm[a, 0]
+        b1 = biasprm[a, 1]
+        ok = (gain != 0.0) & (b1 != 0.0)
+        if not ok.all():
+            a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
         if a.size:
-            length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j[a]]]
-            ctrl[a] = -(b0[a] + b1[a] * length) / gain[a]
-    limited = model.actuator_ctrllimited.astype(bool)
-    lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
-    ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
+            length = gear[a, 0] * data.qpos[adr]
+            ctrl[a] = -(biasprm[a, 0] + b1 * length) / gain
+    if limited.size:
+        ctrl[limited] = np.clip(ctrl[limited], ctrlrange[limited, 0], ctrlrange[limited, 1])
     return ctrl
 
 
