@@ -322,10 +322,10 @@ class Rollout:
         (and fills the rest with the last state) where the loop goes on: any warning
         returns None and the caller runs the loop.
 
-        Two calls: the first substep (a tail at rest stops there, as in the loop), then
-        all the others at once (one ``rollout`` call costs ~10-15 µs of fixed overhead
-        here, more than a substep; a tail that stops midway simulates substeps past its
-        end, which only touch the private scratch).
+        The first substep is one ``mj_step`` as in the loop (a tail at rest stops there);
+        all the others run in one ``rollout`` call (a call costs ~10-15 µs of fixed
+        overhead here, more than a substep; a tail that stops midway simulates substeps
+        past its end, which only touch the private scratch).
 
         Returns:
             rows (K, 1 + nq + nv) as :meth:`_tail_by_loop`, or None after a warning.
@@ -341,30 +341,23 @@ class Rollout:
         ncol = 1 + nq + nv
         rows = np.empty((n + 1, self._n_full))  # full physics state per waypoint
         mujoco.mj_getState(m, s, rows[0], _FULL)
-        user = np.empty((1, n, self._n_user))  # the user inputs, held over the tail
+        # Substep 1 exactly as the loop runs it (a tail at rest stops here).
+        mujoco.mj_step(m, s)
+        mujoco.mj_getState(m, s, rows[1], _FULL)
+        if n == 1 or np.abs(rows[1, 1 + nq:ncol]).max() <= vel_tol:
+            return rows[:2, :ncol]
+        # Substeps 2..n in one rollout call from the scratch's state after substep 1.
+        user = np.empty((1, n - 1, self._n_user))  # the user inputs, held over the tail
         mujoco.mj_getState(m, s, user[0, 0], _USER)
         user[0, 1:] = user[0, 0]
         warm = np.array(s.qacc_warmstart).reshape(1, nv)
-        models, datas = [m], [s]
         counters = s.warning.number  # a view of the scratch's warning counters
-        end = n
-        k = 0
-        chunk = 1
-        while k < n:
-            hi = min(k + chunk, n)
-            chunk = n
-            if k:
-                warm[0] = s.qacc_warmstart  # the scratch holds substep k
-            counters[:] = 0
-            self._roll.rollout(models, datas, hi - k, _USER, rows[k:k + 1], warm, user[:, :hi - k],
-                               rows[None, k + 1:hi + 1], None, None)
-            if counters.any():
-                return None
-            stop = np.abs(rows[k + 1:hi + 1, 1 + nq:ncol]).max(axis=1) <= vel_tol
-            if stop.any():
-                end = k + 1 + int(stop.argmax())  # the first substep that passes
-                break
-            k = hi
+        counters[:] = 0
+        self._roll.rollout([m], [s], n - 1, _USER, rows[1:2], warm, user, rows[None, 2:], None, None)
+        if counters.any():
+            return None
+        stop = np.abs(rows[2:, 1 + nq:ncol]).max(axis=1) <= vel_tol
+        end = 2 + int(stop.argmax()) if stop.any() else n  # the first substep that passes
         return rows[:end + 1, :ncol]
 
 
