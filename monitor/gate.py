@@ -124,6 +124,7 @@ class Rollout:
         self.c_tail = True
         """Run braking tails in ``mujoco.rollout`` where exact (False: always the ``mj_step`` loop)."""
         self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
+        self._tail_bufs: tuple[np.ndarray, ...] | None = None  # buffers of the C tail (see _tail_by_rollout)
         self._n_full = self._n_user = 0
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
@@ -347,11 +348,15 @@ class Rollout:
         if n == 1 or np.abs(rows[1, 1 + nq:ncol]).max() <= vel_tol:
             return rows[:2, :ncol]
         # Substeps 2..n in one rollout call from the scratch's state after substep 1.
-        user = np.empty((1, n - 1, self._n_user))  # the user inputs, held over the tail
+        bufs = self._tail_bufs
+        if bufs is None or bufs[0].shape[1] != n - 1:
+            # (user inputs held over the tail, warm start, warning counters: views of the scratch)
+            bufs = self._tail_bufs = (np.empty((1, n - 1, self._n_user)), np.empty((1, nv)), s.warning.number,
+                                      s.qacc_warmstart)
+        user, warm, counters, s_warm = bufs
         mujoco.mj_getState(m, s, user[0, 0], _USER)
         user[0, 1:] = user[0, 0]
-        warm = np.array(s.qacc_warmstart).reshape(1, nv)
-        counters = s.warning.number  # a view of the scratch's warning counters
+        warm[0] = s_warm
         counters[:] = 0
         self._roll.rollout([m], [s], n - 1, _USER, rows[1:2], warm, user, rows[None, 2:], None, None)
         if counters.any():
