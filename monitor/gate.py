@@ -685,9 +685,11 @@ def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> 
     A shallow copy (the pair results, possibly not built yet, are shared); ``window`` and
     ``stats`` are its own.
     """
-    out = copy.copy(cert)
-    object.__setattr__(out, "window", window)
-    object.__setattr__(out, "stats", {**cert.stats, "joint_window": span})
+    out = object.__new__(type(cert))  # = copy.copy(cert) (a dataclass: its __dict__ is its state)
+    state = out.__dict__
+    state.update(cert.__dict__)
+    state["window"] = window
+    state["stats"] = {**cert.stats, "joint_window": span}
     return out
 
 
