@@ -606,6 +606,29 @@ class StepReport:
                               certify_us=self.certify_us if timing else None), **safety_keys(self)}
 
 
+def _all_culled(cert: Certificate) -> int | None:
+    """The number of pairs if every one of them was decided by the broad phase, else None.
+
+    From the certificate's documented stats (``pairs``: the pair count; ``checker_mix``:
+    ``{method: count}``), without building its :class:`PairResult` tuple (the engine builds
+    it lazily, ~50-100 µs per gated Pusher step): ``checker_mix == {"culled": pairs}`` means
+    each pair's ``method`` is ``"culled"``. ``tests/test_gate_reports.py`` checks it against
+    the built pairs.
+    """
+    stats = cert.stats
+    n = stats.get("pairs")
+    mix = stats.get("checker_mix")
+    if type(n) is int and n > 0 and type(mix) is dict and len(mix) == 1 and mix.get("culled") == n:
+        return n
+    return None
+
+
+def _npairs(cert: Certificate) -> int:
+    """``len(cert.pairs)`` without building the pairs when the stats already say it."""
+    n = _all_culled(cert)
+    return len(cert.pairs) if n is None else n
+
+
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
                 fallback_certified: bool, terminated: bool, time: float, brake_verdict: str = "",
                 certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
@@ -618,11 +641,16 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         checker = np.full(int(npairs or 0), "", dtype=object)
         mix, wit, earliest, clearance = "", None, inf, inf
     else:
-        names = [str(p.method) for p in cert.pairs]
-        checker = np.empty(len(names), dtype=object)
-        checker[:] = names
-        counts = Counter(names)
-        mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
+        n = _all_culled(cert)
+        if n is not None:  # every pair culled (the common gated step): no PairResult is built
+            checker = np.full(n, "culled", dtype=object)
+            mix = f"culled:{n}" if n else ""
+        else:
+            names = [str(p.method) for p in cert.pairs]
+            checker = np.empty(len(names), dtype=object)
+            checker[:] = names
+            counts = Counter(names)
+            mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
         clearance = float(cert.clearance)
@@ -1029,7 +1057,7 @@ class Gate:
             self._remember(cert, keys)
         us = (time.perf_counter() - t_start) * 1e6
         self.stats["reused_pairs"] += len(reused)
-        self.stats["pairs"] += len(cert.pairs)
+        self.stats["pairs"] += _npairs(cert)
         return cert, us
 
     def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,

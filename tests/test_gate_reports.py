@@ -109,3 +109,34 @@ def test_arm_reports_do_not_depend_on_the_tail_simulator():
     old, _ = _gym("monitor/Arm-v0", False, 40)
     _same(new, old)
     assert s["replaced"] > 0 and s["brake_rejected"] > 0 and s["joint"] > 0
+
+
+def test_the_all_culled_shortcut_gives_the_info_built_from_the_pairs():
+    """info["safety"] without building PairResults (every pair culled) equals the one built from them."""
+    from collections import Counter
+
+    from monitor.gate import _all_culled
+
+    shortcuts = others = 0
+    for env_id, kw in (("Pusher-v5", {"pairs": "mujoco"}), ("monitor/Arm-v0", {})):
+        env = SafetyGate(gym.make(env_id), **kw)
+        env.action_space.seed(0)
+        env.reset(seed=0)
+        pairs_seen = 0
+        for _ in range(25):
+            _, _, term, trunc, info = env.step(env.action_space.sample())
+            cert = env.gate.last_report.certificate
+            if _all_culled(cert) is not None:
+                shortcuts += 1
+            else:
+                others += 1
+            names = [str(p.method) for p in cert.pairs]  # the oracle: the pairs themselves
+            pairs_seen += len(cert.pairs)
+            counts = Counter(names)
+            assert info["safety"]["checker"].tolist() == names
+            assert info["safety"]["checker_mix"] == " ".join(f"{m}:{counts[m]}" for m in sorted(counts))
+            assert info["safety"]["monitored_pairs"] == len(names)
+            if term or trunc:
+                env.reset(seed=1)
+        env.close()
+    assert shortcuts > 0 and others > 0  # both branches ran

@@ -46,7 +46,7 @@ def tunnel(brake=True):
             mujoco.mj_resetDataKeyframe(m, d, 0); gate.reset()
         r = gate.step(d, ctrls[k // 20])
         h.update(report_key(r).encode()); h.update(d.qpos.tobytes()); h.update(d.qvel.tobytes())
-    return gate.summary(), h.hexdigest()
+    return {**gate.summary(), "pairs_total": gate.stats["pairs"]}, h.hexdigest()
 
 
 def gymrun(env_id, brake=True, **kw):
@@ -60,7 +60,7 @@ def gymrun(env_id, brake=True, **kw):
         h.update(d.qpos.tobytes()); h.update(d.qvel.tobytes())
         if te or tr:
             env.reset(seed=1)
-    return env.gate.summary(), h.hexdigest()
+    return {**env.gate.summary(), "pairs_total": env.gate.stats["pairs"]}, h.hexdigest()
 
 
 for name, f in [("tunnel", lambda: tunnel()), ("Pusher-v5", lambda: gymrun("Pusher-v5", pairs="mujoco")),
@@ -69,4 +69,4 @@ for name, f in [("tunnel", lambda: tunnel()), ("Pusher-v5", lambda: gymrun("Push
                 ("monitor/Arm-v0 brake=False", lambda: gymrun("monitor/Arm-v0", brake=False))]:
     s, dig = f()
     print(f"{name:28s} steps {steps} joint {s.get('joint', 0)} replaced {s['replaced']} "
-          f"brake_rejected {s['brake_rejected']} {dig[:16]}")
+          f"brake_rejected {s['brake_rejected']} pairs {s['pairs_total']} {dig[:16]}")

@@ -30,8 +30,16 @@ for o, nm in [(G.Gate, "decide"), (G.Rollout, "states"), (G.Rollout, "brake_rows
               (P, "pack_trajectory"), (KK, "_pack_agrees"), (P, "plan_data_agrees"), (P, "static_key"),
               (KK, "window_kernel"), (S.Scene, "sync"), (G.Gate, "_split_reuse"), (G, "_part"),
               (G.StepReport, "info"), (G.Gate, "_write_log"), (G.Gate, "_account"), (G, "hold_ctrl"),
-              (G.Rollout, "window_matches"), (G.Rollout, "commit"), (E, "_check_model")]:
+              (G.Rollout, "window_matches"), (G.Rollout, "commit"), (E, "_check_model"),
+              (G.Gate, "_sync_scene"), (G.Gate, "_remember"), (G, "safety_info"), (GG.SafetyGate, "_step_env"),
+              (GG.SafetyGate, "_check_applied_ctrl"), (GG.SafetyGate, "_as_inner"), (GG.SafetyGate, "_commit_sim"),
+              (G.Rollout, "_tail_by_rollout"), (E, "_certify_fast"), (E, "_fast_inputs"), (GG.SafetyGate, "step")]:
     wrap(o, nm)
+import monitor.gate_policy as GP
+for nm in ("safety_keys", "applied_cost", "block_reason"):
+    wrap(GP, nm); wrap(G, nm)
+src = [c for c in vars(E).values() if isinstance(c, type) and hasattr(c, "build_pairs")]
+for c in src: wrap(c, "build_pairs")
 kw = {"pairs": "mujoco"} if "Pusher" in env_id else {}
 g = GG.SafetyGate(gym.make(env_id), brake=brake, **kw); u = gym.make(env_id)
 u.reset(seed=0); u.action_space.seed(0); acts = [u.action_space.sample() for _ in range(n)]
