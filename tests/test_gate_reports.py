@@ -140,3 +140,37 @@ def test_the_all_culled_shortcut_gives_the_info_built_from_the_pairs():
                 env.reset(seed=1)
         env.close()
     assert shortcuts > 0 and others > 0  # both branches ran
+
+
+def test_the_pair_count_from_the_stats_equals_the_built_pairs(monkeypatch):
+    """Gate.stats["pairs"] is summed from each certificate's stats (no PairResult built); it must
+    equal the number of pair results of every certificate the gate made: joint and two-call
+    steps, reuse subsets (merged certificates), fallbacks and tail-covered windows. (The
+    ongoing-contact rule's recombined certificates keep their pair list and stats; no episode
+    here starts in contact.)"""
+    from monitor.gate import Gate as _Gate
+
+    certs = []
+    real = _Gate._certify
+
+    def spy(self, plan):
+        cert, us = real(self, plan)
+        certs.append(cert)
+        return cert, us
+
+    monkeypatch.setattr(_Gate, "_certify", spy)
+    for run in (lambda: _tunnel(True, 120), lambda: _gym("monitor/Arm-v0", True, 30),
+                lambda: _gym("Pusher-v5", True, 20, pairs="mujoco")):
+        certs.clear()
+        _, summary = run()
+        assert certs
+        assert sum(len(c.pairs) for c in certs) == sum(c.stats["pairs"] for c in certs)
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    gate = Gate(m, ongoing="deepen")
+    certs.clear()
+    for _ in range(60):
+        gate.step(d, np.array([3.0]))
+    assert gate.stats["pairs"] == sum(len(c.pairs) for c in certs)
+    assert gate.stats["reused_pairs"] > 0 and gate.stats["replaced"] > 0
