@@ -127,6 +127,23 @@ class Rollout:
         self._tail_bufs: tuple[np.ndarray, ...] | None = None  # buffers of the C tail (see _tail_by_rollout)
         self._n_full = self._n_user = 0
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle / deepcopy state: without the C rollout object and views into the scratches.
+
+        ``mujoco._rollout.Rollout`` does not pickle, and a copied view of a scratch array
+        (``_s_ctrl``, the tail's warning counters and warm start) would be a detached copy,
+        no longer the copied ``MjData``'s memory; all are rebuilt from the copied scratches.
+        """
+        state = self.__dict__.copy()
+        state.pop("_s_ctrl", None)
+        state["_roll"] = None
+        state["_tail_bufs"] = None
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._s_ctrl = self.scratch.ctrl
+
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
 

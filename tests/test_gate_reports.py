@@ -174,3 +174,38 @@ def test_the_pair_count_from_the_stats_equals_the_built_pairs(monkeypatch):
         gate.step(d, np.array([3.0]))
     assert gate.stats["pairs"] == sum(len(c.pairs) for c in certs)
     assert gate.stats["reused_pairs"] > 0 and gate.stats["replaced"] > 0
+
+
+def _warm_arm_gate():
+    m = mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+    rng = np.random.default_rng(0)
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    gate = Gate(m)
+    for _ in range(3):
+        gate.step(d, rng.uniform(m.actuator_ctrlrange[:, 0], m.actuator_ctrlrange[:, 1]))
+    return gate, d
+
+
+def test_a_copied_gate_gives_the_same_reports():
+    """A deep-copied or pickled Gate (after steps: its scratches, C tail and caches in use) decides
+    exactly as the original on the same states. Regression: the copy's scratch control was a
+    detached copy of the old view (every copied prediction ran under a stale control) and, with the
+    C tail, the rollout object did not pickle."""
+    import copy
+    import pickle
+
+    for clone in (copy.deepcopy, lambda g: pickle.loads(pickle.dumps(g))):
+        gate, d = _warm_arm_gate()
+        g2 = clone(gate)
+        d2 = mujoco.MjData(g2.model)
+        mujoco.mj_copyData(d2, g2.model, d)
+        m = gate.model
+        ctrls = np.random.default_rng(5).uniform(m.actuator_ctrlrange[:, 0], m.actuator_ctrlrange[:, 1],
+                                                 size=(15, m.nu))
+        for c in ctrls:
+            r = gate.step(d, c)
+            r2 = g2.step(d2, c)
+            assert report_key(r2) == report_key(r)
+            assert np.array_equal(d2.qpos, d.qpos) and np.array_equal(d2.qvel, d.qvel)
+        assert g2.stats["joint"] > 0  # the braking tail ran in the copy
