@@ -115,6 +115,9 @@ from monitor.tolerances import DEFAULT, Tolerances
 
 _U = 2.0**-53
 _ETA = 1e-9
+USE_COMPILED = True
+"""Default of :func:`subdivide`'s ``compiled``: the numba level kernel (``fat_kernels``), or the
+numpy kernels of this module (False; the oracle the tests compare against)."""
 """Relative widening of parameter ranges [0, 1] and tau-intervals (conservative)."""
 
 
@@ -811,13 +814,15 @@ def _sqrt_jinv(m: Metric) -> float:
 
 
 def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
-                   tolerances: Tolerances = DEFAULT) -> np.ndarray:
+                   tolerances: Tolerances = DEFAULT, *, compiled: bool = False) -> np.ndarray:
     """One ball test of one pair: which units' fat A-feature meets B (for tests and tools).
 
     Args:
         pd: pair data from :func:`prepare_pair` (or built from feature sets).
         L: (3, 3) linear part of the centre g (A body frame -> B frame); p: (3,).
         R: ball radius (metric of ``pd.A.metric``), used as given (no padding).
+        compiled: evaluate with :func:`monitor.certify.fat_kernels.fat_level` (pre-filter
+            off) instead of the numpy oracle kernels.
 
     Returns:
         (n_units,) bool, in the order of ``pd.A.units x pd.B.units`` (or A vertices for a half-space).
@@ -826,6 +831,8 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
     T = _build_tables([pd], C)
     tol = tolerances
     L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    if compiled:
+        return _one_ball_compiled(pd, C, T, L1, p1, R1, tol, prefilter=False)[1]
     eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
                      np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
     ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
@@ -835,14 +842,35 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
 
 
 def prefilter_separated(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
-                        tolerances: Tolerances = DEFAULT) -> bool:
-    """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests."""
+                        tolerances: Tolerances = DEFAULT, *, compiled: bool = False) -> bool:
+    """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests.
+
+    ``compiled``: the answer of :func:`monitor.certify.fat_kernels.fat_level` instead of
+    the numpy oracle.
+    """
     tol = tolerances
     L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    if compiled:
+        C = _Concat([pd])
+        return bool(_one_ball_compiled(pd, C, _build_tables([pd], C), L1, p1, R1, tol, prefilter=True)[0][0])
     eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
                      np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
     ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
     return bool(_Prefilter([pd]).separated(np.zeros(1, np.int64), ball, tol)[0])
+
+
+def _one_ball_compiled(pd: _PairData, C: _Concat, T: _Tables, L1: np.ndarray, p1: np.ndarray,
+                       R1: np.ndarray, tol: Tolerances, prefilter: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(sep (1,), unit_fired (n_units,)) of one ball by the compiled level kernel."""
+    fast = _FastLevel(C, T, _Prefilter([pd]) if prefilter else None, np.array([pd.A.rho_max]),
+                      np.array([pd.r], float), np.array([pd.A.extent]), np.array([pd.B.extent]),
+                      np.array([pd.A.flat_err]), np.array([pd.B.flat_err]),
+                      np.array([_sqrt_jinv(pd.A.metric)]), tol)
+    uid = T.pair_units[0]
+    fr = _Frontier(np.zeros(1, np.int64), np.zeros(1), np.ones(1), np.zeros(1, np.int64),
+                   np.zeros(len(uid), np.int64), uid)
+    sep, fired, *_ = fast.level(fr, L1, p1, R1)
+    return sep, fired
 
 
 class _Prefilter:
@@ -900,6 +928,64 @@ class _Prefilter:
 
 
 # ============================================================================ driver
+
+
+def _c(x: np.ndarray, dtype: Any = np.float64) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=dtype)
+
+
+def _flat_rows(T: _Tables) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Global row table as three (n_rows,) int64 arrays: type code, A feature, B feature.
+
+    Type codes follow ``_TYPES`` (``fat_kernels.T_VF`` ...); for VH rows the B column is
+    the pair index (the half-space of that pair).
+    """
+    types, cols_a, cols_b = [], [], []
+    for k, t in enumerate(_TYPES):
+        rows = T.rows[t]
+        n = len(rows["pair"])
+        types.append(np.full(n, k, np.int64))
+        cols_a.append(rows["a"])
+        cols_b.append(rows["b"] if "b" in rows else rows["pair"])
+    return (_c(np.concatenate(types), np.int64), _c(np.concatenate(cols_a), np.int64),
+            _c(np.concatenate(cols_b), np.int64))
+
+
+class _FastLevel:
+    """Flat arrays of one :func:`subdivide` call for :func:`monitor.certify.fat_kernels.fat_level`."""
+
+    def __init__(self, C: _Concat, T: _Tables, pre: _Prefilter | None, rho_max: np.ndarray,
+                 r_pair: np.ndarray, a_ext: np.ndarray, b_ext: np.ndarray, flat_a: np.ndarray,
+                 flat_b: np.ndarray, sqj: np.ndarray, tol: Tolerances):
+        from monitor.certify import fat_kernels
+        self.kernel = fat_kernels.fat_level
+        rt, ra, rb = _flat_rows(T)
+        if pre is not None:
+            pf = (_c(pre.V), _c(pre.qv), _c(pre.n), _c(pre.off), _c(pre.on, np.bool_),
+                  _c(pre.two, np.bool_), 1)
+        else:
+            P = len(rho_max)
+            pf = (np.zeros((P, 1, 3)), np.zeros((P, 1)), np.zeros((P, 1, 3)), np.zeros((P, 1)),
+                  np.zeros(P, np.bool_), np.zeros(P, np.bool_), 0)
+        self.per_pair = tuple(_c(x) for x in (rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj)) + pf
+        self.feats = tuple(_c(x) for x in (C.av, C.aqv, C.ae_v0, C.ae_d, C.ae_k, C.af_o, C.af_U, C.af_k0,
+                                            C.af_kg, C.af_K, C.af_hn, C.af_hc, C.be_w0, C.be_e, C.bf_o,
+                                            C.bf_n, C.bf_U, C.bf_hn, C.bf_hc, C.h_n, C.h_off))
+        self.rows = (rt, ra, rb, _c(T.unit_ptr, np.int64), _c(T.unit_rows, np.int64))
+        self.tol = (float(tol.rel_pad), float(tol.abs_pad), float(tol.scale_pad))
+
+    def level(self, fr: _Frontier, L: np.ndarray, p: np.ndarray, R: np.ndarray):
+        """(sep (N,), unit_fired (K,), rows per item (N,), units per item (N,), distinct rows)."""
+        N, K = len(fr.pair), len(fr.unit_item)
+        sep = np.empty(N, np.bool_)
+        fired = np.empty(K, np.bool_)
+        rows_i = np.empty(N, np.int64)
+        units_i = np.empty(N, np.int64)
+        nrow = self.kernel(_c(fr.pair, np.int64), _c(L), _c(p), _c(R), *self.per_pair, *self.feats,
+                           *self.rows, _c(fr.unit_item, np.int64), _c(fr.unit_id, np.int64), *self.tol,
+                           sep, fired, rows_i, units_i)
+        return sep, fired, rows_i, units_i, int(nrow)
+
 
 
 @dataclass
@@ -974,11 +1060,15 @@ def frontier_over_cap(pair: np.ndarray, t0: np.ndarray, go: np.ndarray, cap: int
 def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: float, epsilon: float,
               tolerances: Tolerances = DEFAULT, budget: Budget | None = None,
               active: np.ndarray | None = None, extra0: Any = None,
-              prefilter: bool = True) -> SubdivisionResult:
-    """Breadth-first subdivision over all pairs (Listings 1-2, Remark 2 pruning).
+              prefilter: bool = True, compiled: bool | None = None) -> SubdivisionResult:
+    """Breadth-first subdivision over all pairs (§6, Listings 1-2, Remark 2 pruning).
 
     ``prefilter`` runs :class:`_Prefilter` on every item first (items it excludes count no
     unit tests; their number is in ``SubdivisionResult.prefiltered``).
+    ``compiled`` evaluates each level's pre-filter and rows in one numba call
+    (:func:`monitor.certify.fat_kernels.fat_level`); False runs the numpy kernels of this
+    module, kept as the test oracle (same tests, same pads, same counts); None: the module
+    switch :data:`USE_COMPILED`.
     """
     tol = tolerances
     C = _Concat(pairs)
@@ -994,6 +1084,8 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     flat_a = np.array([pd.A.flat_err for pd in pairs], float)
     flat_b = np.array([pd.B.flat_err for pd in pairs], float)
     sqj = np.array([_sqrt_jinv(pd.A.metric) for pd in pairs], float)
+    fast = (_FastLevel(C, T, pre, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj, tol)
+            if (USE_COMPILED if compiled is None else compiled) and pairs else None)
     units_i = [T.pair_units[i] for i in idx_pairs]
     fr = _Frontier(idx_pairs.astype(np.int64), np.full(len(idx_pairs), t0), np.full(len(idx_pairs), t1),
                    np.zeros(len(idx_pairs), np.int64),
@@ -1018,14 +1110,19 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
             L, p, R = provider.balls(fr)
             R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
             pr = fr.pair
-            eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
-            ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
-            if pre is not None:
-                sep = pre.separated(fr.pair, ball, tol)
-                live = np.nonzero(~sep[fr.unit_item])[0]
+            if fast is None:
+                eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
+            if fast is not None:
+                check_active_budget()
+                sep, unit_fired, rows_i, units_i_n, nrow = fast.level(fr, L, p, R)
             else:
-                live = np.arange(len(fr.unit_item))
-            uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
+                ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
+                if pre is not None:
+                    sep = pre.separated(fr.pair, ball, tol)
+                    live = np.nonzero(~sep[fr.unit_item])[0]
+                else:
+                    live = np.arange(len(fr.unit_item))
+                uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
         except BudgetExhausted:  # this level's frontier stays unresolved, as at the check above
             exhausted = True
             for i in range(len(fr.pair)):
@@ -1033,10 +1130,14 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
             break
         if pre is not None:
             np.add.at(prefiltered, fr.pair[sep], 1)
-        unit_fired = np.zeros(len(fr.unit_item), bool)
-        unit_fired[live] = uf_live
-        np.add.at(row_tests, fr.pair[u_item], 1)
-        np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
+        if fast is not None:
+            np.add.at(row_tests, fr.pair, rows_i)
+            np.add.at(unit_tests, fr.pair, units_i_n)
+        else:
+            unit_fired = np.zeros(len(fr.unit_item), bool)
+            unit_fired[live] = uf_live
+            np.add.at(row_tests, fr.pair[u_item], 1)
+            np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
         np.add.at(items_n, fr.pair, 1)
         if budget is not None:
             budget.charge(nrow)
@@ -1208,7 +1309,8 @@ def prepare_pair(shape_a: ConvexShape, shape_b: ConvexShape, margin: float,
 def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShape, int]],
                 window: tuple[float, float], margin: float, epsilon: float,
                 tolerances: Tolerances = DEFAULT, budget: Budget | None = None, *,
-                static: np.ndarray | None = None, check_start: bool = True) -> list[PairOutcome]:
+                static: np.ndarray | None = None, check_start: bool = True,
+                compiled: bool | None = None) -> list[PairOutcome]:
     """Toleranced-ball check of shape pairs under a trajectory.
 
     Args:
@@ -1222,6 +1324,8 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
         static: optional (nbody,) bool; a static body is chosen as the fixed side.
         check_start: run the exact static test at t0 for solid pairs (containment is
             invisible to boundary tests). The engine does it itself and passes False.
+        compiled: run the levels in :func:`monitor.certify.fat_kernels.fat_level`; False:
+            the numpy kernels of this module (the test oracle); None: :data:`USE_COMPILED`.
 
     Returns:
         One :class:`PairOutcome` per item: ``"certified"`` or ``"unresolved"`` (the engine
@@ -1259,7 +1363,7 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
                 active[i] = False
     if active.any():
         prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds])
-        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active)
+        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active, compiled=compiled)
         for i in np.nonzero(active)[0]:
             iv = res.intervals[i]
             outs[i] = PairOutcome(

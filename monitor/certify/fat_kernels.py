@@ -1,0 +1,419 @@
+"""Compiled fat-feature tests of the toleranced checker (Schröcker & Weber §3-§4, numba).
+
+One call per subdivision level evaluates, for every frontier item (a sub-interval
+covered by the ball B_R(g) of §5, eq. 9-10) and every unit that fired on the parent
+(Remark 2 pruning), the elementary rows of :mod:`monitor.certify.toleranced`:
+
+* the pre-filter (orbit of A inside conv{ball(g(v), F(v))}; §3: the orbit of a point
+  under B_R(g) is the ball of radius R rho(x), eq. 4),
+* VF / VH: a vertex's ball (§3, eq. 4) against a face of B / a half-space,
+* EE: the fat edge (§3, the hyperboloid of eq. 6) against an edge of B,
+* FE: the fat face (§3, the two-sheet hyperboloid of eq. 8 over sigma(P), Prop. 1)
+  against an edge of B (§4, including the crossing case Listing 2 misses),
+* EF: an edge of A crossing a face of B at the centre pose (§4).
+
+Every test is the scalar transcription of the numpy oracle in ``toleranced.py``
+(``_kernel_VF``, ``_kernel_EE``, ``_kernel_FE``, ``_kernel_EF``, ``_kernel_VH``,
+``_Prefilter.separated``, ``_eps_items``, ``_Ball``): same quantities, same rounding pads,
+same NaN rule (a non-finite value fires a row and never separates an item). The numpy
+versions stay as the test oracle (``tests/test_fat_kernels.py``).
+
+Layout. Features are the flat arrays of ``toleranced._Concat``; rows are the global
+row table (``row_type``, ``row_a``, ``row_b``: for VH ``row_b`` is the pair index);
+units are CSR (``unit_ptr``, ``unit_rows``). Rows shared by several units of the same
+item are evaluated once (as ``np.unique`` over (item, row) keys in the oracle).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+T_VF = 0
+T_EE = 1
+T_FE = 2
+T_EF = 3
+T_VH = 4
+"""Row type codes, in the order of ``toleranced._TYPES``."""
+
+_U = 2.0**-53
+_ETA = 1e-9
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _mx(x, y):
+    """np.maximum for scalars: NaN if either is NaN."""
+    if x != x or y != y:
+        return math.nan
+    return x if x >= y else y
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _mn(x, y):
+    """np.minimum for scalars: NaN if either is NaN."""
+    if x != x or y != y:
+        return math.nan
+    return x if x <= y else y
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _pad2(S, e, rel):
+    """Pad (m^2) of a quadratic value whose terms sum to S in absolute value (toleranced doc)."""
+    S = abs(S)
+    return 8.0 * rel * S + 2.0 * math.sqrt(S) * e + e * e
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _qmax01(a, b, c):
+    """Max of a t^2 + b t + c over t in [0, 1] (vertex included if within [-eta, 1 + eta])."""
+    best = _mx(c, a + b + c)
+    t = -b / (2.0 * a)
+    v = c - b * b / (4.0 * a)
+    if a < 0 and t >= -_ETA and t <= 1 + _ETA:
+        return _mx(best, v)
+    return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _apply(L, p, it, x):
+    """g(x) = L[it] x + p[it] for a (3,) body-frame point x; returns three floats."""
+    y0 = L[it, 0, 0] * x[0] + L[it, 0, 1] * x[1] + L[it, 0, 2] * x[2] + p[it, 0]
+    y1 = L[it, 1, 0] * x[0] + L[it, 1, 1] * x[1] + L[it, 1, 2] * x[2] + p[it, 1]
+    y2 = L[it, 2, 0] * x[0] + L[it, 2, 1] * x[1] + L[it, 2, 2] * x[2] + p[it, 2]
+    return y0, y1, y2
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _lin(L, it, x):
+    """L[it] x for a (3,) direction x."""
+    y0 = L[it, 0, 0] * x[0] + L[it, 0, 1] * x[1] + L[it, 0, 2] * x[2]
+    y1 = L[it, 1, 0] * x[0] + L[it, 1, 1] * x[1] + L[it, 1, 2] * x[2]
+    y2 = L[it, 2, 0] * x[0] + L[it, 2, 1] * x[1] + L[it, 2, 2] * x[2]
+    return y0, y1, y2
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _clip(g0, h0, lo, hi, hn, hc, f, w0, w1, dw0, dw1, extra):
+    """Intersect [lo, hi] with {s : g_k s <= h_k} for the half-planes of polygon f.
+
+    Row k: g_k = hn[f, k] . dw, h_k = hc[f, k] - hn[f, k] . w + extra (the oracle's
+    ``_clip_interval`` with EF's second constraint set). ``g0, h0`` unused placeholders
+    keep the call shape uniform. Returns (lo, hi, empty).
+    """
+    upper = math.inf
+    lower = -math.inf
+    empty = False
+    for k in range(hn.shape[1]):
+        g = hn[f, k, 0] * dw0 + hn[f, k, 1] * dw1
+        h = hc[f, k] - (hn[f, k, 0] * w0 + hn[f, k, 1] * w1) + extra
+        ratio = h / g
+        if g > 0:
+            upper = _mn(upper, ratio)
+        elif g < 0:
+            lower = _mx(lower, ratio)
+        elif g == 0 and h < 0:
+            empty = True
+    lo = _mx(lo, lower)
+    hi = _mn(hi, upper)
+    return lo, hi, empty or (lo > hi)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_vf(a, b, it, L, p, R2, Dl, eps, av, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc, rel):
+    """VF: vertex a of A (ball of radius F(v), eq. 4) against the interior of face b of B."""
+    y0, y1, y2 = _apply(L, p, it, av[a])
+    r0, r1, r2 = y0 - bf_o[b, 0], y1 - bf_o[b, 1], y2 - bf_o[b, 2]
+    h = r0 * bf_n[b, 0] + r1 * bf_n[b, 1] + r2 * bf_n[b, 2]
+    w0 = r0 * bf_U[b, 0, 0] + r1 * bf_U[b, 1, 0] + r2 * bf_U[b, 2, 0]
+    w1 = r0 * bf_U[b, 0, 1] + r1 * bf_U[b, 1, 1] + r2 * bf_U[b, 2, 1]
+    e = eps[it]
+    q = R2[it] * aqv[a] + Dl[it]
+    for k in range(bf_hn.shape[1]):
+        if bf_hn[b, k, 0] * w0 + bf_hn[b, k, 1] * w1 > bf_hc[b, k] + 4 * e:
+            return False
+    return not (q - h * h < -_pad2(q + h * h, e, rel))
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_vh(a, pr, it, L, p, R2, Dl, eps, av, aqv, h_n, h_off, rel, pad0):
+    """VH: vertex a of A against the half-space of pair pr (h - F concave: vertices suffice)."""
+    y0, y1, y2 = _apply(L, p, it, av[a])
+    h = y0 * h_n[pr, 0] + y1 * h_n[pr, 1] + y2 * h_n[pr, 2] - h_off[pr]
+    e = eps[it] + pad0 + rel * abs(h_off[pr])
+    q = R2[it] * aqv[a] + Dl[it]
+    return not ((h > 4 * e) and (q - h * h < -_pad2(q + h * h, e, rel)))
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_ee(a, b, it, L, p, R2i, Dl, e, ae_v0, ae_d, ae_k, be_w0, be_e, rel):
+    """EE: the fat edge a of A (hyperboloid of eq. 6 with its end balls) against edge b of B."""
+    y0, y1, y2 = _apply(L, p, it, ae_v0[a])
+    D0, D1, D2 = _lin(L, it, ae_d[a])
+    E0, E1, E2 = be_e[b, 0], be_e[b, 1], be_e[b, 2]
+    P0, P1, P2 = y0 - be_w0[b, 0], y1 - be_w0[b, 1], y2 - be_w0[b, 2]
+    k0, k1, k2 = ae_k[a, 0], ae_k[a, 1], ae_k[a, 2]
+    DD = D0 * D0 + D1 * D1 + D2 * D2
+    EE = E0 * E0 + E1 * E1 + E2 * E2
+    DE = D0 * E0 + D1 * E1 + D2 * E2
+    PD = P0 * D0 + P1 * D1 + P2 * D2
+    PE = P0 * E0 + P1 * E1 + P2 * E2
+    PP = P0 * P0 + P1 * P1 + P2 * P2
+    a_ss = R2i * k2 - DD
+    a_tt = -EE
+    a_st = 2.0 * DE
+    b_s = R2i * k1 - 2.0 * PD
+    b_t = 2.0 * PE
+    c = R2i * k0 + Dl - PP
+    sq = math.sqrt(PP) + math.sqrt(DD) + math.sqrt(EE)
+    S = abs(R2i * k0) + Dl + abs(R2i * k1) + abs(R2i * k2) + sq * sq
+    pad = _pad2(S, e, rel)
+    best = _qmax01(a_tt, b_t, c)
+    best = _mx(best, _qmax01(a_tt, b_t + a_st, c + a_ss + b_s))
+    best = _mx(best, _qmax01(a_ss, b_s, c))
+    best = _mx(best, _qmax01(a_ss, b_s + a_st, c + a_tt + b_t))
+    fire = not (best < -pad)
+    det = 4.0 * a_ss * a_tt - a_st * a_st
+    band = 1e3 * _U * (4.0 * abs(a_ss * a_tt) + a_st * a_st)
+    deg = (DD == 0) or (EE == 0)
+    if (not deg) and abs(det) <= band:
+        return True
+    if (not deg) and a_ss < 0 and det > band:
+        s_ = (-2.0 * a_tt * b_s + a_st * b_t) / det
+        t_ = (-2.0 * a_ss * b_t + a_st * b_s) / det
+        val = c + 0.5 * (b_s * s_ + b_t * t_)
+        cc = 2 * abs(a_ss) + abs(a_st) + 2 * abs(a_tt)
+        cond = cc * cc / det
+        if s_ >= -_ETA and s_ <= 1 + _ETA and t_ >= -_ETA and t_ <= 1 + _ETA:
+            Sx = S + abs(b_s * s_) + abs(b_t * t_)
+            if val >= -_pad2(Sx, e, rel) * (1.0 + cond):
+                fire = True
+    return fire
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_fe(a, b, it, L, p, R2i, Dl, e, af_o, af_U, af_k0, af_kg, af_K, af_hn, af_hc, be_w0, be_e, rel):
+    """FE: the fat face a of A (two-sheet hyperboloid, eq. 8, Prop. 1) against edge b of B."""
+    o0, o1, o2 = _apply(L, p, it, af_o[a])
+    # Up = L U (3, 2)
+    u00 = L[it, 0, 0] * af_U[a, 0, 0] + L[it, 0, 1] * af_U[a, 1, 0] + L[it, 0, 2] * af_U[a, 2, 0]
+    u10 = L[it, 1, 0] * af_U[a, 0, 0] + L[it, 1, 1] * af_U[a, 1, 0] + L[it, 1, 2] * af_U[a, 2, 0]
+    u20 = L[it, 2, 0] * af_U[a, 0, 0] + L[it, 2, 1] * af_U[a, 1, 0] + L[it, 2, 2] * af_U[a, 2, 0]
+    u01 = L[it, 0, 0] * af_U[a, 0, 1] + L[it, 0, 1] * af_U[a, 1, 1] + L[it, 0, 2] * af_U[a, 2, 1]
+    u11 = L[it, 1, 0] * af_U[a, 0, 1] + L[it, 1, 1] * af_U[a, 1, 1] + L[it, 1, 2] * af_U[a, 2, 1]
+    u21 = L[it, 2, 0] * af_U[a, 0, 1] + L[it, 2, 1] * af_U[a, 1, 1] + L[it, 2, 2] * af_U[a, 2, 1]
+    E0, E1, E2 = be_e[b, 0], be_e[b, 1], be_e[b, 2]
+    P0, P1, P2 = o0 - be_w0[b, 0], o1 - be_w0[b, 1], o2 - be_w0[b, 2]
+    a11 = (u00 * u00 + u10 * u10 + u20 * u20) - R2i * af_K[a, 0, 0]
+    a12 = (u00 * u01 + u10 * u11 + u20 * u21) - R2i * af_K[a, 0, 1]
+    a22 = (u01 * u01 + u11 * u11 + u21 * u21) - R2i * af_K[a, 1, 1]
+    det = a11 * a22 - a12 * a12
+    band = 1e3 * _U * (abs(a11 * a22) + a12 * a12)
+    if not (abs(det) > band):
+        return True            # ambiguous (or NaN): fire
+    if not (a11 > 0 and det > band):
+        return False           # some beta_i >= 1: the face part is empty (EE covers the boundary)
+    ca0 = R2i * af_kg[a, 0] - (u00 * P0 + u10 * P1 + u20 * P2)
+    ca1 = R2i * af_kg[a, 1] - (u01 * P0 + u11 * P1 + u21 * P2)
+    cb0 = u00 * E0 + u10 * E1 + u20 * E2
+    cb1 = u01 * E0 + u11 * E1 + u21 * E2
+    wa0 = (a22 * ca0 - a12 * ca1) / det
+    wa1 = (-a12 * ca0 + a11 * ca1) / det
+    wb0 = (a22 * cb0 - a12 * cb1) / det
+    wb1 = (-a12 * cb0 + a11 * cb1) / det
+    EE_ = E0 * E0 + E1 * E1 + E2 * E2
+    PE = P0 * E0 + P1 * E1 + P2 * E2
+    PP = P0 * P0 + P1 * P1 + P2 * P2
+    cbwb = cb0 * wb0 + cb1 * wb1
+    cawb = ca0 * wb0 + ca1 * wb1
+    cawa = ca0 * wa0 + ca1 * wa1
+    k0 = af_k0[a]
+    v2 = -EE_ + cbwb
+    v1 = 2.0 * PE + 2.0 * cawb
+    v0 = R2i * k0 + Dl - PP + cawa
+    S = abs(R2i * k0) + Dl + PP + abs(cawa) + 2 * abs(PE) + 2 * abs(cawb) + EE_ + abs(cbwb)
+    cc = abs(a11) + abs(a22) + 2 * abs(a12)
+    cond = cc * cc / det
+    pad = _pad2(S, e, rel) * (1.0 + cond)
+    # tau-interval where w*(tau) = wa + tau wb lies in P (widened)
+    wscale = 1.0 + math.sqrt(wa0 * wa0 + wa1 * wa1) + math.sqrt(wb0 * wb0 + wb1 * wb1)
+    extra = _ETA * wscale * (1.0 + cond * 1e-6) + 4 * e
+    lo, hi, empty = _clip(0.0, 0.0, -_ETA, 1.0 + _ETA, af_hn, af_hc, a, wa0, wa1, wb0, wb1, extra)
+    ok = not empty
+    lo_c = lo if ok else 0.0
+    hi_c = hi if ok else 0.0
+    best = _mx(v0 + v1 * lo_c + v2 * lo_c * lo_c, v0 + v1 * hi_c + v2 * hi_c * hi_c)
+    tv = -v1 / (2.0 * v2)
+    if v2 < 0 and tv >= lo_c and tv <= hi_c:
+        best = _mx(best, v0 + v1 * tv + v2 * tv * tv)
+    return (ok and not (best < -pad)) or not math.isfinite(best)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_ef(a, b, it, L, p, eps, ae_v0, ae_d, bf_o, bf_n, bf_U, bf_hn, bf_hc):
+    """EF: edge a of A at the centre pose g crosses polygon b of B (slab |h| <= e, clipped by b)."""
+    y0, y1, y2 = _apply(L, p, it, ae_v0[a])
+    D0, D1, D2 = _lin(L, it, ae_d[a])
+    r0, r1, r2 = y0 - bf_o[b, 0], y1 - bf_o[b, 1], y2 - bf_o[b, 2]
+    h0 = r0 * bf_n[b, 0] + r1 * bf_n[b, 1] + r2 * bf_n[b, 2]
+    dh = D0 * bf_n[b, 0] + D1 * bf_n[b, 1] + D2 * bf_n[b, 2]
+    e = 4 * eps[it]
+    # slab -e <= h0 + s dh <= e as two rows (g, h) = (dh, e - h0), (-dh, e + h0)
+    upper = math.inf
+    lower = -math.inf
+    empty = False
+    for k in range(2):
+        g = dh if k == 0 else -dh
+        h = (e - h0) if k == 0 else (e + h0)
+        ratio = h / g
+        if g > 0:
+            upper = _mn(upper, ratio)
+        elif g < 0:
+            lower = _mx(lower, ratio)
+        elif g == 0 and h < 0:
+            empty = True
+    lo = _mx(-_ETA, lower)
+    hi = _mn(1.0 + _ETA, upper)
+    empty = empty or (lo > hi)
+    w0 = r0 * bf_U[b, 0, 0] + r1 * bf_U[b, 1, 0] + r2 * bf_U[b, 2, 0]
+    w1 = r0 * bf_U[b, 0, 1] + r1 * bf_U[b, 1, 1] + r2 * bf_U[b, 2, 1]
+    dw0 = D0 * bf_U[b, 0, 0] + D1 * bf_U[b, 1, 0] + D2 * bf_U[b, 2, 0]
+    dw1 = D0 * bf_U[b, 0, 1] + D1 * bf_U[b, 1, 1] + D2 * bf_U[b, 2, 1]
+    lo2, hi2, empty2 = _clip(0.0, 0.0, lo, hi, bf_hn, bf_hc, b, w0, w1, dw0, dw1, e)
+    return (not empty) and (not empty2)
+
+
+@njit(cache=True, no_cfunc_wrapper=True, error_model="numpy")
+def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
+              pf_V, pf_qv, pf_n, pf_off, pf_on, pf_two, use_prefilter,
+              av, aqv, ae_v0, ae_d, ae_k, af_o, af_U, af_k0, af_kg, af_K, af_hn, af_hc,
+              be_w0, be_e, bf_o, bf_n, bf_U, bf_hn, bf_hc, h_n, h_off,
+              row_type, row_a, row_b, unit_ptr, unit_rows, unit_item, unit_id,
+              rel_pad, abs_pad, scale_pad,
+              sep, unit_fired, rows_per_item, units_per_item):
+    """One subdivision level of the fat-feature stage (§6 Listing 1-2 inner tests, §3-§4).
+
+    Args:
+        pair: (N,) pair index of each item. L (N, 3, 3), p (N, 3): the centre g (A body
+            frame -> B frame); R (N,): the padded ball radius (m, metric of §2).
+        rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj: (P,) per pair: max rho over A
+            (already widened), inflation radius r (m), coordinate extents (m), face
+            non-planarity (m), sqrt(lambda_max(J^-1)).
+        pf_*: the pre-filter tables (``toleranced._Prefilter``); ``use_prefilter`` 0/1.
+        av ... h_off: the features (``toleranced._Concat``).
+        row_type, row_a, row_b: (n_rows,) global row table; unit_ptr, unit_rows: unit CSR.
+        unit_item, unit_id: (K,) active (item, unit) pairs.
+        rel_pad, abs_pad, scale_pad: ``Tolerances`` fields.
+        sep: out (N,) bool, item excluded by the pre-filter.
+        unit_fired: out (K,) bool. rows_per_item, units_per_item: out (N,) int64, distinct
+            rows evaluated / units tested per item.
+
+    Returns:
+        Number of distinct (item, row) evaluations (the oracle's ``len(ukey)``).
+    """
+    N = pair.shape[0]
+    R2 = np.empty(N)
+    Dl = np.empty(N)
+    eps = np.empty(N)
+    for i in range(N):
+        k = pair[i]
+        Ri = R[i]
+        R2[i] = Ri * Ri
+        r = r_pair[k]
+        ru = r + rel_pad * abs(r) + abs_pad
+        Dl[i] = ru * ru + 2.0 * ru * Ri * rho_max[k]
+        Lf = 0.0
+        for a in range(3):
+            for b in range(3):
+                Lf += L[i, a, b] * L[i, a, b]
+        Lf = math.sqrt(Lf)
+        mag = a_ext[k] + b_ext[k] + math.sqrt(p[i, 0] * p[i, 0] + p[i, 1] * p[i, 1] + p[i, 2] * p[i, 2]) + 1.0
+        eps[i] = abs_pad + (scale_pad + 8 * rel_pad) * mag + flat_a[k] * (Lf + Ri * sqj[k]) + flat_b[k]
+        sep[i] = False
+        rows_per_item[i] = 0
+        units_per_item[i] = 0
+        if use_prefilter and pf_on[k]:
+            sep[i] = _separated(i, k, L, p, R2, Dl, eps, pf_V, pf_qv, pf_n, pf_off, pf_two[k], rel_pad)
+    n_rows = row_type.shape[0]
+    stamp = np.full(n_rows, -1, np.int64)
+    val = np.zeros(n_rows, np.bool_)
+    order = np.argsort(unit_item, kind="mergesort")
+    total = 0
+    for j in range(order.shape[0]):
+        ku = order[j]
+        it = unit_item[ku]
+        unit_fired[ku] = False
+        if sep[it]:
+            continue
+        units_per_item[it] += 1
+        u = unit_id[ku]
+        fired = False
+        for q in range(unit_ptr[u], unit_ptr[u + 1]):
+            g = unit_rows[q]
+            if stamp[g] == it:
+                f = val[g]
+            else:
+                t, a, b = row_type[g], row_a[g], row_b[g]
+                if t == T_VF:
+                    f = _row_vf(a, b, it, L, p, R2, Dl, eps, av, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc, rel_pad)
+                elif t == T_EE:
+                    f = _row_ee(a, b, it, L, p, R2[it], Dl[it], eps[it], ae_v0, ae_d, ae_k, be_w0, be_e,
+                                rel_pad)
+                elif t == T_FE:
+                    f = _row_fe(a, b, it, L, p, R2[it], Dl[it], eps[it], af_o, af_U, af_k0, af_kg, af_K,
+                                af_hn, af_hc, be_w0, be_e, rel_pad)
+                elif t == T_EF:
+                    f = _row_ef(a, b, it, L, p, eps, ae_v0, ae_d, bf_o, bf_n, bf_U, bf_hn, bf_hc)
+                else:
+                    f = _row_vh(a, b, it, L, p, R2, Dl, eps, av, aqv, h_n, h_off, rel_pad, abs_pad)
+                stamp[g] = it
+                val[g] = f
+                rows_per_item[it] += 1
+                total += 1
+            fired = fired or f
+        unit_fired[ku] = fired
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _separated(i, k, L, p, R2, Dl, eps, V, qv, n, off, two, rel_pad):
+    """Pre-filter of item i (pair k): the orbit's hull conv{ball(g(v), F(v))} misses a face plane of B.
+
+    NaN anywhere makes the pad NaN, and then nothing separates (the oracle's rule).
+    """
+    nv = V.shape[1]
+    nf = n.shape[1]
+    Fmax = -math.inf
+    hmax = -math.inf
+    omax = -math.inf
+    Y = np.empty((nv, 3))
+    F = np.empty(nv)
+    for v in range(nv):
+        y0, y1, y2 = _apply(L, p, i, V[k, v])
+        Y[v, 0], Y[v, 1], Y[v, 2] = y0, y1, y2
+        F[v] = math.sqrt(R2[i] * qv[k, v] + Dl[i])
+        Fmax = _mx(Fmax, F[v])
+    for f in range(nf):
+        omax = _mx(omax, abs(off[k, f]))
+        for v in range(nv):
+            h = n[k, f, 0] * Y[v, 0] + n[k, f, 1] * Y[v, 1] + n[k, f, 2] * Y[v, 2] - off[k, f]
+            hmax = _mx(hmax, abs(h))
+    pad = 8.0 * rel_pad * (hmax + Fmax + omax) + 4.0 * eps[i]
+    if pad != pad:
+        return False
+    for f in range(nf):
+        lo = math.inf
+        hi = -math.inf
+        for v in range(nv):
+            h = n[k, f, 0] * Y[v, 0] + n[k, f, 1] * Y[v, 1] + n[k, f, 2] * Y[v, 2] - off[k, f]
+            lo = _mn(lo, h - F[v])
+            hi = _mx(hi, h + F[v])
+        if lo > pad:
+            return True
+        if two and hi < -pad:
+            return True
+    return False
+
+
+__all__ = ["fat_level", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]
