@@ -220,3 +220,60 @@ def test_subdivision_identical_to_numpy_and_certified_is_sampled_clear(interp):
                 d = shape_distance(s1, (rot[j, b1], pos[j, b1]), s2, (rot[j, b2], pos[j, b2]))
                 assert d.upper > margin - 1e-9, (case, ts[j], d.upper)
     assert "certified" in verdicts and "unresolved" in verdicts, verdicts
+
+
+@pytest.mark.parametrize("interp", ["lerp_slerp", "screw"])
+def test_trajectory_balls_compiled_match_numpy(interp):
+    """Centre g and radius R of the compiled provider against the numpy one (both bodies move),
+    and every sampled relative pose of each sub-interval inside the compiled ball (the oracle).
+
+    lerp_slerp takes poses and bounds from the motion pack (the compiled kernels' bound: the
+    minimum of the chain and Taylor bounds, so it can be tighter than BodyMotion's across
+    waypoints); screw takes the Trajectory protocol's (radii equal up to rounding).
+    """
+    from monitor.certify.toleranced import _Frontier, _TrajectoryBalls
+    from monitor.motion.bodymotion import BodyMotion
+
+    rng = np.random.default_rng(zlib.crc32(("balls-" + interp).encode()))
+    K, nb = 4, 4
+    pos = rng.normal(size=(K, nb, 3))
+    pos[:, 0] = 0.0
+    q = rng.normal(size=(K, nb, 4))
+    q /= np.linalg.norm(q, axis=2, keepdims=True)
+    q[:, 0] = [1.0, 0, 0, 0]
+    bm = BodyMotion(np.array([0.0, 0.3, 0.7, 1.0]), pos, q, interpolation=interp,
+                    ref_points=rng.normal(size=(nb, 3)) * 0.1)
+    shapes = [box_polytope(np.array([0.2, 0.3, 0.1])), polytope_from_points(rng.normal(size=(9, 3)) * 0.3)]
+    metrics = [moving_features(s).metric for s in shapes]
+    ba, bb = np.array([1, 2]), np.array([3, 0])
+    num = _TrajectoryBalls(bm, ba, bb, metrics)
+    com = _TrajectoryBalls(bm, ba, bb, metrics, compiled=True)
+    assert (com.pack is not None) == (interp == "lerp_slerp")
+    N = 300
+    t0 = np.sort(rng.uniform(0, 1, N))
+    t1 = np.minimum(1.0, t0 + np.exp(rng.uniform(np.log(1e-6), 0.0, N)))
+    fr = _Frontier(rng.integers(0, 2, N), t0, t1, np.zeros(N, np.int64), np.zeros(0, np.int64),
+                   np.zeros(0, np.int64))
+    L0, p0, R0 = num.balls(fr)
+    L1, p1, R1 = com.balls(fr)
+    assert np.allclose(L1, L0, rtol=0, atol=1e-14)
+    assert np.allclose(p1, p0, rtol=0, atol=1e-13)
+    assert np.all(R1 <= R0 * (1 + 1e-7)), np.max(R1 / R0)
+    if interp == "screw":
+        assert np.allclose(R1, R0, rtol=1e-12, atol=0)
+    assert R0.min() > 0
+    # sampled relative poses X_BA(t) lie in B_R(g): sqrt(sum_i w_i |X_BA(t) m_i - g(m_i)|^2) <= R
+    worst = 0.0
+    for n in range(0, N, 5):
+        k = int(fr.pair[n])
+        ts = np.linspace(t0[n], t1[n], 41)
+        P, Rt = bm.body_poses(ts)
+        a, b = ba[k], bb[k]
+        m, w = metrics[k].points, metrics[k].weights
+        xa = np.einsum("tij,mj->tmi", Rt[:, a], m) + P[:, a, None, :]
+        rel = np.einsum("tji,tmj->tmi", Rt[:, b], xa - P[:, b, None, :])
+        g = m @ L1[n].T + p1[n]
+        dist = np.sqrt(np.einsum("m,tm->t", w, ((rel - g) ** 2).sum(axis=2)))
+        assert dist.max() <= R1[n] * (1 + 1e-9) + 1e-12, (n, dist.max(), R1[n])
+        worst = max(worst, float(dist.max() / R1[n]))
+    assert worst > 0.3, worst     # the samples come near the radius (the check has teeth)

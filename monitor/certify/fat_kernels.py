@@ -416,4 +416,53 @@ def _separated(i, k, L, p, R2, Dl, eps, V, qv, n, off, two, rel_pad):
     return False
 
 
-__all__ = ["fat_level", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]
+@njit(cache=True, no_cfunc_wrapper=True, error_model="numpy")
+def traj_balls(pair, body_a, body_b, pos, rot, trans, angle, ref, mp_all, mw_all, mp_off, pad_factor,
+               L_out, p_out, R_out):
+    """Balls B_R(g) of a trajectory's sub-intervals (§2 metric, §5; ``toleranced._TrajectoryBalls``).
+
+    For item n of pair k (A = body_a[k] moving, B = body_b[k] fixed side): the centre is the
+    relative pose at the midpoint, g = X_WB^-1 X_WA (L = R_WB^T R_WA, p = R_WB^T (p_WA - p_WB));
+    a metric point m of A moves by at most delta(m) = T_A + chord(angle_A) |m - c_A| + T_B +
+    chord(angle_B) |g(m) - c_B| (the motion-bound contract applied to A at m and to B at g(m)),
+    padded by ``pad_factor``; R^2 = sum_i w_i delta(m_i)^2 (the metric's definition, eq. 1-3).
+
+    Args:
+        pair: (N,) pair of each item. body_a, body_b: (P,) body indices.
+        pos (N, nbody, 3), rot (N, nbody, 3, 3): world poses at the item midpoints.
+        trans, angle: (N, nbody) motion bounds of the items' sub-intervals (m, rad).
+        ref: (nbody, 3) reference points of the bounds (body frames).
+        mp_all (M, 3), mw_all (M,): metric points and weights of every pair's A, CSR by
+            mp_off (P + 1,).
+        pad_factor: 1 + 8 rel_pad.
+        L_out (N, 3, 3), p_out (N, 3), R_out (N,): outputs (R unpadded, as the oracle).
+    """
+    for n in range(pair.shape[0]):
+        k = pair[n]
+        a = body_a[k]
+        b = body_b[k]
+        for i in range(3):
+            for c in range(3):
+                L_out[n, i, c] = rot[n, b, 0, i] * rot[n, a, 0, c] + rot[n, b, 1, i] * rot[n, a, 1, c] \
+                    + rot[n, b, 2, i] * rot[n, a, 2, c]
+            p_out[n, i] = rot[n, b, 0, i] * (pos[n, a, 0] - pos[n, b, 0]) \
+                + rot[n, b, 1, i] * (pos[n, a, 1] - pos[n, b, 1]) \
+                + rot[n, b, 2, i] * (pos[n, a, 2] - pos[n, b, 2])
+        TA, TB = trans[n, a], trans[n, b]
+        chA = 2.0 * math.sin(0.5 * _mn(angle[n, a], math.pi))
+        chB = 2.0 * math.sin(0.5 * _mn(angle[n, b], math.pi))
+        R2 = 0.0
+        for j in range(mp_off[k], mp_off[k + 1]):
+            m0, m1, m2 = mp_all[j, 0], mp_all[j, 1], mp_all[j, 2]
+            x0, x1, x2 = m0 - ref[a, 0], m1 - ref[a, 1], m2 - ref[a, 2]
+            dA = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+            y0 = L_out[n, 0, 0] * m0 + L_out[n, 0, 1] * m1 + L_out[n, 0, 2] * m2 + p_out[n, 0] - ref[b, 0]
+            y1 = L_out[n, 1, 0] * m0 + L_out[n, 1, 1] * m1 + L_out[n, 1, 2] * m2 + p_out[n, 1] - ref[b, 1]
+            y2 = L_out[n, 2, 0] * m0 + L_out[n, 2, 1] * m1 + L_out[n, 2, 2] * m2 + p_out[n, 2] - ref[b, 2]
+            dB = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            d = (TA + chA * dA + TB + chB * dB) * pad_factor
+            R2 += mw_all[j] * d * d
+        R_out[n] = math.sqrt(R2)
+
+
+__all__ = ["fat_level", "traj_balls", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]

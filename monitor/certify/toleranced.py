@@ -1249,7 +1249,8 @@ class _TrajectoryBalls(BallProvider):
     we evaluate per feature point (tighter than the closed form in design.md) and pad.
     """
 
-    def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric]):
+    def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric],
+                 compiled: bool = False):
         self.traj = traj
         self.ba, self.bb = body_a, body_b
         self.ref = np.asarray(traj.ref_points, float)
@@ -1258,8 +1259,37 @@ class _TrajectoryBalls(BallProvider):
         self.mp_off = np.cumsum([0] + [len(x) for x in self.mp])
         self.mp_all = np.concatenate(self.mp)
         self.mw_all = np.concatenate(self.mw)
+        self.pack = _motion_pack(traj) if compiled else None
+        if compiled:
+            self.flat = (_c(body_a, np.int64), _c(body_b, np.int64), _c(self.ref), _c(self.mp_all),
+                         _c(self.mw_all), _c(self.mp_off, np.int64))
 
     def balls(self, fr: _Frontier):
+        if hasattr(self, "flat"):
+            return self._balls_compiled(fr)
+        return self._balls_numpy(fr)
+
+    def _balls_compiled(self, fr: _Frontier):
+        """Compiled balls: the radii in :func:`fat_kernels.traj_balls`.
+
+        Poses and bounds come from one compiled call when the motion packs (lerp+slerp
+        BodyMotion, Plan), else from the Trajectory protocol (screw BodyMotion, others).
+        """
+        from monitor.certify import fat_kernels
+        if self.pack is not None:
+            from monitor.motion.pack import poses_and_bounds
+            pos, rot, mb = poses_and_bounds(self.pack, fr.t0, fr.t1)
+        else:
+            pos, rot = self.traj.body_poses(0.5 * (fr.t0 + fr.t1))
+            mb = self.traj.motion_bounds(fr.t0, fr.t1)
+        N = len(fr.pair)
+        L, p, R = np.empty((N, 3, 3)), np.empty((N, 3)), np.empty(N)
+        ba, bb, ref, mp_all, mw_all, mp_off = self.flat
+        fat_kernels.traj_balls(_c(fr.pair, np.int64), ba, bb, _c(pos), _c(rot), _c(mb.trans), _c(mb.angle),
+                               ref, mp_all, mw_all, mp_off, 1.0 + 8 * DEFAULT.rel_pad, L, p, R)
+        return L, p, R
+
+    def _balls_numpy(self, fr: _Frontier):
         mids = 0.5 * (fr.t0 + fr.t1)
         pos, rot = self.traj.body_poses(mids)
         mb = self.traj.motion_bounds(fr.t0, fr.t1)
@@ -1285,6 +1315,37 @@ class _TrajectoryBalls(BallProvider):
         d = d * (1.0 + 8 * DEFAULT.rel_pad)
         R2 = np.bincount(item, weights=w * d * d, minlength=len(mids))
         return L, p, np.sqrt(R2)
+
+
+_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _motion_pack(traj: Trajectory) -> Any:
+    """The compiled kernels' pack of ``traj`` (lerp+slerp BodyMotion or Plan), or None.
+
+    Its poses equal the trajectory's; its bounds are the compiled kernels' (``motion.kernel``,
+    the contract of ``motion.plan``, the bound the compiled whole-shape stage already uses):
+    on one segment with reference points at the body origins they equal BodyMotion's to
+    < 1e-8 relative (measured), across waypoints they can be tighter (minimum of the chain
+    and Taylor bounds). tests/test_fat_kernels.py samples the resulting balls. A BodyMotion
+    is immutable (read-only arrays), so its pack is cached on it; a Plan is packed per call.
+    """
+    from monitor.errors import MonitorError
+    from monitor.motion.bodymotion import BodyMotion
+    from monitor.motion.pack import pack_trajectory
+    if isinstance(traj, BodyMotion):
+        hit = _PACKS.get(traj)
+        if hit is None:
+            try:
+                hit = pack_trajectory(traj)
+            except MonitorError:
+                hit = False
+            _PACKS[traj] = hit
+        return hit or None
+    try:
+        return pack_trajectory(traj)
+    except MonitorError:
+        return None
 
 
 def _orient(shape_a: ConvexShape, body_a: int, shape_b: ConvexShape, body_b: int,
@@ -1362,8 +1423,9 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
                                       info={"start_overlap": True, "start_upper": res.upper})
                 active[i] = False
     if active.any():
-        prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds])
-        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active, compiled=compiled)
+        comp = USE_COMPILED if compiled is None else compiled
+        prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds], compiled=comp)
+        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active, compiled=comp)
         for i in np.nonzero(active)[0]:
             iv = res.intervals[i]
             outs[i] = PairOutcome(
