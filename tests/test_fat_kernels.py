@@ -277,3 +277,22 @@ def test_trajectory_balls_compiled_match_numpy(interp):
         assert dist.max() <= R1[n] * (1 + 1e-9) + 1e-12, (n, dist.max(), R1[n])
         worst = max(worst, float(dist.max() / R1[n]))
     assert worst > 0.3, worst     # the samples come near the radius (the check has teeth)
+
+
+def test_merged_intervals_equal_sorted_sequential_merge():
+    """The vectorised interval union of the driver against the sequential one (toleranced._merge)."""
+    from monitor.certify.toleranced import _merge, _merged_intervals
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        chunks, ref = [], [[] for _ in range(4)]
+        for _ in range(rng.integers(0, 5)):
+            n = int(rng.integers(0, 30))
+            pr = rng.integers(0, 4, n)
+            grid = rng.integers(0, 64, n) / 64.0                 # dyadic ends: touching intervals
+            w = rng.integers(0, 4, n) / 64.0                      # including points (w = 0)
+            chunks.append((pr, grid, grid + w))
+            for k, a, b in zip(pr, grid, grid + w):
+                ref[k].append((float(a), float(b)))
+        got = _merged_intervals(chunks, 4)
+        assert got == [_merge(sorted(x)) for x in ref]

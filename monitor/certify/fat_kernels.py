@@ -121,9 +121,8 @@ def _clip(g0, h0, lo, hi, hn, hc, f, w0, w1, dw0, dw1, extra):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
-def _row_vf(a, b, it, L, p, R2, Dl, eps, av, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc, rel):
-    """VF: vertex a of A (ball of radius F(v), eq. 4) against the interior of face b of B."""
-    y0, y1, y2 = _apply(L, p, it, av[a])
+def _row_vf(y0, y1, y2, a, b, it, R2, Dl, eps, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc, rel):
+    """VF: vertex a of A at g(v) = y (ball of radius F(v), eq. 4) against the interior of face b of B."""
     r0, r1, r2 = y0 - bf_o[b, 0], y1 - bf_o[b, 1], y2 - bf_o[b, 2]
     h = r0 * bf_n[b, 0] + r1 * bf_n[b, 1] + r2 * bf_n[b, 2]
     w0 = r0 * bf_U[b, 0, 0] + r1 * bf_U[b, 1, 0] + r2 * bf_U[b, 2, 0]
@@ -137,9 +136,8 @@ def _row_vf(a, b, it, L, p, R2, Dl, eps, av, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
-def _row_vh(a, pr, it, L, p, R2, Dl, eps, av, aqv, h_n, h_off, rel, pad0):
-    """VH: vertex a of A against the half-space of pair pr (h - F concave: vertices suffice)."""
-    y0, y1, y2 = _apply(L, p, it, av[a])
+def _row_vh(y0, y1, y2, a, pr, it, R2, Dl, eps, aqv, h_n, h_off, rel, pad0):
+    """VH: vertex a of A at g(v) = y against the half-space of pair pr (h - F concave: vertices suffice)."""
     h = y0 * h_n[pr, 0] + y1 * h_n[pr, 1] + y2 * h_n[pr, 2] - h_off[pr]
     e = eps[it] + pad0 + rel * abs(h_off[pr])
     q = R2[it] * aqv[a] + Dl[it]
@@ -147,10 +145,8 @@ def _row_vh(a, pr, it, L, p, R2, Dl, eps, av, aqv, h_n, h_off, rel, pad0):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
-def _row_ee(a, b, it, L, p, R2i, Dl, e, ae_v0, ae_d, ae_k, be_w0, be_e, rel):
-    """EE: the fat edge a of A (hyperboloid of eq. 6 with its end balls) against edge b of B."""
-    y0, y1, y2 = _apply(L, p, it, ae_v0[a])
-    D0, D1, D2 = _lin(L, it, ae_d[a])
+def _row_ee(y0, y1, y2, D0, D1, D2, a, b, R2i, Dl, e, ae_k, be_w0, be_e, rel):
+    """EE: fat edge a of A (g(e(s)) = y + s D; hyperboloid of eq. 6, end balls) vs edge b of B."""
     E0, E1, E2 = be_e[b, 0], be_e[b, 1], be_e[b, 2]
     P0, P1, P2 = y0 - be_w0[b, 0], y1 - be_w0[b, 1], y2 - be_w0[b, 2]
     k0, k1, k2 = ae_k[a, 0], ae_k[a, 1], ae_k[a, 2]
@@ -193,23 +189,39 @@ def _row_ee(a, b, it, L, p, R2i, Dl, e, ae_v0, ae_d, ae_k, be_w0, be_e, rel):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
-def _row_fe(a, b, it, L, p, R2i, Dl, e, af_o, af_U, af_k0, af_kg, af_K, af_hn, af_hc, be_w0, be_e, rel):
-    """FE: the fat face a of A (two-sheet hyperboloid, eq. 8, Prop. 1) against edge b of B."""
+def _face_frame(a, it, L, p, R2i, af_o, af_U, af_K, out):
+    """Per (face a of A, item): g(o) (3), L U (3, 2) column-major (6), a11, a12, a22, det, band (5).
+
+    The FE quantities that do not depend on B's edge (the 2x2 Hessian G - R^2 K, eq. 7-8).
+    """
     o0, o1, o2 = _apply(L, p, it, af_o[a])
-    # Up = L U (3, 2)
     u00 = L[it, 0, 0] * af_U[a, 0, 0] + L[it, 0, 1] * af_U[a, 1, 0] + L[it, 0, 2] * af_U[a, 2, 0]
     u10 = L[it, 1, 0] * af_U[a, 0, 0] + L[it, 1, 1] * af_U[a, 1, 0] + L[it, 1, 2] * af_U[a, 2, 0]
     u20 = L[it, 2, 0] * af_U[a, 0, 0] + L[it, 2, 1] * af_U[a, 1, 0] + L[it, 2, 2] * af_U[a, 2, 0]
     u01 = L[it, 0, 0] * af_U[a, 0, 1] + L[it, 0, 1] * af_U[a, 1, 1] + L[it, 0, 2] * af_U[a, 2, 1]
     u11 = L[it, 1, 0] * af_U[a, 0, 1] + L[it, 1, 1] * af_U[a, 1, 1] + L[it, 1, 2] * af_U[a, 2, 1]
     u21 = L[it, 2, 0] * af_U[a, 0, 1] + L[it, 2, 1] * af_U[a, 1, 1] + L[it, 2, 2] * af_U[a, 2, 1]
-    E0, E1, E2 = be_e[b, 0], be_e[b, 1], be_e[b, 2]
-    P0, P1, P2 = o0 - be_w0[b, 0], o1 - be_w0[b, 1], o2 - be_w0[b, 2]
     a11 = (u00 * u00 + u10 * u10 + u20 * u20) - R2i * af_K[a, 0, 0]
     a12 = (u00 * u01 + u10 * u11 + u20 * u21) - R2i * af_K[a, 0, 1]
     a22 = (u01 * u01 + u11 * u11 + u21 * u21) - R2i * af_K[a, 1, 1]
     det = a11 * a22 - a12 * a12
-    band = 1e3 * _U * (abs(a11 * a22) + a12 * a12)
+    out[0], out[1], out[2] = o0, o1, o2
+    out[3], out[4], out[5], out[6], out[7], out[8] = u00, u10, u20, u01, u11, u21
+    out[9], out[10], out[11], out[12] = a11, a12, a22, det
+    out[13] = 1e3 * _U * (abs(a11 * a22) + a12 * a12)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _row_fe(fr_, a, b, R2i, Dl, e, af_k0, af_kg, af_hn, af_hc, be_w0, be_e, rel):
+    """FE: fat face a of A (two-sheet hyperboloid, eq. 8, Prop. 1) against edge b of B.
+
+    ``fr_`` is the face's :func:`_face_frame` for the item.
+    """
+    o0, o1, o2 = fr_[0], fr_[1], fr_[2]
+    u00, u10, u20, u01, u11, u21 = fr_[3], fr_[4], fr_[5], fr_[6], fr_[7], fr_[8]
+    a11, a12, a22, det, band = fr_[9], fr_[10], fr_[11], fr_[12], fr_[13]
+    E0, E1, E2 = be_e[b, 0], be_e[b, 1], be_e[b, 2]
+    P0, P1, P2 = o0 - be_w0[b, 0], o1 - be_w0[b, 1], o2 - be_w0[b, 2]
     if not (abs(det) > band):
         return True            # ambiguous (or NaN): fire
     if not (a11 > 0 and det > band):
@@ -251,10 +263,8 @@ def _row_fe(a, b, it, L, p, R2i, Dl, e, af_o, af_U, af_k0, af_kg, af_K, af_hn, a
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
-def _row_ef(a, b, it, L, p, eps, ae_v0, ae_d, bf_o, bf_n, bf_U, bf_hn, bf_hc):
-    """EF: edge a of A at the centre pose g crosses polygon b of B (slab |h| <= e, clipped by b)."""
-    y0, y1, y2 = _apply(L, p, it, ae_v0[a])
-    D0, D1, D2 = _lin(L, it, ae_d[a])
+def _row_ef(y0, y1, y2, D0, D1, D2, b, it, eps, bf_o, bf_n, bf_U, bf_hn, bf_hc):
+    """EF: edge a of A at the centre pose, y + s D, crosses polygon b of B (slab |h| <= e, clipped by b)."""
     r0, r1, r2 = y0 - bf_o[b, 0], y1 - bf_o[b, 1], y2 - bf_o[b, 2]
     h0 = r0 * bf_n[b, 0] + r1 * bf_n[b, 1] + r2 * bf_n[b, 2]
     dh = D0 * bf_n[b, 0] + D1 * bf_n[b, 1] + D2 * bf_n[b, 2]
@@ -338,6 +348,13 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
     n_rows = row_type.shape[0]
     stamp = np.full(n_rows, -1, np.int64)
     val = np.zeros(n_rows, np.bool_)
+    # per item, the A features mapped by g (computed on first use; same expressions as per row)
+    yv = np.empty((av.shape[0], 3))
+    st_v = np.full(av.shape[0], -1, np.int64)
+    ye = np.empty((ae_v0.shape[0], 6))
+    st_e = np.full(ae_v0.shape[0], -1, np.int64)
+    ff = np.empty((af_o.shape[0], 14))
+    st_f = np.full(af_o.shape[0], -1, np.int64)
     order = np.argsort(unit_item, kind="mergesort")
     total = 0
     for j in range(order.shape[0]):
@@ -355,18 +372,33 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
                 f = val[g]
             else:
                 t, a, b = row_type[g], row_a[g], row_b[g]
-                if t == T_VF:
-                    f = _row_vf(a, b, it, L, p, R2, Dl, eps, av, aqv, bf_o, bf_n, bf_U, bf_hn, bf_hc, rel_pad)
-                elif t == T_EE:
-                    f = _row_ee(a, b, it, L, p, R2[it], Dl[it], eps[it], ae_v0, ae_d, ae_k, be_w0, be_e,
-                                rel_pad)
-                elif t == T_FE:
-                    f = _row_fe(a, b, it, L, p, R2[it], Dl[it], eps[it], af_o, af_U, af_k0, af_kg, af_K,
-                                af_hn, af_hc, be_w0, be_e, rel_pad)
-                elif t == T_EF:
-                    f = _row_ef(a, b, it, L, p, eps, ae_v0, ae_d, bf_o, bf_n, bf_U, bf_hn, bf_hc)
+                if t == T_VF or t == T_VH:
+                    if st_v[a] != it:
+                        yv[a, 0], yv[a, 1], yv[a, 2] = _apply(L, p, it, av[a])
+                        st_v[a] = it
+                    if t == T_VF:
+                        f = _row_vf(yv[a, 0], yv[a, 1], yv[a, 2], a, b, it, R2, Dl, eps, aqv, bf_o, bf_n,
+                                    bf_U, bf_hn, bf_hc, rel_pad)
+                    else:
+                        f = _row_vh(yv[a, 0], yv[a, 1], yv[a, 2], a, b, it, R2, Dl, eps, aqv, h_n, h_off,
+                                    rel_pad, abs_pad)
+                elif t == T_EE or t == T_EF:
+                    if st_e[a] != it:
+                        ye[a, 0], ye[a, 1], ye[a, 2] = _apply(L, p, it, ae_v0[a])
+                        ye[a, 3], ye[a, 4], ye[a, 5] = _lin(L, it, ae_d[a])
+                        st_e[a] = it
+                    if t == T_EE:
+                        f = _row_ee(ye[a, 0], ye[a, 1], ye[a, 2], ye[a, 3], ye[a, 4], ye[a, 5], a, b, R2[it],
+                                    Dl[it], eps[it], ae_k, be_w0, be_e, rel_pad)
+                    else:
+                        f = _row_ef(ye[a, 0], ye[a, 1], ye[a, 2], ye[a, 3], ye[a, 4], ye[a, 5], b, it, eps,
+                                    bf_o, bf_n, bf_U, bf_hn, bf_hc)
                 else:
-                    f = _row_vh(a, b, it, L, p, R2, Dl, eps, av, aqv, h_n, h_off, rel_pad, abs_pad)
+                    if st_f[a] != it:
+                        _face_frame(a, it, L, p, R2[it], af_o, af_U, af_K, ff[a])
+                        st_f[a] = it
+                    f = _row_fe(ff[a], a, b, R2[it], Dl[it], eps[it], af_k0, af_kg, af_hn, af_hc, be_w0, be_e,
+                                rel_pad)
                 stamp[g] = it
                 val[g] = f
                 rows_per_item[it] += 1

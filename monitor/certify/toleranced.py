@@ -1091,7 +1091,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
                    np.zeros(len(idx_pairs), np.int64),
                    np.repeat(np.arange(len(idx_pairs)), [len(u) for u in units_i]).astype(np.int64),
                    np.concatenate(units_i) if units_i else np.zeros(0, np.int64), extra0)
-    intervals: list[list[tuple[float, float]]] = [[] for _ in range(npair)]
+    stopped: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []   # (pair, t0, t1) chunks
     unit_tests = np.zeros(npair, np.int64)
     row_tests = np.zeros(npair, np.int64)
     items_n = np.zeros(npair, np.int64)
@@ -1101,8 +1101,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     while len(fr.pair):
         if budget is not None and budget.exhausted:
             exhausted = True
-            for i in range(len(fr.pair)):
-                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            stopped.append((fr.pair, fr.t0, fr.t1))
             break
         N = len(fr.pair)
         np.maximum.at(max_depth, fr.pair, fr.depth)
@@ -1125,20 +1124,19 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
                 uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
         except BudgetExhausted:  # this level's frontier stays unresolved, as at the check above
             exhausted = True
-            for i in range(len(fr.pair)):
-                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            stopped.append((fr.pair, fr.t0, fr.t1))
             break
         if pre is not None:
-            np.add.at(prefiltered, fr.pair[sep], 1)
+            prefiltered += np.bincount(fr.pair[sep], minlength=npair)
         if fast is not None:
-            np.add.at(row_tests, fr.pair, rows_i)
-            np.add.at(unit_tests, fr.pair, units_i_n)
+            row_tests += _count(fr.pair, rows_i, npair)
+            unit_tests += _count(fr.pair, units_i_n, npair)
         else:
             unit_fired = np.zeros(len(fr.unit_item), bool)
             unit_fired[live] = uf_live
-            np.add.at(row_tests, fr.pair[u_item], 1)
-            np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
-        np.add.at(items_n, fr.pair, 1)
+            row_tests += np.bincount(fr.pair[u_item], minlength=npair)
+            unit_tests += np.bincount(fr.pair[fr.unit_item[live]], minlength=npair)
+        items_n += np.bincount(fr.pair, minlength=npair)
         if budget is not None:
             budget.charge(nrow)
         item_fired = np.zeros(N, bool)
@@ -1146,13 +1144,13 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         # termination (eq. 11) or depth cap
         small = R * rho_max[fr.pair] < epsilon
         stop = item_fired & (small | (fr.depth >= tol.max_depth))
-        for i in np.nonzero(stop)[0]:
-            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+        if stop.any():
+            stopped.append((fr.pair[stop], fr.t0[stop], fr.t1[stop]))
         go = item_fired & ~stop
         over = frontier_over_cap(fr.pair, fr.t0, go, int(tol.max_frontier))
-        for i in np.nonzero(over)[0]:
-            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
-        np.add.at(capped, fr.pair[over], 1)
+        if over.any():
+            stopped.append((fr.pair[over], fr.t0[over], fr.t1[over]))
+            capped += np.bincount(fr.pair[over], minlength=npair)
         go &= ~over
         if not go.any():
             break
@@ -1167,9 +1165,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         fr = _Frontier(np.concatenate([fr.pair[keep]] * 2), np.concatenate([fr.t0[keep], mid]),
                        np.concatenate([mid, fr.t1[keep]]), np.concatenate([fr.depth[keep] + 1] * 2),
                        np.concatenate([ui, ui + k]), np.concatenate([uid, uid]), extra)
-    for lst in intervals:
-        lst.sort()
-    return SubdivisionResult([_merge(x) for x in intervals], unit_tests, row_tests, max_depth, items_n,
+    return SubdivisionResult(_merged_intervals(stopped, npair), unit_tests, row_tests, max_depth, items_n,
                              exhausted, prefiltered, capped)
 
 
@@ -1216,6 +1212,39 @@ def first_interval_dfs(pd: _PairData, provider: BallProvider, t0: float, t1: flo
             continue
         return (float(fr.t0[0]), float(fr.t1[0])), tests, depth
     return None, tests, depth
+
+
+def _count(idx: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
+    """Exact integer ``np.add.at(zeros(n), idx, weights)`` (weights >= 0, sums < 2^53)."""
+    return np.bincount(idx, weights=weights, minlength=n).astype(np.int64)
+
+
+def _merged_intervals(chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray]], npair: int
+                      ) -> list[list[tuple[float, float]]]:
+    """Per pair, the sorted union of the stopped items' [t0, t1] (as :func:`_merge` of the sorted list).
+
+    Sorted by (pair, t0, t1), an interval starts a new run iff its t0 exceeds the running max
+    of the previous t1 (of the same pair); a run is [its first t0, its running max of t1].
+    """
+    out: list[list[tuple[float, float]]] = [[] for _ in range(npair)]
+    if not chunks:
+        return out
+    pr = np.concatenate([c[0] for c in chunks])
+    if not len(pr):
+        return out
+    a = np.concatenate([c[1] for c in chunks]).astype(float)
+    b = np.concatenate([c[2] for c in chunks]).astype(float)
+    order = np.lexsort((b, a, pr))
+    pr, a, b = pr[order], a[order], b[order]
+    cuts = np.flatnonzero(np.diff(pr)) + 1
+    for lo, hi in zip(np.concatenate([[0], cuts]).tolist(), np.concatenate([cuts, [len(pr)]]).tolist()):
+        aa, cm = a[lo:hi], np.maximum.accumulate(b[lo:hi])
+        start = np.ones(hi - lo, bool)
+        start[1:] = aa[1:] > cm[:-1]
+        s_idx = np.flatnonzero(start)
+        e_idx = np.concatenate([s_idx[1:] - 1, [hi - lo - 1]])
+        out[int(pr[lo])] = list(zip(aa[s_idx].tolist(), cm[e_idx].tolist()))
+    return out
 
 
 def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
