@@ -1,6 +1,7 @@
-"""Per-case time, route and verdict of the quick peers cases (toleranced, eps 1e-3), with the
-fat-feature stage compiled (``toleranced.USE_COMPILED = True``) and with the numpy oracle
-kernels (False), interleaved in the same run. Usage:
+"""Per-case time, route and verdict of the quick peers cases, numpy oracle vs compiled.
+
+Toleranced, eps 1e-3; the fat-feature stage compiled (``toleranced.USE_COMPILED = True``)
+and with the numpy oracle kernels (False), interleaved in the same run. Usage:
 
     PYTHONPATH=$PWD .venv/bin/python scripts/measure_fat_kernels.py [min seconds per case]
 """
@@ -25,6 +26,7 @@ def _route(mix: dict, group: str) -> str:
 
 
 def main() -> None:
+    """Print the per-case table and the medians."""
     min_s = float(sys.argv[1]) if len(sys.argv) > 1 else 0.2
     cases = make_cases(seed=7, quick=True)
     res = {True: [], False: []}

@@ -296,3 +296,43 @@ def test_merged_intervals_equal_sorted_sequential_merge():
                 ref[k].append((float(a), float(b)))
         got = _merged_intervals(chunks, 4)
         assert got == [_merge(sorted(x)) for x in ref]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_screw_poses_bounds_match_bodymotion(seed):
+    """The compiled screw poses and bounds against BodyMotion's numpy ones (the oracle), on
+    random multi-waypoint screw motions with offset reference points, a static and a
+    translating body; sub-intervals from the whole window down to 1e-9 s, and at the ends."""
+    from monitor.certify.toleranced import _screw_poses_bounds
+    from monitor.motion.bodymotion import BodyMotion
+
+    rng = np.random.default_rng(100 + seed)
+    K, nb = 5, 4
+    times = np.cumsum(np.concatenate([[0.0], rng.uniform(0.1, 0.5, K - 1)]))
+    pos = rng.normal(size=(K, nb, 3))
+    pos[:, 0] = 0.0
+    pos[:, 1] = pos[0, 1]                          # body 1 static
+    q = rng.normal(size=(K, nb, 4))
+    q /= np.linalg.norm(q, axis=2, keepdims=True)
+    q[:, 0] = [1.0, 0, 0, 0]
+    q[:, 1] = q[0, 1]
+    q[:, 2] = q[0, 2]                              # body 2 translates only
+    if seed == 2:
+        q[3, 3] = -q[2, 3]                          # a sign flip (same rotation)
+    bm = BodyMotion(times, pos, q, interpolation="screw", ref_points=rng.normal(size=(nb, 3)) * 0.2)
+    T = times[-1]
+    N = 400
+    t0 = rng.uniform(0, T, N)
+    w = np.exp(rng.uniform(np.log(1e-9), np.log(T), N))
+    t1 = np.minimum(T, t0 + w)
+    t0[:3], t1[:3] = [0.0, 0.0, T], [T, 1e-6, T]
+    t0[3], t1[3] = times[2], times[2]
+    pos_c, rot_c, mb_c = _screw_poses_bounds(bm, bm.screw_arrays(), t0, t1)
+    pos_n, rot_n = bm.body_poses(0.5 * (t0 + t1))
+    mb_n = bm.motion_bounds(t0, t1)
+    assert np.allclose(pos_c, pos_n, rtol=0, atol=1e-13)
+    assert np.allclose(rot_c, rot_n, rtol=0, atol=1e-14)
+    assert np.allclose(mb_c.trans, mb_n.trans, rtol=1e-12, atol=1e-15)
+    assert np.allclose(mb_c.angle, mb_n.angle, rtol=1e-12, atol=1e-15)
+    assert np.all(mb_c.trans[:, 1] == 0) and np.all(mb_c.angle[:, 2] == 0)
+    assert mb_c.trans[:, 3].max() > 0.1 and mb_c.angle[:, 3].max() > 0.1

@@ -497,4 +497,217 @@ def traj_balls(pair, body_a, body_b, pos, rot, trans, angle, ref, mp_all, mw_all
         R_out[n] = math.sqrt(R2)
 
 
-__all__ = ["fat_level", "traj_balls", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]
+# ---------------------------------------------------------------------------- screw motions
+# Poses and bounds of a screw BodyMotion (monitor.motion.bodymotion, module docstring: "Screw
+# motion bound (derivation)"), the scalar transcription of BodyMotion._poses / _bounds /
+# _screw_ref_deviation and of _kinematics (Segments.locate, QuatTrack.interp,
+# vector_deviation, rotation_deviation) and _screw (screw_point, helix_span). The numpy
+# methods stay the oracle (tests/test_fat_kernels.py).
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _locate(times, t):
+    """Segment i, parameter s in [0, 1], at_end (``Segments.locate``)."""
+    K = times.shape[0]
+    i = np.searchsorted(times, t, side="right") - 1
+    i = min(max(i, 0), K - 2)
+    s = (t - times[i]) / (times[i + 1] - times[i])
+    s = min(max(s, 0.0), 1.0)
+    return i, s, t >= times[K - 1]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _screw_b(phi):
+    """(phi - sin phi) / phi^3, series below 0.1 (``_screw._b``)."""
+    if phi < 0.1:
+        p2 = phi * phi
+        return 1 / 6 - p2 / 120 + p2**2 / 5040 - p2**3 / 362880 + p2**4 / 39916800
+    return (phi - math.sin(phi)) / phi**3
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _helix_span(d, P, th, sigma):
+    """Helix displacement sigma sqrt(d^2 + (sinc(th sigma / 2) P)^2), sigma in [0, 1] (``helix_span``)."""
+    sigma = min(max(sigma, 0.0), 1.0)
+    return sigma * math.hypot(d, np.sinc(th * sigma / (2.0 * np.pi)) * P)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _screw_pose(b, i, s, at_end, pos, quat, target, half, same, rotating, omega, v, x, q):
+    """World origin x (3) and quaternion q (4) of body b at (segment i, parameter s)."""
+    K = pos.shape[0]
+    if at_end:
+        for c in range(3):
+            x[c] = pos[K - 1, b, c]
+        for c in range(4):
+            q[c] = quat[K - 1, b, c]
+        return
+    h = half[i, b]
+    den = np.sinc(h / np.pi)
+    c0 = (1.0 - s) * np.sinc((1.0 - s) * h / np.pi) / den
+    c1 = s * np.sinc(s * h / np.pi) / den
+    if same[i, b] or s == 0.0:
+        for c in range(4):
+            q[c] = quat[i, b, c]
+    else:
+        for c in range(4):
+            q[c] = c0 * quat[i, b, c] + c1 * target[i, b, c]
+    if rotating[b] and s != 0.0:
+        w0, w1, w2 = omega[i, b, 0], omega[i, b, 1], omega[i, b, 2]
+        th = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        phi = s * th
+        y0, y1, y2 = pos[i, b, 0], pos[i, b, 1], pos[i, b, 2]
+        v0, v1, v2 = v[i, b, 0], v[i, b, 1], v[i, b, 2]
+        wy0, wy1, wy2 = _cross(w0, w1, w2, y0, y1, y2)
+        wwy0, wwy1, wwy2 = _cross(w0, w1, w2, wy0, wy1, wy2)
+        wv0, wv1, wv2 = _cross(w0, w1, w2, v0, v1, v2)
+        wwv0, wwv1, wwv2 = _cross(w0, w1, w2, wv0, wv1, wv2)
+        k1 = s * np.sinc(phi / np.pi)
+        ka = s * s * (0.5 * np.sinc(phi / (2.0 * np.pi)) ** 2)
+        kb = s**3 * _screw_b(phi)
+        x[0] = y0 + k1 * wy0 + ka * wwy0 + s * v0 + ka * wv0 + kb * wwv0
+        x[1] = y1 + k1 * wy1 + ka * wwy1 + s * v1 + ka * wv1 + kb * wwv1
+        x[2] = y2 + k1 * wy2 + ka * wwy2 + s * v2 + ka * wv2 + kb * wwv2
+    else:
+        for c in range(3):
+            x[c] = pos[i, b, c] + s * (pos[i + 1, b, c] - pos[i, b, c])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _quat_mat(q, R):
+    """Rotation matrix of q / |q| (``_kinematics.quat_to_mat``)."""
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    R[0, 0] = 1 - 2 * (y * y + z * z)
+    R[0, 1] = 2 * (x * y - w * z)
+    R[0, 2] = 2 * (x * z + w * y)
+    R[1, 0] = 2 * (x * y + w * z)
+    R[1, 1] = 1 - 2 * (x * x + z * z)
+    R[1, 2] = 2 * (y * z - w * x)
+    R[2, 0] = 2 * (x * z - w * y)
+    R[2, 1] = 2 * (y * z + w * x)
+    R[2, 2] = 1 - 2 * (x * x + y * y)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy")
+def _path(times, cum, phi, b, t):
+    """Cumulative slerp path length of body b at time t (``QuatTrack.path`` after ``locate``)."""
+    i, s, _ = _locate(times, t)
+    return cum[i, b] + s * phi[i, b]
+
+
+@njit(cache=True, no_cfunc_wrapper=True, error_model="numpy")
+def screw_poses_bounds(times, pos, quat, target, half, phi, cum, same, moving, rotating, omega, v,
+                       hx_d, hx_P, hx_th, ref, ref_W, prm, ta, tb, out_pos, out_rot, out_trans, out_angle):
+    """Midpoint poses and certified bounds of a screw BodyMotion for N sub-intervals (one call).
+
+    Args:
+        times (K,), pos (K, nb, 3), quat (K, nb, 4): waypoints. target, half, phi, same
+            (K-1, nb, ...), cum (K, nb): slerp tracks. moving, rotating (nb,) bool.
+            omega, v (K-1, nb, 3), hx_d, hx_P, hx_th (K-1, nb): twists and helix constants.
+            ref (nb, 3), ref_W (K, nb, 3): reference points (body, world at waypoints).
+        prm: (rel_pad, abs_pad, scale_pad, pos_mag, scale, screw_pad).
+        ta, tb: (N,) sub-intervals inside the window.
+        out_pos (N, nb, 3), out_rot (N, nb, 3, 3): poses at the midpoints;
+        out_trans, out_angle (N, nb): the bounds (m, rad), as ``BodyMotion.motion_bounds``.
+    """
+    rel, ab, scale_pad, pos_mag, scale, screw_pad = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
+    K, nb = pos.shape[0], pos.shape[1]
+    xa = np.empty(3)
+    xb = np.empty(3)
+    qa = np.empty(4)
+    qb = np.empty(4)
+    qm = np.empty(4)
+    Rm = np.empty((3, 3))
+    for n in range(ta.shape[0]):
+        t0, t1 = ta[n], tb[n]
+        tm = 0.5 * (t0 + t1)
+        ia, sa, ea = _locate(times, t0)
+        ib, sb, eb = _locate(times, t1)
+        im, sm, em = _locate(times, tm)
+        lo = np.searchsorted(times, t0, side="right")
+        hi = np.searchsorted(times, t1, side="left")
+        j = min(max(np.searchsorted(times, tm, side="right") - 1, 0), K - 1)
+        near_left = max(times[j], t0)
+        near_right = max(min(times[min(j + 1, K - 1)], t1), tm)
+        for b in range(nb):
+            xm = out_pos[n, b]
+            _screw_pose(b, im, sm, em, pos, quat, target, half, same, rotating, omega, v, xm, qm)
+            _quat_mat(qm, out_rot[n, b])
+            out_trans[n, b] = 0.0
+            out_angle[n, b] = 0.0
+            if not moving[b]:
+                continue
+            _screw_pose(b, ia, sa, ea, pos, quat, target, half, same, rotating, omega, v, xa, qa)
+            _screw_pose(b, ib, sb, eb, pos, quat, target, half, same, rotating, omega, v, xb, qb)
+            # vector_deviation of the waypoint positions
+            dx = max(_norm(xa[0] - xm[0], xa[1] - xm[1], xa[2] - xm[2]),
+                     _norm(xb[0] - xm[0], xb[1] - xm[1], xb[2] - xm[2]))
+            for w in range(lo, hi):
+                dx = max(dx, _norm(pos[w, b, 0] - xm[0], pos[w, b, 1] - xm[1], pos[w, b, 2] - xm[2]))
+            dx = dx + rel * pos_mag
+            th = 0.0
+            if rotating[b]:
+                nq = math.sqrt(qm[0] * qm[0] + qm[1] * qm[1] + qm[2] * qm[2] + qm[3] * qm[3])
+                s_m = cum[im, b] + sm * phi[im, b]
+                dev = max(abs(s_m - _path(times, cum, phi, b, near_left)),
+                          abs(_path(times, cum, phi, b, near_right) - s_m))
+                for w in range(lo, hi):
+                    dd = 0.0
+                    ss = 0.0
+                    for c in range(4):
+                        u = quat[w, b, c] - qm[c] / nq
+                        dd += u * u
+                        u = quat[w, b, c] + qm[c] / nq
+                        ss += u * u
+                    dd, ss = math.sqrt(dd), math.sqrt(ss)
+                    d_w = 4.0 * math.atan2(min(dd, ss), max(dd, ss))
+                    t_w = times[w]
+                    if t_w <= tm:
+                        outer = max(times[max(w - 1, 0)], t0)
+                    else:
+                        outer = min(times[min(w + 1, K - 1)], t1)
+                    dev = max(dev, d_w + abs(_path(times, cum, phi, b, outer) - cum[w, b]))
+                dev = min(dev, math.pi)
+                th = dev + rel * (cum[K - 1, b] + 1.0)
+                th = min(th * (1.0 + rel) + ab, math.pi)
+            if rotating[b]:
+                # _screw_ref_deviation: helix pieces of the reference point's world image
+                hseg = times[im + 1] - times[im]
+                left = max(tm - near_left, 0.0) / hseg
+                right = max(near_right - tm, 0.0) / hseg
+                T = _helix_span(hx_d[im, b], hx_P[im, b], hx_th[im, b], max(left, right))
+                if hi > lo:
+                    _quat_mat(qm, Rm)
+                    ym0 = xm[0] + Rm[0, 0] * ref[b, 0] + Rm[0, 1] * ref[b, 1] + Rm[0, 2] * ref[b, 2]
+                    ym1 = xm[1] + Rm[1, 0] * ref[b, 0] + Rm[1, 1] * ref[b, 1] + Rm[1, 2] * ref[b, 2]
+                    ym2 = xm[2] + Rm[2, 0] * ref[b, 0] + Rm[2, 1] * ref[b, 1] + Rm[2, 2] * ref[b, 2]
+                    for w in range(lo, hi):
+                        d_w = _norm(ref_W[w, b, 0] - ym0, ref_W[w, b, 1] - ym1, ref_W[w, b, 2] - ym2)
+                        t_w = times[w]
+                        if t_w <= tm:
+                            k = min(max(w - 1, 0), K - 2)
+                            outer = max(times[max(w - 1, 0)], t0)
+                        else:
+                            k = min(max(w, 0), K - 2)
+                            outer = min(times[min(w + 1, K - 1)], t1)
+                        sigma = abs(outer - t_w) / (times[k + 1] - times[k])
+                        T = max(T, d_w + _helix_span(hx_d[k, b], hx_P[k, b], hx_th[k, b], sigma))
+                T = T + screw_pad
+            else:
+                T = dx + 2.0 * math.sin(0.5 * min(th, math.pi)) * _norm(ref[b, 0], ref[b, 1], ref[b, 2])
+            out_trans[n, b] = T * (1.0 + rel) + ab + scale_pad * scale
+            out_angle[n, b] = th
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _norm(x, y, z):
+    return math.sqrt(x * x + y * y + z * z)
+
+
+__all__ = ["fat_level", "traj_balls", "screw_poses_bounds", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]

@@ -1289,6 +1289,10 @@ class _TrajectoryBalls(BallProvider):
         self.mp_all = np.concatenate(self.mp)
         self.mw_all = np.concatenate(self.mw)
         self.pack = _motion_pack(traj) if compiled else None
+        self.screw = None
+        if compiled and self.pack is None and getattr(traj, "interpolation", None) == "screw" \
+                and hasattr(traj, "screw_arrays"):
+            self.screw = traj.screw_arrays()
         if compiled:
             self.flat = (_c(body_a, np.int64), _c(body_b, np.int64), _c(self.ref), _c(self.mp_all),
                          _c(self.mw_all), _c(self.mp_off, np.int64))
@@ -1308,6 +1312,8 @@ class _TrajectoryBalls(BallProvider):
         if self.pack is not None:
             from monitor.motion.pack import poses_and_bounds
             pos, rot, mb = poses_and_bounds(self.pack, fr.t0, fr.t1)
+        elif self.screw is not None:
+            pos, rot, mb = _screw_poses_bounds(self.traj, self.screw, fr.t0, fr.t1)
         else:
             pos, rot = self.traj.body_poses(0.5 * (fr.t0 + fr.t1))
             mb = self.traj.motion_bounds(fr.t0, fr.t1)
@@ -1347,6 +1353,23 @@ class _TrajectoryBalls(BallProvider):
 
 
 _PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _screw_poses_bounds(traj: Any, arrays: tuple, t0: np.ndarray, t1: np.ndarray):
+    """Midpoint poses and motion bounds of a screw BodyMotion in one compiled call.
+
+    Same numbers as ``traj.body_poses((t0 + t1) / 2)`` and ``traj.motion_bounds(t0, t1)``
+    (:func:`monitor.certify.fat_kernels.screw_poses_bounds`; rounding-level differences).
+    """
+    from monitor.certify import fat_kernels
+    from monitor.motion import _kinematics as K
+    from monitor.motion.base import MotionBounds
+    a, b = K.check_interval_arrays(t0, t1, traj.window)
+    N, nb = a.shape[0], arrays[1].shape[1]
+    pos, rot = np.empty((N, nb, 3)), np.empty((N, nb, 3, 3))
+    trans, angle = np.empty((N, nb)), np.empty((N, nb))
+    fat_kernels.screw_poses_bounds(*arrays, _c(a), _c(b), pos, rot, trans, angle)
+    return pos, rot, MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
 
 
 def _motion_pack(traj: Trajectory) -> Any:
