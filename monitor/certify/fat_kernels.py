@@ -300,7 +300,7 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
               av, aqv, ae_v0, ae_d, ae_k, af_o, af_U, af_k0, af_kg, af_K, af_hn, af_hc,
               be_w0, be_e, bf_o, bf_n, bf_U, bf_hn, bf_hc, h_n, h_off,
               row_type, row_a, row_b, unit_ptr, unit_rows, unit_item, unit_id,
-              rel_pad, abs_pad, scale_pad,
+              rel_pad, abs_pad, scale_pad, short_circuit,
               sep, unit_fired, rows_per_item, units_per_item):
     """One subdivision level of the fat-feature stage (§6 Listing 1-2 inner tests, §3-§4).
 
@@ -315,6 +315,9 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
         row_type, row_a, row_b: (n_rows,) global row table; unit_ptr, unit_rows: unit CSR.
         unit_item, unit_id: (K,) active (item, unit) pairs.
         rel_pad, abs_pad, scale_pad: ``Tolerances`` fields.
+        short_circuit: 1 = a unit stops at its first firing row (the unit's answer is the OR
+            of its rows, so ``unit_fired`` is the same; fewer rows are evaluated and counted),
+            0 = every row of every active unit is evaluated (the oracle's counts).
         sep: out (N,) bool, item excluded by the pre-filter.
         unit_fired: out (K,) bool. rows_per_item, units_per_item: out (N,) int64, distinct
             rows evaluated / units tested per item.
@@ -404,6 +407,8 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
                 rows_per_item[it] += 1
                 total += 1
             fired = fired or f
+            if fired and short_circuit:
+                break
         unit_fired[ku] = fired
     return total
 

@@ -116,6 +116,9 @@ from monitor.tolerances import DEFAULT, Tolerances
 _U = 2.0**-53
 _ETA = 1e-9
 USE_COMPILED = True
+SHORT_CIRCUIT = True
+"""Compiled levels: a unit stops evaluating rows at its first firing row (same unit answers and
+intervals; ``row_tests`` then counts the rows evaluated, fewer than the oracle's)."""
 """Default of :func:`subdivide`'s ``compiled``: the numba level kernel (``fat_kernels``), or the
 numpy kernels of this module (False; the oracle the tests compare against)."""
 """Relative widening of parameter ranges [0, 1] and tau-intervals (conservative)."""
@@ -865,7 +868,7 @@ def _one_ball_compiled(pd: _PairData, C: _Concat, T: _Tables, L1: np.ndarray, p1
     fast = _FastLevel(C, T, _Prefilter([pd]) if prefilter else None, np.array([pd.A.rho_max]),
                       np.array([pd.r], float), np.array([pd.A.extent]), np.array([pd.B.extent]),
                       np.array([pd.A.flat_err]), np.array([pd.B.flat_err]),
-                      np.array([_sqrt_jinv(pd.A.metric)]), tol)
+                      np.array([_sqrt_jinv(pd.A.metric)]), tol, short_circuit=False)
     uid = T.pair_units[0]
     fr = _Frontier(np.zeros(1, np.int64), np.zeros(1), np.ones(1), np.zeros(1, np.int64),
                    np.zeros(len(uid), np.int64), uid)
@@ -956,7 +959,7 @@ class _FastLevel:
 
     def __init__(self, C: _Concat, T: _Tables, pre: _Prefilter | None, rho_max: np.ndarray,
                  r_pair: np.ndarray, a_ext: np.ndarray, b_ext: np.ndarray, flat_a: np.ndarray,
-                 flat_b: np.ndarray, sqj: np.ndarray, tol: Tolerances):
+                 flat_b: np.ndarray, sqj: np.ndarray, tol: Tolerances, short_circuit: bool = True):
         from monitor.certify import fat_kernels
         self.kernel = fat_kernels.fat_level
         rt, ra, rb = _flat_rows(T)
@@ -972,7 +975,7 @@ class _FastLevel:
                                             C.af_kg, C.af_K, C.af_hn, C.af_hc, C.be_w0, C.be_e, C.bf_o,
                                             C.bf_n, C.bf_U, C.bf_hn, C.bf_hc, C.h_n, C.h_off))
         self.rows = (rt, ra, rb, _c(T.unit_ptr, np.int64), _c(T.unit_rows, np.int64))
-        self.tol = (float(tol.rel_pad), float(tol.abs_pad), float(tol.scale_pad))
+        self.tol = (float(tol.rel_pad), float(tol.abs_pad), float(tol.scale_pad), int(bool(short_circuit)))
 
     def level(self, fr: _Frontier, L: np.ndarray, p: np.ndarray, R: np.ndarray):
         """(sep (N,), unit_fired (K,), rows per item (N,), units per item (N,), distinct rows)."""
@@ -1084,7 +1087,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     flat_a = np.array([pd.A.flat_err for pd in pairs], float)
     flat_b = np.array([pd.B.flat_err for pd in pairs], float)
     sqj = np.array([_sqrt_jinv(pd.A.metric) for pd in pairs], float)
-    fast = (_FastLevel(C, T, pre, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj, tol)
+    fast = (_FastLevel(C, T, pre, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj, tol, SHORT_CIRCUIT)
             if (USE_COMPILED if compiled is None else compiled) and pairs else None)
     units_i = [T.pair_units[i] for i in idx_pairs]
     fr = _Frontier(idx_pairs.astype(np.int64), np.full(len(idx_pairs), t0), np.full(len(idx_pairs), t1),
