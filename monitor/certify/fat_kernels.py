@@ -31,6 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
+from monitor.motion.kernel import _search_left, _search_right
+
 T_VF = 0
 T_EE = 1
 T_FE = 2
@@ -358,7 +360,16 @@ def fat_level(pair, L, p, R, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj,
     st_e = np.full(ae_v0.shape[0], -1, np.int64)
     ff = np.empty((af_o.shape[0], 14))
     st_f = np.full(af_o.shape[0], -1, np.int64)
-    order = np.argsort(unit_item, kind="mergesort")
+    # units grouped by item, stable (counting sort; numba's argsort costs seconds of cold compile)
+    start = np.zeros(N + 1, np.int64)
+    for j in range(unit_item.shape[0]):
+        start[unit_item[j] + 1] += 1
+    for i in range(N):
+        start[i + 1] += start[i]
+    order = np.empty(unit_item.shape[0], np.int64)
+    for j in range(unit_item.shape[0]):
+        order[start[unit_item[j]]] = j
+        start[unit_item[j]] += 1
     total = 0
     for j in range(order.shape[0]):
         ku = order[j]
@@ -514,7 +525,7 @@ def traj_balls(pair, body_a, body_b, pos, rot, trans, angle, ref, mp_all, mw_all
 def _locate(times, t):
     """Segment i, parameter s in [0, 1], at_end (``Segments.locate``)."""
     K = times.shape[0]
-    i = np.searchsorted(times, t, side="right") - 1
+    i = _search_right(times, t) - 1
     i = min(max(i, 0), K - 2)
     s = (t - times[i]) / (times[i + 1] - times[i])
     s = min(max(s, 0.0), 1.0)
@@ -635,9 +646,9 @@ def screw_poses_bounds(times, pos, quat, target, half, phi, cum, same, moving, r
         ia, sa, ea = _locate(times, t0)
         ib, sb, eb = _locate(times, t1)
         im, sm, em = _locate(times, tm)
-        lo = np.searchsorted(times, t0, side="right")
-        hi = np.searchsorted(times, t1, side="left")
-        j = min(max(np.searchsorted(times, tm, side="right") - 1, 0), K - 1)
+        lo = _search_right(times, t0)
+        hi = _search_left(times, t1)
+        j = min(max(_search_right(times, tm) - 1, 0), K - 1)
         near_left = max(times[j], t0)
         near_right = max(min(times[min(j + 1, K - 1)], t1), tm)
         for b in range(nb):
