@@ -348,3 +348,11 @@ def test_screw_poses_bounds_match_bodymotion(seed):
     assert np.allclose(mb_c.angle, mb_n.angle, rtol=1e-12, atol=1e-15)
     assert np.all(mb_c.trans[:, 1] == 0) and np.all(mb_c.angle[:, 2] == 0)
     assert mb_c.trans[:, 3].max() > 0.1 and mb_c.angle[:, 3].max() > 0.1
+
+
+def test_warm_kernels_compiles_the_three_entry_points():
+    from monitor.certify import fat_kernels as FK
+    from monitor.certify.toleranced import warm_kernels
+
+    warm_kernels()
+    assert FK.fat_level.signatures and FK.traj_balls.signatures and FK.screw_poses_bounds.signatures

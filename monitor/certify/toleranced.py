@@ -1495,6 +1495,28 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
     return outs  # type: ignore[return-value]
 
 
+def warm_kernels() -> None:
+    """Compile (or load from numba's disk cache) the fat-feature stage's kernels once.
+
+    :func:`monitor.certify.fat_kernels.fat_level`, ``traj_balls`` and ``screw_poses_bounds``
+    on a tiny box pair and a two-body screw motion. With an empty cache this takes several
+    seconds (docs/notes/issue-12-slowcases.md); call it before any budgeted ``certify``
+    that may reach the fat-feature stage (``monitor.warmup``).
+    """
+    from monitor.geometry.polytope import box_polytope
+    from monitor.motion.bodymotion import BodyMotion
+
+    box = box_polytope(np.array([0.1, 0.1, 0.1]))
+    pos = np.zeros((2, 2, 3))
+    pos[:, 1] = [[0.3, 0.0, 0.0], [0.3, 0.1, 0.0]]
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (2, 2, 1))
+    quat[1, 1] = [np.cos(0.2), 0.0, 0.0, np.sin(0.2)]
+    for interp in ("lerp_slerp", "screw"):
+        bm = BodyMotion(np.array([0.0, 1.0]), pos, quat, interpolation=interp)
+        check_pairs(bm, [(box, 1, box, 0)], (0.0, 1.0), 0.0, 0.05, compiled=True, check_start=False)
+
+
 __all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
            "subdivide", "check_pairs", "BallProvider", "SubdivisionResult", "first_interval_dfs",
-           "fat_units_fire", "prefilter_separated", "frontier_over_cap", "Frontier", "PairData"]
+           "fat_units_fire", "prefilter_separated", "frontier_over_cap", "Frontier", "PairData",
+           "warm_kernels", "USE_COMPILED", "SHORT_CIRCUIT"]
