@@ -1355,9 +1355,6 @@ class _TrajectoryBalls(BallProvider):
         return L, p, np.sqrt(R2)
 
 
-_PACKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
 def _screw_poses_bounds(traj: Any, arrays: tuple, t0: np.ndarray, t1: np.ndarray):
     """Midpoint poses and motion bounds of a screw BodyMotion in one compiled call.
 
@@ -1378,29 +1375,16 @@ def _screw_poses_bounds(traj: Any, arrays: tuple, t0: np.ndarray, t1: np.ndarray
 def _motion_pack(traj: Trajectory) -> Any:
     """The compiled kernels' pack of ``traj`` (lerp+slerp BodyMotion or Plan), or None.
 
-    Its poses equal the trajectory's; its bounds are the compiled kernels' (``motion.kernel``,
-    the contract of ``motion.plan``, the bound the compiled whole-shape stage already uses):
-    on one segment with reference points at the body origins they equal BodyMotion's to
-    < 1e-8 relative (measured), across waypoints they can be tighter (minimum of the chain
-    and Taylor bounds). tests/test_fat_kernels.py samples the resulting balls. A BodyMotion
-    is immutable (read-only arrays), so its pack is cached on it; a Plan is packed per call.
+    :func:`monitor.certify.kernels.trajectory_pack`: the engine's own pack, cached per
+    trajectory object and checked once against the trajectory's poses. Its poses equal
+    the trajectory's; its bounds are the compiled kernels' (``motion.kernel``, the contract
+    of ``motion.plan``, the bound the compiled whole-shape stage already uses): on one
+    segment with reference points at the body origins they equal BodyMotion's to < 1e-8
+    relative (measured), across waypoints they can be tighter (minimum of the chain and
+    Taylor bounds). tests/test_fat_kernels.py samples the resulting balls.
     """
-    from monitor.errors import MonitorError
-    from monitor.motion.bodymotion import BodyMotion
-    from monitor.motion.pack import pack_trajectory
-    if isinstance(traj, BodyMotion):
-        hit = _PACKS.get(traj)
-        if hit is None:
-            try:
-                hit = pack_trajectory(traj)
-            except MonitorError:
-                hit = False
-            _PACKS[traj] = hit
-        return hit or None
-    try:
-        return pack_trajectory(traj)
-    except MonitorError:
-        return None
+    from monitor.certify.kernels import trajectory_pack
+    return trajectory_pack(traj)
 
 
 def _orient(shape_a: ConvexShape, body_a: int, shape_b: ConvexShape, body_b: int,
