@@ -135,6 +135,24 @@ class _Snapshot:
         self.model = model
         self.views = [(f, getattr(model, f)) for f in SYNC_FIELDS]
         self.opt = model.opt  # a live view of mjOption
+        self._live: list[tuple[Any, bytes]] | None = None  # (view, saved bytes) of non-empty fields
+
+    def unchanged(self) -> bool:
+        """True if no watched field differs from the snapshot (the per-call test of :meth:`Scene.sync`).
+
+        Same comparison as :meth:`changed` (every byte of every watched field, and
+        ``opt.disableflags``), stopping at the first difference and building no list.
+        Empty arrays (e.g. ``mesh_vert`` without meshes) have nothing to compare.
+        """
+        live = self._live
+        if live is None:
+            live = self._live = [(v, b) for (_f, v), b in zip(self.views, self.saved) if v.size]
+        if int(self.opt.disableflags) != self.disableflags:
+            return False
+        for v, b in live:
+            if v.tobytes() != b:
+                return False
+        return True
 
     def __getstate__(self) -> dict[str, Any]:  # views are not picklable; rebound on load
         return {"model": self.model, "saved": self.saved, "disableflags": self.disableflags}
@@ -343,6 +361,16 @@ class Scene:
         self._acm_spec: dict[str, Any] = {}  # set by from_model: allowed/hazards/allow/reference
         # a scene built by hand without an MjModel (tests, pure-geometry use) has nothing to watch
         self._snapshot = _Snapshot(model) if model is not None else None
+        self._hot: dict[str, Any] = {}
+        """Per-scene values the engine derives from the scene (``monitor.certify.engine``:
+        selections, packed flags, model checks already made); emptied by :meth:`sync` and
+        not pickled. Entries also hold the objects they were derived from (``pair_ids``,
+        the snapshot) and are used only while those are still the scene's."""
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_hot"] = {}
+        return state
 
     # ------------------------------------------------------------------ model edits
 
@@ -366,8 +394,10 @@ class Scene:
         """
         if self._snapshot is None:
             return False
+        if self._snapshot.unchanged():
+            return False
         changed = self._snapshot.changed()
-        if not changed:
+        if not changed:  # cannot differ from unchanged() (same bytes); kept as a guard
             return False
         what = ", ".join(changed)
         try:
@@ -386,6 +416,7 @@ class Scene:
         self._snapshot = fresh._snapshot
         for cached in ("candidate_pairs", "model_hash"):
             self.__dict__.pop(cached, None)
+        self._hot = {}
         self.version += 1
         return True
 

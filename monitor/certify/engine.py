@@ -104,6 +104,13 @@ def _check_model(scene: Any, plan: Any) -> Any:
     sync = getattr(scene, "sync", None)
     if sync is not None:
         sync()
+    hot = _hot(scene)
+    if hot is not None and type(plan) is _plan_class():
+        memo = hot.get("plan_current")
+        st = getattr(plan, "_st", None)
+        if (memo is not None and memo[0] is getattr(scene, "_snapshot", None) and st is not None
+                and plan.model is scene.model and memo[1].get(id(st)) is st):
+            return plan        # see _remember_current: the same checks, already passed
     pm = getattr(plan, "model", None)
     if pm is not None and pm is not scene.model:
         try:
@@ -117,15 +124,77 @@ def _check_model(scene: Any, plan: Any) -> Any:
     if int(plan.nbody) != len(scene.body_names):
         raise ModelMismatchError(f"plan has {plan.nbody} bodies, scene has {len(scene.body_names)}")
     current = getattr(plan, "is_current", None)
-    if current is not None and not current():
-        plan = plan.refreshed()
+    if current is not None:
+        if not current():
+            plan = plan.refreshed()
+        elif hot is not None and pm is scene.model and type(plan) is _plan_class():
+            _remember_current(scene, hot, plan)
     return plan
+
+
+_PLAN_CLASS: list = []
+
+
+def _plan_class() -> type:
+    """:class:`monitor.motion.plan.Plan` (imported on first use)."""
+    if not _PLAN_CLASS:
+        from monitor.motion.plan import Plan
+        _PLAN_CLASS.append(Plan)
+    return _PLAN_CLASS[0]
+
+
+def _hot(scene: Any) -> dict | None:
+    """The scene's engine cache (``Scene._hot``, emptied by ``Scene.sync``), or None (duck-typed scenes)."""
+    hot = getattr(scene, "_hot", None)
+    if hot is None and getattr(scene, "_snapshot", None) is not None:
+        try:   # a Scene unpickled from an older version
+            hot = scene._hot = {}
+        except AttributeError:
+            return None
+    return hot
+
+
+def _remember_current(scene: Any, hot: dict, plan: Any) -> None:
+    """Record that ``plan`` passed ``is_current`` against the model as the scene's snapshot holds it.
+
+    ``Plan.is_current()`` is ``_structure_key(plan.model) == plan._st.key``: it depends only on
+    the plan's (cached, shared) structure object ``_st`` and the model's bytes of
+    ``plan._STRUCT_FIELDS`` plus array sizes. Every one of those fields is watched by the
+    scene's snapshot (``monitor.scene.SYNC_FIELDS``; asserted by
+    ``tests/test_engine_entry.py``) and sizes cannot change in place. So while ``scene.sync()``
+    finds the model equal to the same snapshot object (every watched byte unchanged), any
+    plan with the same ``_st`` object on the same model object is still current: the next
+    call skips the ``is_current`` bytes join. ``Scene.sync`` empties ``_hot`` when it
+    rebuilds, and the memo also holds the snapshot it was made under. Only exact
+    :class:`~monitor.motion.plan.Plan` objects (no subclass overriding ``is_current``).
+    The memo holds the ``_st`` objects themselves, so their ``id`` is not reused.
+    """
+    snap = getattr(scene, "_snapshot", None)
+    st = getattr(plan, "_st", None)
+    if snap is None or st is None or not snap.unchanged():
+        return
+    memo = hot.get("plan_current")
+    if memo is None or memo[0] is not snap:
+        memo = hot["plan_current"] = (snap, {})
+    if len(memo[1]) >= 16:
+        memo[1].clear()
+    memo[1][id(st)] = st
 
 
 def _select(scene: Any, pairs: Any) -> np.ndarray:
     """Sorted (S,) int64 indices of the selected candidate pairs (all of them when ``pairs`` is None)."""
     if pairs is None:
-        return np.arange(len(scene.pair_ids), dtype=np.int64)
+        pid = scene.pair_ids
+        hot = _hot(scene)
+        if hot is not None:
+            hit = hot.get("sel_all")
+            if hit is not None and hit[0] is pid:
+                return hit[1]
+        sel = np.arange(len(pid), dtype=np.int64)
+        if hot is not None:
+            sel.setflags(write=False)
+            hot["sel_all"] = (pid, sel)
+        return sel
     index = {}
     for i, (a, b) in enumerate(scene.candidate_pairs):
         index[(a, b)] = i
@@ -169,7 +238,7 @@ def _make_budget(budget: Any) -> Budget:
     the kernels it uses (``python -m monitor warmup`` compiles every path ahead of time).
     """
     if budget is None:
-        return Budget(seconds=DEFAULT_BUDGET_SECONDS)
+        return Budget.default(DEFAULT_BUDGET_SECONDS)
     if isinstance(budget, Budget):
         return budget
     if isinstance(budget, dict):
@@ -501,11 +570,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
 
     sp, mp = fast
     moving = np.asarray(plan.moving_bodies(), bool)
-    static = np.asarray(scene.body_static, bool)
     P = len(sel)
     pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
-    fixed = (static & ~moving).astype(np.int64)
-    mov = moving.astype(np.int64)
+    fixed, mov = _body_flags(scene, moving)
     # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
     # every surviving pair takes the Python route, which calls the replacement
     narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
@@ -520,7 +587,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     sc = np.empty((_NSUB, G, 3))
     sr = np.empty((_NSUB, G))
     info = np.zeros(KS.WI_SIZE)
-    none = np.zeros(0, np.int64)
+    none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
     S = int(KS.window_kernel(sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
@@ -629,7 +696,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
     has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
     verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to].copy(), res[:done_to].copy(), unfin, results,
+    # views, not copies: code / gap / surv / res are this call's own arrays, not written after here
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to], res[:done_to], unfin, results,
                         geoms, (t0, t1), sc, sr, float(info[KS.WI_PAD]))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
@@ -660,8 +728,41 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
-    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
-                       lazy, stats, allowed)
+    return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
+                                earliest, clearance, lazy, stats, allowed)
+
+
+_VERDICT_OF = {v.value: v for v in Verdict}
+_METHOD_OF = {m.value: m for m in Method}
+"""Verdict / Method member of a validated string (a member is its own key: StrEnum hashes as its value)."""
+_NONE = np.zeros(0, np.int64)
+"""The empty ``route`` of a window_kernel call (nothing is ever written to it)."""
+
+
+def _body_flags(scene: Any, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(fixed, mov): (nbody,) int64 ``body_static & ~moving`` and ``moving``, the window kernel's flags.
+
+    Cached per scene (``Scene._hot``) for each moving mask, keyed on the mask's bytes and held
+    with the ``body_static`` array they were made from (``Scene.sync`` replaces it); the kernel
+    only reads them. Duck-typed scenes without the cache compute them per call.
+    """
+    static = scene.body_static
+    hot = _hot(scene)
+    if hot is not None:
+        memo = hot.get("body_flags")
+        if memo is None or memo[0] is not static:
+            memo = hot["body_flags"] = (static, {})
+        key = moving.tobytes()
+        hit = memo[1].get(key)
+        if hit is not None:
+            return hit
+    fixed = (np.asarray(static, bool) & ~moving).astype(np.int64)
+    mov = moving.astype(np.int64)
+    if hot is not None:
+        if len(memo[1]) >= 64:
+            memo[1].clear()
+        memo[1][key] = (fixed, mov)
+    return fixed, mov
 
 
 def _translates(plan: Any, mp: Any, b: int) -> bool:
