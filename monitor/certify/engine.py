@@ -316,7 +316,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
     bud = _make_budget(budget)
     pen_tol = check_rule(ongoing, penetration_tol)
-    allowed = tuple(getattr(scene, "allowed_pairs", ()))
+    allowed = getattr(scene, "allowed_pairs", ())
+    if type(allowed) is not tuple:
+        allowed = tuple(allowed)
     sel = _select(scene, pairs)
     if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
         return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
@@ -332,7 +334,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
                                  allowed, fast)
         else:
             cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
-    if ongoing == "deepen":  # issue 13: contacts present at t0 (monitor/certify/ongoing.py)
+    # issue 13: contacts present at t0 (monitor/certify/ongoing.py); deepen returns a
+    # "certified" certificate unchanged (no pair can be an ongoing contact), so it is not called
+    if ongoing == "deepen" and cert.verdict != "certified":
         cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
                       budget=bud, tolerances=tol, penetration_tol=pen_tol)
     return cert
@@ -434,11 +438,20 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     mp = KS.trajectory_pack(plan)
     if mp is None:
         return None
-    try:
-        sp = KS.scene_pack(scene)
-    except (MonitorError, TypeError, AttributeError, ValueError):
-        return None
-    if sp.geoms.body.shape[0] != len(scene.geoms) or int(plan.nbody) != mp.nbody:
+    hot = _hot(scene)
+    hit = None if hot is None else hot.get("scene_pack")
+    if hit is not None and hit[0] is scene.geoms and hit[1] is scene.pair_ids and hit[2] is KS.scene_pack:
+        sp = hit[3]         # what KS.scene_pack returned for these geoms / pair_ids objects
+    else:
+        try:
+            sp = KS.scene_pack(scene)
+        except (MonitorError, TypeError, AttributeError, ValueError):
+            return None
+        if sp.geoms.body.shape[0] != len(scene.geoms):
+            return None
+        if hot is not None:
+            hot["scene_pack"] = (scene.geoms, scene.pair_ids, KS.scene_pack, sp)
+    if int(plan.nbody) != mp.nbody:
         return None
     return sp, mp
 
@@ -594,7 +607,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                              sc, sr, info))
     done_to = min(first, S)
     charged = info[KS.WI_TESTS]
-    bud.charge(int(charged))
+    if charged:
+        bud.charge(int(charged))
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -634,9 +648,12 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         done_to = S
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
-    if narrow and done_to and not stopped:
+    svl = surv[:done_to].tolist()
+    codes = code.take(svl).tolist() if done_to else []
+    if narrow and done_to and not stopped and KS.WK_UNRES in codes:
         full_tests = _full_search(KS, sp.geoms, mp, pid, surv, code, res, done_to, t0, t1, margin, epsilon,
                                   tol, bud)
+        codes = code.take(svl).tolist()     # convicted pairs are WK_VIOL now
     # -- the Python stages on what the kernel left open -------------------------------------
     # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
@@ -645,8 +662,6 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     geoms = scene.geoms
     if done_to < S:                       # budget: survivors the kernel never reached
         unfin[surv[done_to:S]] = True
-    svl = surv[:done_to].tolist()
-    codes = code[surv[:done_to]].tolist() if done_to else []
     todo = []
     start_known: dict[int, bool] = {}   # i -> start pose NOT proven clear (the kernel's exact test)
     vslots, cslots, wslots = [], [], []
@@ -698,7 +713,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
     # views, not copies: code / gap / surv / res are this call's own arrays, not written after here
     lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to], res[:done_to], unfin, results,
-                        geoms, (t0, t1), sc, sr, float(info[KS.WI_PAD]))
+                        geoms, (t0, t1), sc, sr, info.item(KS.WI_PAD))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
             if r.verdict == "violation" and r.witness is not None]
@@ -707,7 +722,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         cand.append((float(res[s, KS.R_WTIME]), int(sel[k]), None, k, s))
     witness = None
     if cand:
-        best = min(cand, key=lambda c: (c[0], c[1]))
+        best = cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1]))
         witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
     if verdict != "certified":
@@ -720,7 +735,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     clears += [float(res[s, KS.R_CLEAR]) for s in cslots]
     if vslots or n_unfin:
         clears.append(float("-inf"))
-    best_cull = float(info[KS.WI_BEST])
+    best_cull = info.item(KS.WI_BEST)
     if best_cull < float("inf"):
         clears.append(best_cull)
     clearance = float(min(clears)) if clears else float("inf")
