@@ -506,10 +506,10 @@ class _WindowPairs:
         """The Witness of pair k, a violation decided by the kernel (survivor slot s)."""
         KS = _kernels()
         self._names()
-        a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
+        a, b = self.pid[k].tolist()
         row = self.res[s]
-        return Witness(float(row[KS.R_WTIME]), (self.names[a], self.names[b]),
-                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), float(row[KS.R_WUPPER]))
+        return Witness(row.item(KS.R_WTIME), (self.names[a], self.names[b]),
+                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), row.item(KS.R_WUPPER))
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
@@ -648,12 +648,13 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         done_to = S
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
-    svl = surv[:done_to].tolist()
-    codes = code.take(svl).tolist() if done_to else []
+    sv = surv[:done_to]
+    svl = sv.tolist()
+    codes = code[sv].tolist() if done_to else []
     if narrow and done_to and not stopped and KS.WK_UNRES in codes:
         full_tests = _full_search(KS, sp.geoms, mp, pid, surv, code, res, done_to, t0, t1, margin, epsilon,
                                   tol, bud)
-        codes = code.take(svl).tolist()     # convicted pairs are WK_VIOL now
+        codes = code[sv].tolist()           # convicted pairs are WK_VIOL now
     # -- the Python stages on what the kernel left open -------------------------------------
     # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
