@@ -136,9 +136,9 @@ def pusher_calls() -> Iterator[tuple[str, Any]]:
 
 def record(path: str) -> None:
     out = {name: _summary(run()) for name, run in calls()}
-    with open(path, "w") as f:
-        json.dump(out, f, indent=0, sort_keys=True)
-        f.write("\n")
+    with open(path, "w") as f:   # one call per line
+        f.write("{\n" + ",\n".join(f"{json.dumps(k)}: {json.dumps(v, sort_keys=True)}"
+                                    for k, v in sorted(out.items())) + "\n}\n")
 
 
 if __name__ == "__main__":

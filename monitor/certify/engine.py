@@ -655,6 +655,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         full_tests = _full_search(KS, sp.geoms, mp, pid, surv, code, res, done_to, t0, t1, margin, epsilon,
                                   tol, bud)
         codes = code[sv].tolist()           # convicted pairs are WK_VIOL now
+    rows = res[:done_to].tolist() if done_to else []   # the result rows as Python floats (read below)
     # -- the Python stages on what the kernel left open -------------------------------------
     # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
@@ -672,7 +673,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             i, ga, gb = int(sel[k]), geoms[int(pid[k, 0])], geoms[int(pid[k, 1])]
             todo.append((i, ga, gb))
             if c != KS.WK_PYTHON:
-                lo = float(res[s, KS.R_START_LO])
+                lo = rows[s][KS.R_START_LO]
                 start_known[i] = not (lo > margin or lo + ga.shape.radius + gb.shape.radius > 0)
             continue
         if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
@@ -706,8 +707,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         mix["budget"] = n_unfin
     # -- 6. combine (arrays for the kernel's pairs, PairResults for the Python ones) ------------
     for s in wslots:
-        tests_total += int(res[s, KS.R_TESTS])
-        depth_max = max(depth_max, int(res[s, KS.R_DEPTH]))
+        tests_total += int(rows[s][KS.R_TESTS])
+        depth_max = max(depth_max, int(rows[s][KS.R_DEPTH]))
     checked_r = [results[i] for i in sorted(results)] if results else []
     has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
     has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
@@ -720,7 +721,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             if r.verdict == "violation" and r.witness is not None]
     for s in vslots:
         k = svl[s]
-        cand.append((float(res[s, KS.R_WTIME]), int(sel[k]), None, k, s))
+        cand.append((rows[s][KS.R_WTIME], int(sel[k]), None, k, s))
     witness = None
     if cand:
         best = cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1]))
@@ -730,10 +731,10 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
         starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
         for s in vslots:
-            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else float(res[s, KS.R_FIRST_UNRES]))
+            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else rows[s][KS.R_FIRST_UNRES])
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
-    clears += [float(res[s, KS.R_CLEAR]) for s in cslots]
+    clears += [rows[s][KS.R_CLEAR] for s in cslots]
     if vslots or n_unfin:
         clears.append(float("-inf"))
     best_cull = info.item(KS.WI_BEST)
