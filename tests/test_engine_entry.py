@@ -155,3 +155,12 @@ def test_trusted_constructors_equal_the_validating_ones():
     d = Certificate("violation", *args, "auto", w, 0.4, float("-inf"), (), {"x": 1}, ())
     assert c == d and c.to_dict() == d.to_dict() and c.pairs == ()
     assert type(c.verdict) is Verdict and type(c.method) is Method
+    # the engine builds kernel witnesses field for field: valid while Witness has exactly
+    # these fields and no __post_init__
+    import dataclasses
+
+    assert [f.name for f in dataclasses.fields(Witness)] == ["time", "geoms", "point", "distance"]
+    assert "__post_init__" not in vars(Witness)
+    assert [f.name for f in dataclasses.fields(Certificate)] == [
+        "verdict", "window", "margin", "epsilon", "method", "witness", "earliest_time", "clearance",
+        "pairs", "stats", "allowed"]

@@ -456,6 +456,7 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     return sp, mp
 
 
+_new = object.__new__
 _NAMES: dict[int, tuple] = {}
 _NAMES_MAX = 16
 
@@ -508,8 +509,12 @@ class _WindowPairs:
         self._names()
         a, b = self.pid[k].tolist()
         row = self.res[s]
-        return Witness(row.item(KS.R_WTIME), (self.names[a], self.names[b]),
-                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), row.item(KS.R_WUPPER))
+        # = Witness(time, geoms, point, distance): a frozen dataclass without __post_init__,
+        # built field for field without its per-field object.__setattr__
+        w = _new(Witness)
+        w.__dict__.update(time=row.item(KS.R_WTIME), geoms=(self.names[a], self.names[b]),
+                          point=row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), distance=row.item(KS.R_WUPPER))
+        return w
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
