@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import gc
 import math
+import sys
 import time
 from typing import Any
 
@@ -132,15 +133,14 @@ def _check_model(scene: Any, plan: Any) -> Any:
     return plan
 
 
-_PLAN_CLASS: list = []
+def _plan_class() -> type | None:
+    """:class:`monitor.motion.plan.Plan` if that module is loaded, else None.
 
-
-def _plan_class() -> type:
-    """:class:`monitor.motion.plan.Plan` (imported on first use)."""
-    if not _PLAN_CLASS:
-        from monitor.motion.plan import Plan
-        _PLAN_CLASS.append(Plan)
-    return _PLAN_CLASS[0]
+    Never imports it (it imports mujoco; ``monitor.certify`` must not): a plan that is a
+    ``Plan`` means the module is loaded already.
+    """
+    mod = sys.modules.get("monitor.motion.plan")
+    return None if mod is None else getattr(mod, "Plan", None)
 
 
 def _hot(scene: Any) -> dict | None:
