@@ -121,6 +121,28 @@ class Rollout:
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
+        self.c_tail = True
+        """Run braking tails in ``mujoco.rollout`` where exact (False: always the ``mj_step`` loop)."""
+        self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
+        self._tail_bufs: tuple[np.ndarray, ...] | None = None  # buffers of the C tail (see _tail_by_rollout)
+        self._n_full = self._n_user = 0
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle / deepcopy state: without the C rollout object and views into the scratches.
+
+        ``mujoco._rollout.Rollout`` does not pickle, and a copied view of a scratch array
+        (``_s_ctrl``, the tail's warning counters and warm start) would be a detached copy,
+        no longer the copied ``MjData``'s memory; all are rebuilt from the copied scratches.
+        """
+        state = self.__dict__.copy()
+        state.pop("_s_ctrl", None)
+        state["_roll"] = None
+        state["_tail_bufs"] = None
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._s_ctrl = self.scratch.ctrl
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
@@ -232,15 +254,23 @@ class Rollout:
 
     def brake_rows(self, data: mujoco.MjData, ctrl: np.ndarray, nstep: int,
                    brake_fn: Callable[[mujoco.MjData], np.ndarray], max_steps: int,
-                   vel_tol: float) -> tuple[np.ndarray, np.ndarray]:
+                   vel_tol: float, *, window_fresh: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The braking tail of :meth:`brake_tail` as raw rows, without building its Plan.
+
+        ``window_fresh=True`` is the caller's promise that :meth:`states` just ran on this
+        ``data``, ``ctrl`` and ``nstep`` (the gate's order): the key check is skipped.
+
+        The substeps run in MuJoCo's C rollout (``mujoco.rollout``, no Python per substep)
+        where that is provably the same computation as the ``mj_step`` loop
+        (:meth:`_tail_by_rollout`), else in the loop (:meth:`_tail_by_loop`). Same rows,
+        same stop index, bit for bit (tested against an independent hand-stepped oracle).
 
         Returns:
             rows (K, 1 + nq + nv): time, qpos, qvel at the tail's waypoints (the first is the
             window's end), and the brake control (nu,).
         """
         m = self.model
-        if not self.window_matches(data, ctrl, nstep):
+        if not (window_fresh and self._key_nstep == nstep) and not self.window_matches(data, ctrl, nstep):
             self.states(data, ctrl, nstep)
         s = self._tail_data
         if s is None:
@@ -250,6 +280,22 @@ class Rollout:
         brake = np.asarray(brake_fn(s), dtype=np.float64)
         s.ctrl[:] = brake
         n = max(int(max_steps), 1)
+        if self.c_tail and _rollout_is_exact(m):
+            rows = self._tail_by_rollout(n, vel_tol)
+            if rows is not None:
+                return rows, brake
+            # a MuJoCo warning in the tail: redo it in the loop (the rollout stops stepping there)
+            mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
+            s.ctrl[:] = brake
+        return self._tail_by_loop(n, vel_tol), brake
+
+    def _tail_by_loop(self, n: int, vel_tol: float) -> np.ndarray:
+        """Up to ``n`` substeps of the tail scratch (state and brake control set), one ``mj_step`` each.
+
+        Returns:
+            rows (K, 1 + nq + nv): time, qpos, qvel; the first row is the scratch's state on entry.
+        """
+        m, s = self.model, self._tail_data
         nq = m.nq
         # One row (time, qpos, qvel) per substep, written by mj_getState. The stop test
         # (every |qvel| <= vel_tol) runs vectorised once per chunk of substeps (chunks of
@@ -276,13 +322,127 @@ class Rollout:
                 end = k + 1 + int(stop.argmax())  # the first substep that passes
                 break
             k = hi
-        return rows[:end + 1], brake
+        return rows[:end + 1]
+
+    def _tail_by_rollout(self, n: int, vel_tol: float) -> np.ndarray | None:
+        """The tail of :meth:`_tail_by_loop` by ``mujoco.rollout`` (C, no Python per substep).
+
+        Why it is the same computation: ``rollout`` sets the scratch's full physics state
+        (``mjSTATE_FULLPHYSICS``: time, qpos, qvel, act, history, plugin, plastic), its
+        ``qacc_warmstart`` and, before every substep, the user inputs (``mjSTATE_USER``:
+        ctrl, applied forces, mocap, eq_active, userdata) -- all taken from the scratch
+        itself, so together exactly its integration state -- then calls ``mj_step`` and
+        reads the full physics state, whose first ``1 + nq + nv`` entries are the loop's
+        row (time, qpos, qvel). Re-setting the user inputs each substep writes the values
+        they already have, because ``mj_step`` never writes them when no callback or plugin
+        is installed (:func:`_rollout_is_exact`). Consecutive chunks continue from the
+        last state and warm start exactly. ``rollout`` stops stepping at a MuJoCo warning
+        (and fills the rest with the last state) where the loop goes on: any warning
+        returns None and the caller runs the loop.
+
+        The first substep is one ``mj_step`` as in the loop (a tail at rest stops there);
+        all the others run in one ``rollout`` call (a call costs ~10-15 µs of fixed
+        overhead here, more than a substep; a tail that stops midway simulates substeps
+        past its end, which only touch the private scratch).
+
+        Returns:
+            rows (K, 1 + nq + nv) as :meth:`_tail_by_loop`, or None after a warning.
+        """
+        m, s = self.model, self._tail_data
+        if self._roll is None:
+            from mujoco import _rollout
+
+            self._roll = _rollout.Rollout(nthread=0)  # runs on the calling thread
+            self._n_full = mujoco.mj_stateSize(m, _FULL)
+            self._n_user = mujoco.mj_stateSize(m, _USER)
+        nq, nv = m.nq, m.nv
+        ncol = 1 + nq + nv
+        rows = np.empty((n + 1, self._n_full))  # full physics state per waypoint
+        mujoco.mj_getState(m, s, rows[0], _FULL)
+        # Substep 1 exactly as the loop runs it (a tail at rest stops here).
+        mujoco.mj_step(m, s)
+        mujoco.mj_getState(m, s, rows[1], _FULL)
+        if n == 1 or np.abs(rows[1, 1 + nq:ncol]).max() <= vel_tol:
+            return rows[:2, :ncol]
+        # Substeps 2..n in one rollout call from the scratch's state after substep 1.
+        bufs = self._tail_bufs
+        if bufs is None or bufs[0].shape[1] != n - 1:
+            # (user inputs held over the tail, warm start, warning counters: views of the scratch)
+            bufs = self._tail_bufs = (np.empty((1, n - 1, self._n_user)), np.empty((1, nv)), s.warning.number,
+                                      s.qacc_warmstart)
+        user, warm, counters, s_warm = bufs
+        mujoco.mj_getState(m, s, user[0, 0], _USER)
+        user[0, 1:] = user[0, 0]
+        warm[0] = s_warm
+        counters[:] = 0
+        self._roll.rollout([m], [s], n - 1, _USER, rows[1:2], warm, user, rows[None, 2:], None, None)
+        if counters.any():
+            return None
+        stop = np.abs(rows[2:, 1 + nq:ncol]).max(axis=1) <= vel_tol
+        end = 2 + int(stop.argmax()) if stop.any() else n  # the first substep that passes
+        return rows[:end + 1, :ncol]
+
+
+_FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS
+_USER = mujoco.mjtState.mjSTATE_USER
+_CALLBACK_GETTERS = tuple(getattr(mujoco, f"get_mjcb_{name}") for name in (
+    "control", "passive", "act_dyn", "act_gain", "act_bias", "sensor", "contactfilter", "time"))
+
+
+def _rollout_is_exact(model: mujoco.MjModel) -> bool:
+    """Whether ``mujoco.rollout`` of a held control is exactly the ``mj_step`` loop.
+
+    See :meth:`Rollout._tail_by_rollout`: degrees of freedom to test for the stop rule, no
+    plugin and no global callback (either could write the user inputs inside ``mj_step``,
+    which the rollout re-sets every substep).
+    """
+    return (model.nv > 0 and model.nplugin == 0
+            and all(get() is None for get in _CALLBACK_GETTERS))
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
 _FIXED = int(mujoco.mjtGain.mjGAIN_FIXED)
 _TRN_JOINT = int(mujoco.mjtTrn.mjTRN_JOINT)
 _HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+
+
+_HOLD_STRUCT = ("actuator_trntype", "actuator_biastype", "actuator_gaintype", "actuator_trnid", "jnt_type",
+                "jnt_qposadr", "actuator_ctrllimited")
+_HOLD_VALUES = ("actuator_gainprm", "actuator_biasprm", "actuator_gear", "actuator_ctrlrange")
+_HOLD_CACHE: dict[int, list[Any]] = {}
+_HOLD_CACHE_MAX = 16
+
+
+def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """Which actuators :func:`hold_ctrl` computes, from the model's CURRENT structure arrays.
+
+    Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
+    by structure alone (joint transmission, affine bias, fixed gain; the value conditions
+    ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
+    joint, the ctrl-limited actuators, and views of the value arrays (gainprm, biasprm,
+    gear, ctrlrange: the model's own buffers, so in-place edits are seen). Cached per model
+    object and keyed on the bytes of every structure array read (an in-place edit of one of
+    them recomputes it); MjModel array views never move, so the cached views stay valid.
+    """
+    hit = _HOLD_CACHE.get(id(model))
+    if hit is None or hit[0] is not model:
+        if len(_HOLD_CACHE) >= _HOLD_CACHE_MAX:
+            _HOLD_CACHE.pop(next(iter(_HOLD_CACHE)))
+        hit = [model, [getattr(model, f) for f in _HOLD_STRUCT],
+               tuple(getattr(model, f) for f in _HOLD_VALUES), None, None]
+        _HOLD_CACHE[id(model)] = hit  # the model reference keeps id(model) unique
+    struct = hit[1]
+    key = b"|".join([v.tobytes() for v in struct])
+    if hit[3] != key:
+        trntype, biastype, gaintype, trnid, jnt_type, jnt_qposadr, ctrllimited = struct
+        j = trnid[:, 0]
+        a = np.flatnonzero((trntype == _TRN_JOINT) & (biastype == _AFFINE) & (gaintype == _FIXED))
+        jt = jnt_type[j[a]]
+        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+        hit[4] = (a, jnt_qposadr[j[a]].copy(), np.flatnonzero(ctrllimited.astype(bool)))
+        hit[3] = key
+    a, adr, limited = hit[4]
+    return a, adr, limited, hit[2]
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -296,8 +456,9 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     where the control is limited.
 
     Vectorised over the actuators and read from the live model on every call (a model
-    edited in place, e.g. a randomised gain, is used as it is now); the same
-    operations per actuator as the scalar formula, so the same floats.
+    edited in place, e.g. a randomised gain, is used as it is now: the structure arrays
+    are compared byte for byte with the cached selection, the values are read live); the
+    same operations per actuator as the scalar formula, so the same floats.
 
     Returns:
         (nu,) float64 control.
@@ -306,22 +467,18 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     ctrl = np.zeros(nu)
     if nu == 0:
         return ctrl
-    gain = model.actuator_gainprm[:, 0]
-    b0, b1 = model.actuator_biasprm[:, 0], model.actuator_biasprm[:, 1]
-    j = model.actuator_trnid[:, 0]
-    ok = ((model.actuator_trntype == _TRN_JOINT) & (model.actuator_biastype == _AFFINE)
-          & (model.actuator_gaintype == _FIXED) & (gain != 0.0) & (b1 != 0.0))
-    if ok.any():
-        a = np.flatnonzero(ok)
-        ja = j[a]
-        jt = model.jnt_type[ja]
-        a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
+    a, adr, limited, (gainprm, biasprm, gear, ctrlrange) = _hold_plan(model)
+    if a.size:
+        gain = gainprm[a, 0]
+        b1 = biasprm[a, 1]
+        ok = (gain != 0.0) & (b1 != 0.0)
+        if not ok.all():
+            a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
         if a.size:
-            length = model.actuator_gear[a, 0] * data.qpos[model.jnt_qposadr[j[a]]]
-            ctrl[a] = -(b0[a] + b1[a] * length) / gain[a]
-    limited = model.actuator_ctrllimited.astype(bool)
-    lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
-    ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
+            length = gear[a, 0] * data.qpos[adr]
+            ctrl[a] = -(biasprm[a, 0] + b1 * length) / gain
+    if limited.size:
+        ctrl[limited] = np.clip(ctrl[limited], ctrlrange[limited, 0], ctrlrange[limited, 1])
     return ctrl
 
 
@@ -466,6 +623,34 @@ class StepReport:
                               certify_us=self.certify_us if timing else None), **safety_keys(self)}
 
 
+def _all_culled(cert: Certificate) -> int | None:
+    """The number of pairs if every one of them was decided by the broad phase, else None.
+
+    From the certificate's documented stats (``pairs``: the pair count; ``checker_mix``:
+    ``{method: count}``), without building its :class:`PairResult` tuple (the engine builds
+    it lazily, ~50-100 µs per gated Pusher step): ``checker_mix == {"culled": pairs}`` means
+    each pair's ``method`` is ``"culled"``. ``tests/test_gate_reports.py`` checks it against
+    the built pairs.
+    """
+    stats = cert.stats
+    n = stats.get("pairs")
+    mix = stats.get("checker_mix")
+    if type(n) is int and n > 0 and type(mix) is dict and len(mix) == 1 and mix.get("culled") == n:
+        return n
+    return None
+
+
+def _npairs(cert: Certificate) -> int:
+    """``len(cert.pairs)`` without building the pairs: the documented ``stats["pairs"]``.
+
+    Every certificate ``certify`` and the gate make has ``stats["pairs"] == len(pairs)``
+    (checked against the built pairs on seeded tunnel / Pusher / Arm episodes in
+    ``tests/test_gate_reports.py``); a certificate without it is counted by its pairs.
+    """
+    n = cert.stats.get("pairs")
+    return n if type(n) is int else len(cert.pairs)
+
+
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
                 fallback_certified: bool, terminated: bool, time: float, brake_verdict: str = "",
                 certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
@@ -478,11 +663,16 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         checker = np.full(int(npairs or 0), "", dtype=object)
         mix, wit, earliest, clearance = "", None, inf, inf
     else:
-        names = [str(p.method) for p in cert.pairs]
-        checker = np.empty(len(names), dtype=object)
-        checker[:] = names
-        counts = Counter(names)
-        mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
+        n = _all_culled(cert)
+        if n is not None:  # every pair culled (the common gated step): no PairResult is built
+            checker = np.full(n, "culled", dtype=object)
+            mix = f"culled:{n}" if n else ""
+        else:
+            names = [str(p.method) for p in cert.pairs]
+            checker = np.empty(len(names), dtype=object)
+            checker[:] = names
+            counts = Counter(names)
+            mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
         clearance = float(cert.clearance)
@@ -545,9 +735,11 @@ def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> 
     A shallow copy (the pair results, possibly not built yet, are shared); ``window`` and
     ``stats`` are its own.
     """
-    out = copy.copy(cert)
-    object.__setattr__(out, "window", window)
-    object.__setattr__(out, "stats", {**cert.stats, "joint_window": span})
+    out = object.__new__(type(cert))  # = copy.copy(cert) (a dataclass: its __dict__ is its state)
+    state = out.__dict__
+    state.update(cert.__dict__)
+    state["window"] = window
+    state["stats"] = {**cert.stats, "joint_window": span}
     return out
 
 
@@ -887,7 +1079,7 @@ class Gate:
             self._remember(cert, keys)
         us = (time.perf_counter() - t_start) * 1e6
         self.stats["reused_pairs"] += len(reused)
-        self.stats["pairs"] += len(cert.pairs)
+        self.stats["pairs"] += _npairs(cert)
         return cert, us
 
     def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,
@@ -1143,7 +1335,8 @@ class Gate:
                 and self.scene.candidate_pairs):
             # Common path: window + braking tail certified by ONE call (see _certify_joint).
             rows, brake_next = self._rollout.brake_rows(
-                data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol)
+                data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol,
+                window_fresh=True)  # states() ran just above on this data, ctrl and n
             tail = _Tail(rows, self.model, data)
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,

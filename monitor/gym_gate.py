@@ -312,9 +312,10 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                     w.action = old
 
     def _predict_fn(self) -> Callable[[Any], Any] | None:
-        u, mode = self.env.unwrapped, self.predictor_mode
+        mode = self.predictor_mode
         if mode == "rollout":
             return None  # the gate's own rollout with ctrl = the env's action
+        u = self.env.unwrapped
         if mode == "plan":
             return u.planned_trajectory
         return lambda a: mode(self.env, self._obs, a)

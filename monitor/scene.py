@@ -117,6 +117,37 @@ SYNC_FIELDS: tuple[str, ...] = (
     "body_jntadr", "body_jntnum", "body_ipos", "geom_rbound",
 )
 """``MjModel`` arrays that :meth:`Scene.sync` watches for in-place edits."""
+_RUN_GAP = 1024
+"""Bytes: watched arrays closer than this share one comparison run (:meth:`_Snapshot.unchanged`)."""
+
+
+def _run_views(views: list[np.ndarray]) -> list[np.ndarray]:
+    """Read-only uint8 views, each spanning a run of ``views`` (C-contiguous, non-empty) and their gaps.
+
+    Runs are formed in address order; an array starts a new run when it begins more than
+    :data:`_RUN_GAP` bytes after the current run's end (or is not C-contiguous). Each run
+    view is strided over its first array's buffer (which keeps the model alive).
+    """
+    spans = sorted((v.__array_interface__["data"][0], v.nbytes, i) for i, v in enumerate(views))
+    runs: list[list[int]] = []
+    for a, n, i in spans:
+        v = views[i]
+        if runs and v.flags.c_contiguous and views[runs[-1][2]].flags.c_contiguous \
+                and 0 <= a - runs[-1][1] <= _RUN_GAP:
+            runs[-1][1] = max(runs[-1][1], a + n)
+        else:
+            runs.append([a, a + n, i])
+    out = []
+    for a, e, i in runs:
+        v = views[i]
+        if not v.flags.c_contiguous:   # compared on its own, as in changed()
+            out.append(v)
+            continue
+        base = v.reshape(-1).view(np.uint8)
+        out.append(np.lib.stride_tricks.as_strided(base, shape=(e - a,), strides=(1,), writeable=False))
+    return out
+
+
 class _Snapshot:
     """Raw bytes of the watched model arrays, read through views kept from construction.
 
@@ -135,6 +166,44 @@ class _Snapshot:
         self.model = model
         self.views = [(f, getattr(model, f)) for f in SYNC_FIELDS]
         self.opt = model.opt  # a live view of mjOption
+        self._live: list[tuple[Any, bytes]] | None = None  # (view, saved bytes) of non-empty fields
+        self._runs: list[tuple[Any, bytes]] | None = None  # (run view, reference bytes), see unchanged()
+
+    def unchanged(self) -> bool:
+        """True if no watched field differs from the snapshot (the per-call test of :meth:`Scene.sync`).
+
+        Same answer as ``not changed()``: every byte of every watched field and
+        ``opt.disableflags`` are compared, stopping at the first difference.
+
+        Fast path: the watched arrays lie in few memory *runs* (MuJoCo allocates the model's
+        arrays in one buffer, in a fixed order; fields closer than :data:`_RUN_GAP` bytes
+        share a run, gap included), compared with one ``tobytes`` each. A run's reference
+        bytes are taken only right after the field-by-field comparison against the
+        snapshot found every watched byte equal, so equal runs imply equal watched fields.
+        When a run differs (a watched field, or an unwatched array inside a gap, was
+        edited) the field-by-field comparison decides, and the references are retaken if it
+        finds nothing watched changed. Reading a gap is memory-safe: it is shorter than a
+        page and lies between two live arrays, so every page it touches is mapped.
+        Empty arrays (e.g. ``mesh_vert`` without meshes) have nothing to compare.
+        """
+        if int(self.opt.disableflags) != self.disableflags:
+            return False
+        runs = self._runs
+        if runs is not None:
+            for v, b in runs:
+                if v.tobytes() != b:
+                    break
+            else:
+                return True
+        live = self._live
+        if live is None:
+            live = self._live = [(v, b) for (_f, v), b in zip(self.views, self.saved) if v.size]
+        for v, b in live:
+            if v.tobytes() != b:
+                return False
+        views = _run_views([v for v, _b in live])
+        self._runs = [(v, v.tobytes()) for v in views]
+        return True
 
     def __getstate__(self) -> dict[str, Any]:  # views are not picklable; rebound on load
         return {"model": self.model, "saved": self.saved, "disableflags": self.disableflags}
@@ -343,6 +412,16 @@ class Scene:
         self._acm_spec: dict[str, Any] = {}  # set by from_model: allowed/hazards/allow/reference
         # a scene built by hand without an MjModel (tests, pure-geometry use) has nothing to watch
         self._snapshot = _Snapshot(model) if model is not None else None
+        self._hot: dict[str, Any] = {}
+        """Per-scene values the engine derives from the scene (``monitor.certify.engine``:
+        selections, packed flags, model checks already made); emptied by :meth:`sync` and
+        not pickled. Entries also hold the objects they were derived from (``pair_ids``,
+        the snapshot) and are used only while those are still the scene's."""
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_hot"] = {}
+        return state
 
     # ------------------------------------------------------------------ model edits
 
@@ -366,8 +445,10 @@ class Scene:
         """
         if self._snapshot is None:
             return False
+        if self._snapshot.unchanged():
+            return False
         changed = self._snapshot.changed()
-        if not changed:
+        if not changed:  # cannot differ from unchanged() (same bytes); kept as a guard
             return False
         what = ", ".join(changed)
         try:
@@ -386,6 +467,7 @@ class Scene:
         self._snapshot = fresh._snapshot
         for cached in ("candidate_pairs", "model_hash"):
             self.__dict__.pop(cached, None)
+        self._hot = {}
         self.version += 1
         return True
 

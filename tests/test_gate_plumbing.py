@@ -116,6 +116,44 @@ def test_hold_ctrl_reads_an_edited_model():
     assert np.array_equal(after, _hold_scalar(m, d))
 
 
+def test_hold_ctrl_sees_in_place_edits_of_the_structure_it_caches():
+    """hold_ctrl caches which actuators it computes per model; every structure or value array
+    it reads, edited in place after a first call, must still be read as it is now."""
+    m = mujoco.MjModel.from_xml_string(_MIXED)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(3)
+    d.qpos[:] = rng.normal(0.0, 0.7, m.nq)
+    pos = 1  # the unlimited <position> actuator on j1 (gear 2)
+    jnt = int(m.actuator_trnid[pos, 0])
+    assert m.actuator_biastype[pos] == mujoco.mjtBias.mjBIAS_AFFINE and not m.actuator_ctrllimited[pos]
+
+    def limit(lo, hi):
+        m.actuator_ctrllimited[pos] = 1
+        m.actuator_ctrlrange[pos] = (lo, hi)
+    edits = [
+        ("actuator_biastype", lambda: m.actuator_biastype.__setitem__(pos, mujoco.mjtBias.mjBIAS_NONE)),
+        ("actuator_gaintype", lambda: m.actuator_gaintype.__setitem__(pos, mujoco.mjtGain.mjGAIN_USER)),
+        ("actuator_trntype", lambda: m.actuator_trntype.__setitem__(pos, mujoco.mjtTrn.mjTRN_SITE)),
+        ("actuator_ctrllimited", lambda: m.actuator_ctrllimited.__setitem__(pos, 1)),  # range (0, 0)
+        ("actuator_ctrlrange", lambda: limit(-1e-3, 1e-3)),
+        ("actuator_gainprm", lambda: m.actuator_gainprm.__setitem__((pos, 0), 0.0)),
+        ("actuator_biasprm", lambda: m.actuator_biasprm.__setitem__((pos, 1), 0.0)),
+        ("jnt_type", lambda: m.jnt_type.__setitem__(jnt, mujoco.mjtJoint.mjJNT_FREE)),
+    ]
+    for name, edit in edits:
+        saved = {f: np.array(getattr(m, f)) for f in (
+            "actuator_biastype", "actuator_gaintype", "actuator_trntype", "actuator_ctrllimited",
+            "actuator_ctrlrange", "actuator_gainprm", "actuator_biasprm", "jnt_type")}
+        before = hold_ctrl(m, d)  # fills the cache
+        assert before[pos] != 0.0 and np.array_equal(before, _hold_scalar(m, d))
+        edit()
+        after = hold_ctrl(m, d)
+        assert np.array_equal(after, _hold_scalar(m, d)), name
+        assert after[pos] != before[pos], name
+        for f, v in saved.items():
+            getattr(m, f)[...] = v
+
+
 def _moving_scalar(model, changes):
     """(moving, rotating) body masks walked body by body from the changed qpos columns."""
     width = {_FREE: 7, _BALL: 4, _SLIDE: 1, _HINGE: 1}

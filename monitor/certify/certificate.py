@@ -193,6 +193,23 @@ class Certificate:
     stats: dict[str, Any] = field(default_factory=dict)
     allowed: tuple[tuple[str, str, str], ...] = ()
 
+    @classmethod
+    def _trusted(cls, verdict: Verdict, window: tuple[float, float], margin: float, epsilon: float,
+                 method: Method, witness: Witness | None, earliest_time: float | None, clearance: float,
+                 pairs: Any, stats: dict[str, Any], allowed: tuple) -> Certificate:
+        """The same Certificate as the constructor makes, for the engine's validated values.
+
+        ``verdict`` must already be a :class:`Verdict` and ``method`` a :class:`Method` (what
+        ``__post_init__`` would make of them); ``pairs`` a tuple or a lazy object with
+        ``build_pairs`` (what :class:`_PairsField` stores). Skips the frozen dataclass's
+        per-field ``object.__setattr__`` and the conversions.
+        """
+        c = object.__new__(cls)
+        c.__dict__.update(verdict=verdict, window=window, margin=margin, epsilon=epsilon, method=method,
+                          witness=witness, earliest_time=earliest_time, clearance=clearance,
+                          _pairs_store=pairs, stats=stats, allowed=allowed)
+        return c
+
     @property
     def ongoing(self) -> tuple[tuple[str, str], ...]:
         """Pairs judged by the ongoing-contact rule (in contact at the window start)."""

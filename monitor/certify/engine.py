@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import gc
 import math
+import sys
 import time
 from typing import Any
 
@@ -104,6 +105,13 @@ def _check_model(scene: Any, plan: Any) -> Any:
     sync = getattr(scene, "sync", None)
     if sync is not None:
         sync()
+    hot = _hot(scene)
+    if hot is not None and type(plan) is _plan_class():
+        memo = hot.get("plan_current")
+        st = getattr(plan, "_st", None)
+        if (memo is not None and memo[0] is getattr(scene, "_snapshot", None) and st is not None
+                and plan.model is scene.model and memo[1].get(id(st)) is st):
+            return plan        # see _remember_current: the same checks, already passed
     pm = getattr(plan, "model", None)
     if pm is not None and pm is not scene.model:
         try:
@@ -117,15 +125,76 @@ def _check_model(scene: Any, plan: Any) -> Any:
     if int(plan.nbody) != len(scene.body_names):
         raise ModelMismatchError(f"plan has {plan.nbody} bodies, scene has {len(scene.body_names)}")
     current = getattr(plan, "is_current", None)
-    if current is not None and not current():
-        plan = plan.refreshed()
+    if current is not None:
+        if not current():
+            plan = plan.refreshed()
+        elif hot is not None and pm is scene.model and type(plan) is _plan_class():
+            _remember_current(scene, hot, plan)
     return plan
+
+
+def _plan_class() -> type | None:
+    """:class:`monitor.motion.plan.Plan` if that module is loaded, else None.
+
+    Never imports it (it imports mujoco; ``monitor.certify`` must not): a plan that is a
+    ``Plan`` means the module is loaded already.
+    """
+    mod = sys.modules.get("monitor.motion.plan")
+    return None if mod is None else getattr(mod, "Plan", None)
+
+
+def _hot(scene: Any) -> dict | None:
+    """The scene's engine cache (``Scene._hot``, emptied by ``Scene.sync``), or None (duck-typed scenes)."""
+    hot = getattr(scene, "_hot", None)
+    if hot is None and getattr(scene, "_snapshot", None) is not None:
+        try:   # a Scene unpickled from an older version
+            hot = scene._hot = {}
+        except AttributeError:
+            return None
+    return hot
+
+
+def _remember_current(scene: Any, hot: dict, plan: Any) -> None:
+    """Record that ``plan`` passed ``is_current`` against the model as the scene's snapshot holds it.
+
+    ``Plan.is_current()`` is ``_structure_key(plan.model) == plan._st.key``: it depends only on
+    the plan's (cached, shared) structure object ``_st`` and the model's bytes of
+    ``plan._STRUCT_FIELDS`` plus array sizes. Every one of those fields is watched by the
+    scene's snapshot (``monitor.scene.SYNC_FIELDS``; asserted by
+    ``tests/test_engine_entry.py``) and sizes cannot change in place. So while ``scene.sync()``
+    finds the model equal to the same snapshot object (every watched byte unchanged), any
+    plan with the same ``_st`` object on the same model object is still current: the next
+    call skips the ``is_current`` bytes join. ``Scene.sync`` empties ``_hot`` when it
+    rebuilds, and the memo also holds the snapshot it was made under. Only exact
+    :class:`~monitor.motion.plan.Plan` objects (no subclass overriding ``is_current``).
+    The memo holds the ``_st`` objects themselves, so their ``id`` is not reused.
+    """
+    snap = getattr(scene, "_snapshot", None)
+    st = getattr(plan, "_st", None)
+    if snap is None or st is None or not snap.unchanged():
+        return
+    memo = hot.get("plan_current")
+    if memo is None or memo[0] is not snap:
+        memo = hot["plan_current"] = (snap, {})
+    if len(memo[1]) >= 16:
+        memo[1].clear()
+    memo[1][id(st)] = st
 
 
 def _select(scene: Any, pairs: Any) -> np.ndarray:
     """Sorted (S,) int64 indices of the selected candidate pairs (all of them when ``pairs`` is None)."""
     if pairs is None:
-        return np.arange(len(scene.pair_ids), dtype=np.int64)
+        pid = scene.pair_ids
+        hot = _hot(scene)
+        if hot is not None:
+            hit = hot.get("sel_all")
+            if hit is not None and hit[0] is pid:
+                return hit[1]
+        sel = np.arange(len(pid), dtype=np.int64)
+        if hot is not None:
+            sel.setflags(write=False)
+            hot["sel_all"] = (pid, sel)
+        return sel
     index = {}
     for i, (a, b) in enumerate(scene.candidate_pairs):
         index[(a, b)] = i
@@ -169,7 +238,7 @@ def _make_budget(budget: Any) -> Budget:
     the kernels it uses (``python -m monitor warmup`` compiles every path ahead of time).
     """
     if budget is None:
-        return Budget(seconds=DEFAULT_BUDGET_SECONDS)
+        return Budget.default(DEFAULT_BUDGET_SECONDS)
     if isinstance(budget, Budget):
         return budget
     if isinstance(budget, dict):
@@ -247,7 +316,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
     bud = _make_budget(budget)
     pen_tol = check_rule(ongoing, penetration_tol)
-    allowed = tuple(getattr(scene, "allowed_pairs", ()))
+    allowed = getattr(scene, "allowed_pairs", ())
+    if type(allowed) is not tuple:
+        allowed = tuple(allowed)
     sel = _select(scene, pairs)
     if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
         return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
@@ -263,7 +334,9 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
                                  allowed, fast)
         else:
             cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
-    if ongoing == "deepen":  # issue 13: contacts present at t0 (monitor/certify/ongoing.py)
+    # issue 13: contacts present at t0 (monitor/certify/ongoing.py); deepen returns a
+    # "certified" certificate unchanged (no pair can be an ongoing contact), so it is not called
+    if ongoing == "deepen" and cert.verdict != "certified":
         cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
                       budget=bud, tolerances=tol, penetration_tol=pen_tol)
     return cert
@@ -365,15 +438,25 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     mp = KS.trajectory_pack(plan)
     if mp is None:
         return None
-    try:
-        sp = KS.scene_pack(scene)
-    except (MonitorError, TypeError, AttributeError, ValueError):
-        return None
-    if sp.geoms.body.shape[0] != len(scene.geoms) or int(plan.nbody) != mp.nbody:
+    hot = _hot(scene)
+    hit = None if hot is None else hot.get("scene_pack")
+    if hit is not None and hit[0] is scene.geoms and hit[1] is scene.pair_ids and hit[2] is KS.scene_pack:
+        sp = hit[3]         # what KS.scene_pack returned for these geoms / pair_ids objects
+    else:
+        try:
+            sp = KS.scene_pack(scene)
+        except (MonitorError, TypeError, AttributeError, ValueError):
+            return None
+        if sp.geoms.body.shape[0] != len(scene.geoms):
+            return None
+        if hot is not None:
+            hot["scene_pack"] = (scene.geoms, scene.pair_ids, KS.scene_pack, sp)
+    if int(plan.nbody) != mp.nbody:
         return None
     return sp, mp
 
 
+_new = object.__new__
 _NAMES: dict[int, tuple] = {}
 _NAMES_MAX = 16
 
@@ -424,10 +507,14 @@ class _WindowPairs:
         """The Witness of pair k, a violation decided by the kernel (survivor slot s)."""
         KS = _kernels()
         self._names()
-        a, b = int(self.pid[k, 0]), int(self.pid[k, 1])
+        a, b = self.pid[k].tolist()
         row = self.res[s]
-        return Witness(float(row[KS.R_WTIME]), (self.names[a], self.names[b]),
-                       row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), float(row[KS.R_WUPPER]))
+        # = Witness(time, geoms, point, distance): a frozen dataclass without __post_init__,
+        # built field for field without its per-field object.__setattr__
+        w = _new(Witness)
+        w.__dict__.update(time=row.item(KS.R_WTIME), geoms=(self.names[a], self.names[b]),
+                          point=row[KS.R_WPOINT:KS.R_WPOINT + 3].copy(), distance=row.item(KS.R_WUPPER))
+        return w
 
     def kernel_result(self, k: int, s: int) -> PairResult:
         """PairResult of pair k decided by the kernel (survivor slot s)."""
@@ -501,11 +588,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
 
     sp, mp = fast
     moving = np.asarray(plan.moving_bodies(), bool)
-    static = np.asarray(scene.body_static, bool)
     P = len(sel)
     pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
-    fixed = (static & ~moving).astype(np.int64)
-    mov = moving.astype(np.int64)
+    fixed, mov = _body_flags(scene, moving)
     # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
     # every surviving pair takes the Python route, which calls the replacement
     narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
@@ -520,14 +605,15 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     sc = np.empty((_NSUB, G, 3))
     sr = np.empty((_NSUB, G))
     info = np.zeros(KS.WI_SIZE)
-    none = np.zeros(0, np.int64)
+    none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
     S = int(KS.window_kernel(sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                              sc, sr, info))
     done_to = min(first, S)
     charged = info[KS.WI_TESTS]
-    bud.charge(int(charged))
+    if charged:
+        bud.charge(int(charged))
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -567,9 +653,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         done_to = S
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
-    if narrow and done_to and not stopped:
+    sv = surv[:done_to]
+    svl = sv.tolist()
+    codes = code[sv].tolist() if done_to else []
+    if narrow and done_to and not stopped and KS.WK_UNRES in codes:
         full_tests = _full_search(KS, sp.geoms, mp, pid, surv, code, res, done_to, t0, t1, margin, epsilon,
                                   tol, bud)
+        codes = code[sv].tolist()           # convicted pairs are WK_VIOL now
+    rows = res[:done_to].tolist() if done_to else []   # the result rows as Python floats (read below)
     # -- the Python stages on what the kernel left open -------------------------------------
     # (plain Python over the S survivors: a handful of numpy calls cost more than the kernel)
     results: dict[int, PairResult] = {}
@@ -578,8 +669,6 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     geoms = scene.geoms
     if done_to < S:                       # budget: survivors the kernel never reached
         unfin[surv[done_to:S]] = True
-    svl = surv[:done_to].tolist()
-    codes = code[surv[:done_to]].tolist() if done_to else []
     todo = []
     start_known: dict[int, bool] = {}   # i -> start pose NOT proven clear (the kernel's exact test)
     vslots, cslots, wslots = [], [], []
@@ -589,7 +678,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             i, ga, gb = int(sel[k]), geoms[int(pid[k, 0])], geoms[int(pid[k, 1])]
             todo.append((i, ga, gb))
             if c != KS.WK_PYTHON:
-                lo = float(res[s, KS.R_START_LO])
+                lo = rows[s][KS.R_START_LO]
                 start_known[i] = not (lo > margin or lo + ga.shape.radius + gb.shape.radius > 0)
             continue
         if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
@@ -623,36 +712,37 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         mix["budget"] = n_unfin
     # -- 6. combine (arrays for the kernel's pairs, PairResults for the Python ones) ------------
     for s in wslots:
-        tests_total += int(res[s, KS.R_TESTS])
-        depth_max = max(depth_max, int(res[s, KS.R_DEPTH]))
+        tests_total += int(rows[s][KS.R_TESTS])
+        depth_max = max(depth_max, int(rows[s][KS.R_DEPTH]))
     checked_r = [results[i] for i in sorted(results)] if results else []
     has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
     has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
     verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to].copy(), res[:done_to].copy(), unfin, results,
-                        geoms, (t0, t1), sc, sr, float(info[KS.WI_PAD]))
+    # views, not copies: code / gap / surv / res are this call's own arrays, not written after here
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to], res[:done_to], unfin, results,
+                        geoms, (t0, t1), sc, sr, info.item(KS.WI_PAD))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
             if r.verdict == "violation" and r.witness is not None]
     for s in vslots:
         k = svl[s]
-        cand.append((float(res[s, KS.R_WTIME]), int(sel[k]), None, k, s))
+        cand.append((rows[s][KS.R_WTIME], int(sel[k]), None, k, s))
     witness = None
     if cand:
-        best = min(cand, key=lambda c: (c[0], c[1]))
+        best = cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1]))
         witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
     if verdict != "certified":
         starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
         starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
         for s in vslots:
-            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else float(res[s, KS.R_FIRST_UNRES]))
+            starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else rows[s][KS.R_FIRST_UNRES])
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
-    clears += [float(res[s, KS.R_CLEAR]) for s in cslots]
+    clears += [rows[s][KS.R_CLEAR] for s in cslots]
     if vslots or n_unfin:
         clears.append(float("-inf"))
-    best_cull = float(info[KS.WI_BEST])
+    best_cull = info.item(KS.WI_BEST)
     if best_cull < float("inf"):
         clears.append(best_cull)
     clearance = float(min(clears)) if clears else float("inf")
@@ -660,8 +750,41 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "tests": tests_total, "max_depth": depth_max,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
-    return Certificate(verdict, (t0, t1), margin, epsilon, method, witness, earliest, clearance,
-                       lazy, stats, allowed)
+    return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
+                                earliest, clearance, lazy, stats, allowed)
+
+
+_VERDICT_OF = {v.value: v for v in Verdict}
+_METHOD_OF = {m.value: m for m in Method}
+"""Verdict / Method member of a validated string (a member is its own key: StrEnum hashes as its value)."""
+_NONE = np.zeros(0, np.int64)
+"""The empty ``route`` of a window_kernel call (nothing is ever written to it)."""
+
+
+def _body_flags(scene: Any, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(fixed, mov): (nbody,) int64 ``body_static & ~moving`` and ``moving``, the window kernel's flags.
+
+    Cached per scene (``Scene._hot``) for each moving mask, keyed on the mask's bytes and held
+    with the ``body_static`` array they were made from (``Scene.sync`` replaces it); the kernel
+    only reads them. Duck-typed scenes without the cache compute them per call.
+    """
+    static = scene.body_static
+    hot = _hot(scene)
+    if hot is not None:
+        memo = hot.get("body_flags")
+        if memo is None or memo[0] is not static:
+            memo = hot["body_flags"] = (static, {})
+        key = moving.tobytes()
+        hit = memo[1].get(key)
+        if hit is not None:
+            return hit
+    fixed = (np.asarray(static, bool) & ~moving).astype(np.int64)
+    mov = moving.astype(np.int64)
+    if hot is not None:
+        if len(memo[1]) >= 64:
+            memo[1].clear()
+        memo[1][key] = (fixed, mov)
+    return fixed, mov
 
 
 def _translates(plan: Any, mp: Any, b: int) -> bool:

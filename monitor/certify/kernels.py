@@ -1282,9 +1282,12 @@ def _is_plain_body_motion(traj) -> bool:
 
     Not a subclass, which may override ``body_poses``.
     """
+    cls = type(traj)
+    if cls.__name__ != "BodyMotion":  # cheap pre-test; the identity test below decides
+        return False
     from monitor.motion.bodymotion import BodyMotion
 
-    return type(traj) is BodyMotion and traj.interpolation == "lerp_slerp"
+    return cls is BodyMotion and traj.interpolation == "lerp_slerp"
 
 
 def _probe_body_motions() -> list:

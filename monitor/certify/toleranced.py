@@ -115,6 +115,12 @@ from monitor.tolerances import DEFAULT, Tolerances
 
 _U = 2.0**-53
 _ETA = 1e-9
+USE_COMPILED = True
+SHORT_CIRCUIT = True
+"""Compiled levels: a unit stops evaluating rows at its first firing row (same unit answers and
+intervals; ``row_tests`` then counts the rows evaluated, fewer than the oracle's)."""
+"""Default of :func:`subdivide`'s ``compiled``: the numba level kernel (``fat_kernels``), or the
+numpy kernels of this module (False; the oracle the tests compare against)."""
 """Relative widening of parameter ranges [0, 1] and tau-intervals (conservative)."""
 
 
@@ -811,13 +817,15 @@ def _sqrt_jinv(m: Metric) -> float:
 
 
 def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
-                   tolerances: Tolerances = DEFAULT) -> np.ndarray:
+                   tolerances: Tolerances = DEFAULT, *, compiled: bool = False) -> np.ndarray:
     """One ball test of one pair: which units' fat A-feature meets B (for tests and tools).
 
     Args:
         pd: pair data from :func:`prepare_pair` (or built from feature sets).
         L: (3, 3) linear part of the centre g (A body frame -> B frame); p: (3,).
         R: ball radius (metric of ``pd.A.metric``), used as given (no padding).
+        compiled: evaluate with :func:`monitor.certify.fat_kernels.fat_level` (pre-filter
+            off) instead of the numpy oracle kernels.
 
     Returns:
         (n_units,) bool, in the order of ``pd.A.units x pd.B.units`` (or A vertices for a half-space).
@@ -826,6 +834,8 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
     T = _build_tables([pd], C)
     tol = tolerances
     L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    if compiled:
+        return _one_ball_compiled(pd, C, T, L1, p1, R1, tol, prefilter=False)[1]
     eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
                      np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
     ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
@@ -835,14 +845,35 @@ def fat_units_fire(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
 
 
 def prefilter_separated(pd: _PairData, L: np.ndarray, p: np.ndarray, R: float,
-                        tolerances: Tolerances = DEFAULT) -> bool:
-    """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests."""
+                        tolerances: Tolerances = DEFAULT, *, compiled: bool = False) -> bool:
+    """The pre-filter's answer for one ball (True = whole orbit provably misses B); for tests.
+
+    ``compiled``: the answer of :func:`monitor.certify.fat_kernels.fat_level` instead of
+    the numpy oracle.
+    """
     tol = tolerances
     L1, p1, R1 = np.asarray(L, float)[None], np.asarray(p, float)[None], np.array([float(R)])
+    if compiled:
+        C = _Concat([pd])
+        return bool(_one_ball_compiled(pd, C, _build_tables([pd], C), L1, p1, R1, tol, prefilter=True)[0][0])
     eps = _eps_items(np.array([pd.A.extent]), np.array([pd.B.extent]), np.array([pd.A.flat_err]),
                      np.array([pd.B.flat_err]), np.array([_sqrt_jinv(pd.A.metric)]), L1, p1, R1, tol)
     ball = _Ball(L1, p1, R1, np.array([pd.A.rho_max]), np.array([pd.r]), eps, tol)
     return bool(_Prefilter([pd]).separated(np.zeros(1, np.int64), ball, tol)[0])
+
+
+def _one_ball_compiled(pd: _PairData, C: _Concat, T: _Tables, L1: np.ndarray, p1: np.ndarray,
+                       R1: np.ndarray, tol: Tolerances, prefilter: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(sep (1,), unit_fired (n_units,)) of one ball by the compiled level kernel."""
+    fast = _FastLevel(C, T, _Prefilter([pd]) if prefilter else None, np.array([pd.A.rho_max]),
+                      np.array([pd.r], float), np.array([pd.A.extent]), np.array([pd.B.extent]),
+                      np.array([pd.A.flat_err]), np.array([pd.B.flat_err]),
+                      np.array([_sqrt_jinv(pd.A.metric)]), tol, short_circuit=False)
+    uid = T.pair_units[0]
+    fr = _Frontier(np.zeros(1, np.int64), np.zeros(1), np.ones(1), np.zeros(1, np.int64),
+                   np.zeros(len(uid), np.int64), uid)
+    sep, fired, *_ = fast.level(fr, L1, p1, R1)
+    return sep, fired
 
 
 class _Prefilter:
@@ -900,6 +931,64 @@ class _Prefilter:
 
 
 # ============================================================================ driver
+
+
+def _c(x: np.ndarray, dtype: Any = np.float64) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=dtype)
+
+
+def _flat_rows(T: _Tables) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Global row table as three (n_rows,) int64 arrays: type code, A feature, B feature.
+
+    Type codes follow ``_TYPES`` (``fat_kernels.T_VF`` ...); for VH rows the B column is
+    the pair index (the half-space of that pair).
+    """
+    types, cols_a, cols_b = [], [], []
+    for k, t in enumerate(_TYPES):
+        rows = T.rows[t]
+        n = len(rows["pair"])
+        types.append(np.full(n, k, np.int64))
+        cols_a.append(rows["a"])
+        cols_b.append(rows["b"] if "b" in rows else rows["pair"])
+    return (_c(np.concatenate(types), np.int64), _c(np.concatenate(cols_a), np.int64),
+            _c(np.concatenate(cols_b), np.int64))
+
+
+class _FastLevel:
+    """Flat arrays of one :func:`subdivide` call for :func:`monitor.certify.fat_kernels.fat_level`."""
+
+    def __init__(self, C: _Concat, T: _Tables, pre: _Prefilter | None, rho_max: np.ndarray,
+                 r_pair: np.ndarray, a_ext: np.ndarray, b_ext: np.ndarray, flat_a: np.ndarray,
+                 flat_b: np.ndarray, sqj: np.ndarray, tol: Tolerances, short_circuit: bool = True):
+        from monitor.certify import fat_kernels
+        self.kernel = fat_kernels.fat_level
+        rt, ra, rb = _flat_rows(T)
+        if pre is not None:
+            pf = (_c(pre.V), _c(pre.qv), _c(pre.n), _c(pre.off), _c(pre.on, np.bool_),
+                  _c(pre.two, np.bool_), 1)
+        else:
+            P = len(rho_max)
+            pf = (np.zeros((P, 1, 3)), np.zeros((P, 1)), np.zeros((P, 1, 3)), np.zeros((P, 1)),
+                  np.zeros(P, np.bool_), np.zeros(P, np.bool_), 0)
+        self.per_pair = tuple(_c(x) for x in (rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj)) + pf
+        self.feats = tuple(_c(x) for x in (C.av, C.aqv, C.ae_v0, C.ae_d, C.ae_k, C.af_o, C.af_U, C.af_k0,
+                                            C.af_kg, C.af_K, C.af_hn, C.af_hc, C.be_w0, C.be_e, C.bf_o,
+                                            C.bf_n, C.bf_U, C.bf_hn, C.bf_hc, C.h_n, C.h_off))
+        self.rows = (rt, ra, rb, _c(T.unit_ptr, np.int64), _c(T.unit_rows, np.int64))
+        self.tol = (float(tol.rel_pad), float(tol.abs_pad), float(tol.scale_pad), int(bool(short_circuit)))
+
+    def level(self, fr: _Frontier, L: np.ndarray, p: np.ndarray, R: np.ndarray):
+        """(sep (N,), unit_fired (K,), rows per item (N,), units per item (N,), distinct rows)."""
+        N, K = len(fr.pair), len(fr.unit_item)
+        sep = np.empty(N, np.bool_)
+        fired = np.empty(K, np.bool_)
+        rows_i = np.empty(N, np.int64)
+        units_i = np.empty(N, np.int64)
+        nrow = self.kernel(_c(fr.pair, np.int64), _c(L), _c(p), _c(R), *self.per_pair, *self.feats,
+                           *self.rows, _c(fr.unit_item, np.int64), _c(fr.unit_id, np.int64), *self.tol,
+                           sep, fired, rows_i, units_i)
+        return sep, fired, rows_i, units_i, int(nrow)
+
 
 
 @dataclass
@@ -974,11 +1063,15 @@ def frontier_over_cap(pair: np.ndarray, t0: np.ndarray, go: np.ndarray, cap: int
 def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: float, epsilon: float,
               tolerances: Tolerances = DEFAULT, budget: Budget | None = None,
               active: np.ndarray | None = None, extra0: Any = None,
-              prefilter: bool = True) -> SubdivisionResult:
-    """Breadth-first subdivision over all pairs (Listings 1-2, Remark 2 pruning).
+              prefilter: bool = True, compiled: bool | None = None) -> SubdivisionResult:
+    """Breadth-first subdivision over all pairs (§6, Listings 1-2, Remark 2 pruning).
 
     ``prefilter`` runs :class:`_Prefilter` on every item first (items it excludes count no
     unit tests; their number is in ``SubdivisionResult.prefiltered``).
+    ``compiled`` evaluates each level's pre-filter and rows in one numba call
+    (:func:`monitor.certify.fat_kernels.fat_level`); False runs the numpy kernels of this
+    module, kept as the test oracle (same tests, same pads, same counts); None: the module
+    switch :data:`USE_COMPILED`.
     """
     tol = tolerances
     C = _Concat(pairs)
@@ -994,12 +1087,14 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     flat_a = np.array([pd.A.flat_err for pd in pairs], float)
     flat_b = np.array([pd.B.flat_err for pd in pairs], float)
     sqj = np.array([_sqrt_jinv(pd.A.metric) for pd in pairs], float)
+    fast = (_FastLevel(C, T, pre, rho_max, r_pair, a_ext, b_ext, flat_a, flat_b, sqj, tol, SHORT_CIRCUIT)
+            if (USE_COMPILED if compiled is None else compiled) and pairs else None)
     units_i = [T.pair_units[i] for i in idx_pairs]
     fr = _Frontier(idx_pairs.astype(np.int64), np.full(len(idx_pairs), t0), np.full(len(idx_pairs), t1),
                    np.zeros(len(idx_pairs), np.int64),
                    np.repeat(np.arange(len(idx_pairs)), [len(u) for u in units_i]).astype(np.int64),
                    np.concatenate(units_i) if units_i else np.zeros(0, np.int64), extra0)
-    intervals: list[list[tuple[float, float]]] = [[] for _ in range(npair)]
+    stopped: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []   # (pair, t0, t1) chunks
     unit_tests = np.zeros(npair, np.int64)
     row_tests = np.zeros(npair, np.int64)
     items_n = np.zeros(npair, np.int64)
@@ -1009,8 +1104,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
     while len(fr.pair):
         if budget is not None and budget.exhausted:
             exhausted = True
-            for i in range(len(fr.pair)):
-                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            stopped.append((fr.pair, fr.t0, fr.t1))
             break
         N = len(fr.pair)
         np.maximum.at(max_depth, fr.pair, fr.depth)
@@ -1018,26 +1112,34 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
             L, p, R = provider.balls(fr)
             R = R * (1.0 + 8 * tol.rel_pad) + tol.abs_pad
             pr = fr.pair
-            eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
-            ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
-            if pre is not None:
-                sep = pre.separated(fr.pair, ball, tol)
-                live = np.nonzero(~sep[fr.unit_item])[0]
+            if fast is None:
+                eps_pos = _eps_items(a_ext[pr], b_ext[pr], flat_a[pr], flat_b[pr], sqj[pr], L, p, R, tol)
+            if fast is not None:
+                check_active_budget()
+                sep, unit_fired, rows_i, units_i_n, nrow = fast.level(fr, L, p, R)
             else:
-                live = np.arange(len(fr.unit_item))
-            uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
+                ball = _Ball(L, p, R, rho_max[pr], r_pair[pr], eps_pos, tol)
+                if pre is not None:
+                    sep = pre.separated(fr.pair, ball, tol)
+                    live = np.nonzero(~sep[fr.unit_item])[0]
+                else:
+                    live = np.arange(len(fr.unit_item))
+                uf_live, cnt, u_item, nrow = _evaluate(C, T, fr.unit_item[live], fr.unit_id[live], ball, tol)
         except BudgetExhausted:  # this level's frontier stays unresolved, as at the check above
             exhausted = True
-            for i in range(len(fr.pair)):
-                intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+            stopped.append((fr.pair, fr.t0, fr.t1))
             break
         if pre is not None:
-            np.add.at(prefiltered, fr.pair[sep], 1)
-        unit_fired = np.zeros(len(fr.unit_item), bool)
-        unit_fired[live] = uf_live
-        np.add.at(row_tests, fr.pair[u_item], 1)
-        np.add.at(unit_tests, fr.pair[fr.unit_item[live]], 1)
-        np.add.at(items_n, fr.pair, 1)
+            prefiltered += np.bincount(fr.pair[sep], minlength=npair)
+        if fast is not None:
+            row_tests += _count(fr.pair, rows_i, npair)
+            unit_tests += _count(fr.pair, units_i_n, npair)
+        else:
+            unit_fired = np.zeros(len(fr.unit_item), bool)
+            unit_fired[live] = uf_live
+            row_tests += np.bincount(fr.pair[u_item], minlength=npair)
+            unit_tests += np.bincount(fr.pair[fr.unit_item[live]], minlength=npair)
+        items_n += np.bincount(fr.pair, minlength=npair)
         if budget is not None:
             budget.charge(nrow)
         item_fired = np.zeros(N, bool)
@@ -1045,13 +1147,13 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         # termination (eq. 11) or depth cap
         small = R * rho_max[fr.pair] < epsilon
         stop = item_fired & (small | (fr.depth >= tol.max_depth))
-        for i in np.nonzero(stop)[0]:
-            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
+        if stop.any():
+            stopped.append((fr.pair[stop], fr.t0[stop], fr.t1[stop]))
         go = item_fired & ~stop
         over = frontier_over_cap(fr.pair, fr.t0, go, int(tol.max_frontier))
-        for i in np.nonzero(over)[0]:
-            intervals[fr.pair[i]].append((float(fr.t0[i]), float(fr.t1[i])))
-        np.add.at(capped, fr.pair[over], 1)
+        if over.any():
+            stopped.append((fr.pair[over], fr.t0[over], fr.t1[over]))
+            capped += np.bincount(fr.pair[over], minlength=npair)
         go &= ~over
         if not go.any():
             break
@@ -1066,9 +1168,7 @@ def subdivide(pairs: list[_PairData], provider: BallProvider, t0: float, t1: flo
         fr = _Frontier(np.concatenate([fr.pair[keep]] * 2), np.concatenate([fr.t0[keep], mid]),
                        np.concatenate([mid, fr.t1[keep]]), np.concatenate([fr.depth[keep] + 1] * 2),
                        np.concatenate([ui, ui + k]), np.concatenate([uid, uid]), extra)
-    for lst in intervals:
-        lst.sort()
-    return SubdivisionResult([_merge(x) for x in intervals], unit_tests, row_tests, max_depth, items_n,
+    return SubdivisionResult(_merged_intervals(stopped, npair), unit_tests, row_tests, max_depth, items_n,
                              exhausted, prefiltered, capped)
 
 
@@ -1117,6 +1217,39 @@ def first_interval_dfs(pd: _PairData, provider: BallProvider, t0: float, t1: flo
     return None, tests, depth
 
 
+def _count(idx: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
+    """Exact integer ``np.add.at(zeros(n), idx, weights)`` (weights >= 0, sums < 2^53)."""
+    return np.bincount(idx, weights=weights, minlength=n).astype(np.int64)
+
+
+def _merged_intervals(chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray]], npair: int
+                      ) -> list[list[tuple[float, float]]]:
+    """Per pair, the sorted union of the stopped items' [t0, t1] (as :func:`_merge` of the sorted list).
+
+    Sorted by (pair, t0, t1), an interval starts a new run iff its t0 exceeds the running max
+    of the previous t1 (of the same pair); a run is [its first t0, its running max of t1].
+    """
+    out: list[list[tuple[float, float]]] = [[] for _ in range(npair)]
+    if not chunks:
+        return out
+    pr = np.concatenate([c[0] for c in chunks])
+    if not len(pr):
+        return out
+    a = np.concatenate([c[1] for c in chunks]).astype(float)
+    b = np.concatenate([c[2] for c in chunks]).astype(float)
+    order = np.lexsort((b, a, pr))
+    pr, a, b = pr[order], a[order], b[order]
+    cuts = np.flatnonzero(np.diff(pr)) + 1
+    for lo, hi in zip(np.concatenate([[0], cuts]).tolist(), np.concatenate([cuts, [len(pr)]]).tolist()):
+        aa, cm = a[lo:hi], np.maximum.accumulate(b[lo:hi])
+        start = np.ones(hi - lo, bool)
+        start[1:] = aa[1:] > cm[:-1]
+        s_idx = np.flatnonzero(start)
+        e_idx = np.concatenate([s_idx[1:] - 1, [hi - lo - 1]])
+        out[int(pr[lo])] = list(zip(aa[s_idx].tolist(), cm[e_idx].tolist()))
+    return out
+
+
 def _merge(iv: list[tuple[float, float]]) -> list[tuple[float, float]]:
     out: list[tuple[float, float]] = []
     for a, b in sorted(iv):
@@ -1148,7 +1281,8 @@ class _TrajectoryBalls(BallProvider):
     we evaluate per feature point (tighter than the closed form in design.md) and pad.
     """
 
-    def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric]):
+    def __init__(self, traj: Trajectory, body_a: np.ndarray, body_b: np.ndarray, metrics: list[Metric],
+                 compiled: bool = False):
         self.traj = traj
         self.ba, self.bb = body_a, body_b
         self.ref = np.asarray(traj.ref_points, float)
@@ -1157,8 +1291,43 @@ class _TrajectoryBalls(BallProvider):
         self.mp_off = np.cumsum([0] + [len(x) for x in self.mp])
         self.mp_all = np.concatenate(self.mp)
         self.mw_all = np.concatenate(self.mw)
+        self.pack = _motion_pack(traj) if compiled else None
+        self.screw = None
+        if compiled and self.pack is None and getattr(traj, "interpolation", None) == "screw" \
+                and hasattr(traj, "screw_arrays"):
+            self.screw = traj.screw_arrays()
+        if compiled:
+            self.flat = (_c(body_a, np.int64), _c(body_b, np.int64), _c(self.ref), _c(self.mp_all),
+                         _c(self.mw_all), _c(self.mp_off, np.int64))
 
     def balls(self, fr: _Frontier):
+        if hasattr(self, "flat"):
+            return self._balls_compiled(fr)
+        return self._balls_numpy(fr)
+
+    def _balls_compiled(self, fr: _Frontier):
+        """Compiled balls: the radii in :func:`fat_kernels.traj_balls`.
+
+        Poses and bounds come from one compiled call when the motion packs (lerp+slerp
+        BodyMotion, Plan), else from the Trajectory protocol (screw BodyMotion, others).
+        """
+        from monitor.certify import fat_kernels
+        if self.pack is not None:
+            from monitor.motion.pack import poses_and_bounds
+            pos, rot, mb = poses_and_bounds(self.pack, fr.t0, fr.t1)
+        elif self.screw is not None:
+            pos, rot, mb = _screw_poses_bounds(self.traj, self.screw, fr.t0, fr.t1)
+        else:
+            pos, rot = self.traj.body_poses(0.5 * (fr.t0 + fr.t1))
+            mb = self.traj.motion_bounds(fr.t0, fr.t1)
+        N = len(fr.pair)
+        L, p, R = np.empty((N, 3, 3)), np.empty((N, 3)), np.empty(N)
+        ba, bb, ref, mp_all, mw_all, mp_off = self.flat
+        fat_kernels.traj_balls(_c(fr.pair, np.int64), ba, bb, _c(pos), _c(rot), _c(mb.trans), _c(mb.angle),
+                               ref, mp_all, mw_all, mp_off, 1.0 + 8 * DEFAULT.rel_pad, L, p, R)
+        return L, p, R
+
+    def _balls_numpy(self, fr: _Frontier):
         mids = 0.5 * (fr.t0 + fr.t1)
         pos, rot = self.traj.body_poses(mids)
         mb = self.traj.motion_bounds(fr.t0, fr.t1)
@@ -1186,6 +1355,38 @@ class _TrajectoryBalls(BallProvider):
         return L, p, np.sqrt(R2)
 
 
+def _screw_poses_bounds(traj: Any, arrays: tuple, t0: np.ndarray, t1: np.ndarray):
+    """Midpoint poses and motion bounds of a screw BodyMotion in one compiled call.
+
+    Same numbers as ``traj.body_poses((t0 + t1) / 2)`` and ``traj.motion_bounds(t0, t1)``
+    (:func:`monitor.certify.fat_kernels.screw_poses_bounds`; rounding-level differences).
+    """
+    from monitor.certify import fat_kernels
+    from monitor.motion import _kinematics as K
+    from monitor.motion.base import MotionBounds
+    a, b = K.check_interval_arrays(t0, t1, traj.window)
+    N, nb = a.shape[0], arrays[1].shape[1]
+    pos, rot = np.empty((N, nb, 3)), np.empty((N, nb, 3, 3))
+    trans, angle = np.empty((N, nb)), np.empty((N, nb))
+    fat_kernels.screw_poses_bounds(*arrays, _c(a), _c(b), pos, rot, trans, angle)
+    return pos, rot, MotionBounds(t0=a, t1=b, trans=trans, angle=angle)
+
+
+def _motion_pack(traj: Trajectory) -> Any:
+    """The compiled kernels' pack of ``traj`` (lerp+slerp BodyMotion or Plan), or None.
+
+    :func:`monitor.certify.kernels.trajectory_pack`: the engine's own pack, cached per
+    trajectory object and checked once against the trajectory's poses. Its poses equal
+    the trajectory's; its bounds are the compiled kernels' (``motion.kernel``, the contract
+    of ``motion.plan``, the bound the compiled whole-shape stage already uses): on one
+    segment with reference points at the body origins they equal BodyMotion's to < 1e-8
+    relative (measured), across waypoints they can be tighter (minimum of the chain and
+    Taylor bounds). tests/test_fat_kernels.py samples the resulting balls.
+    """
+    from monitor.certify.kernels import trajectory_pack
+    return trajectory_pack(traj)
+
+
 def _orient(shape_a: ConvexShape, body_a: int, shape_b: ConvexShape, body_b: int,
             static: np.ndarray | None) -> bool:
     """True if A and B must be swapped (B = half-space, or the static body, is the fixed side)."""
@@ -1208,7 +1409,8 @@ def prepare_pair(shape_a: ConvexShape, shape_b: ConvexShape, margin: float,
 def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShape, int]],
                 window: tuple[float, float], margin: float, epsilon: float,
                 tolerances: Tolerances = DEFAULT, budget: Budget | None = None, *,
-                static: np.ndarray | None = None, check_start: bool = True) -> list[PairOutcome]:
+                static: np.ndarray | None = None, check_start: bool = True,
+                compiled: bool | None = None) -> list[PairOutcome]:
     """Toleranced-ball check of shape pairs under a trajectory.
 
     Args:
@@ -1222,6 +1424,8 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
         static: optional (nbody,) bool; a static body is chosen as the fixed side.
         check_start: run the exact static test at t0 for solid pairs (containment is
             invisible to boundary tests). The engine does it itself and passes False.
+        compiled: run the levels in :func:`monitor.certify.fat_kernels.fat_level`; False:
+            the numpy kernels of this module (the test oracle); None: :data:`USE_COMPILED`.
 
     Returns:
         One :class:`PairOutcome` per item: ``"certified"`` or ``"unresolved"`` (the engine
@@ -1258,8 +1462,9 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
                                       info={"start_overlap": True, "start_upper": res.upper})
                 active[i] = False
     if active.any():
-        prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds])
-        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active)
+        comp = USE_COMPILED if compiled is None else compiled
+        prov = _TrajectoryBalls(traj, np.array(ba), np.array(bb), [pd.A.metric for pd in pds], compiled=comp)
+        res = subdivide(pds, prov, t0, t1, epsilon, tolerances, budget, active, compiled=comp)
         for i in np.nonzero(active)[0]:
             iv = res.intervals[i]
             outs[i] = PairOutcome(
@@ -1274,6 +1479,28 @@ def check_pairs(traj: Trajectory, items: list[tuple[ConvexShape, int, ConvexShap
     return outs  # type: ignore[return-value]
 
 
+def warm_kernels() -> None:
+    """Compile (or load from numba's disk cache) the fat-feature stage's kernels once.
+
+    :func:`monitor.certify.fat_kernels.fat_level`, ``traj_balls`` and ``screw_poses_bounds``
+    on a tiny box pair and a two-body screw motion. With an empty cache this takes several
+    seconds (docs/notes/issue-12-slowcases.md); call it before any budgeted ``certify``
+    that may reach the fat-feature stage (``monitor.warmup``).
+    """
+    from monitor.geometry.polytope import box_polytope
+    from monitor.motion.bodymotion import BodyMotion
+
+    box = box_polytope(np.array([0.1, 0.1, 0.1]))
+    pos = np.zeros((2, 2, 3))
+    pos[:, 1] = [[0.3, 0.0, 0.0], [0.3, 0.1, 0.0]]
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (2, 2, 1))
+    quat[1, 1] = [np.cos(0.2), 0.0, 0.0, np.sin(0.2)]
+    for interp in ("lerp_slerp", "screw"):
+        bm = BodyMotion(np.array([0.0, 1.0]), pos, quat, interpolation=interp)
+        check_pairs(bm, [(box, 1, box, 0)], (0.0, 1.0), 0.0, 0.05, compiled=True, check_start=False)
+
+
 __all__ = ["MovingFeatures", "FixedFeatures", "moving_features", "fixed_features", "prepare_pair",
            "subdivide", "check_pairs", "BallProvider", "SubdivisionResult", "first_interval_dfs",
-           "fat_units_fire", "prefilter_separated", "frontier_over_cap", "Frontier", "PairData"]
+           "fat_units_fire", "prefilter_separated", "frontier_over_cap", "Frontier", "PairData",
+           "warm_kernels", "USE_COMPILED", "SHORT_CIRCUIT"]

@@ -282,6 +282,33 @@ class BodyMotion(WindowTimes):
             dev = np.maximum(dev, w.max(axis=1))
         return dev
 
+    def screw_arrays(self) -> tuple:
+        """Flat arrays of a screw motion for the compiled bounds (``fat_kernels.screw_poses_bounds``).
+
+        (times, pos, quat, target, half, phi, cum, same, moving, rotating, omega, v, hx_d,
+        hx_P, hx_th, ref, ref_W, prm) with the per-body slerp tracks stacked on axis 1 and
+        prm = (rel_pad, abs_pad, scale_pad, pos_mag, scale, screw_pad). Built once.
+
+        Raises:
+            InvalidInputError: the interpolation is not ``"screw"``.
+        """
+        if self._interp != "screw":
+            raise InvalidInputError(f"screw_arrays: interpolation is {self._interp!r}, not 'screw'")
+        hit = getattr(self, "_screw_flat", None)
+        if hit is None:
+            tr = self._tracks
+            c = np.ascontiguousarray
+            tol = self._tol
+            hit = (c(self._times), c(self._pos), c(self._quat),
+                   c(np.stack([t.target for t in tr], axis=1)), c(np.stack([t.half for t in tr], axis=1)),
+                   c(np.stack([t.phi for t in tr], axis=1)), c(np.stack([t.cum for t in tr], axis=1)),
+                   c(np.stack([t.same for t in tr], axis=1)), c(self._moving), c(self._rotating),
+                   c(self._omega), c(self._v), c(self._hx_d), c(self._hx_P), c(self._hx_th), c(self._ref),
+                   c(self._ref_W), np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, self._pos_mag,
+                                             self._scale, self._screw_pad], float))
+            self._screw_flat = hit
+        return hit
+
     def moving_bodies(self) -> np.ndarray:
         """(nbody,) bool: True where the body's waypoint poses are not all identical."""
         return self._moving.copy()

@@ -590,7 +590,7 @@ class Plan(WindowTimes):
     @property
     def nbody(self) -> int:
         """Number of bodies (world included)."""
-        return int(self._model.nbody)
+        return self._st.nbody  # an MjModel's sizes never change
 
     @property
     def ref_points(self) -> np.ndarray:

@@ -1,0 +1,166 @@
+"""The Python around the compiled window (issue 12 items 1, 6): same certificates, sound caches.
+
+* Every certificate of the seeded calls in ``tests/_engine_entry_cases.py`` (bench
+  pair-windows with both methods and two margins (slow), free bodies under translating and
+  rotating BodyMotions, Pusher-v5 windows with both ongoing rules, and plans certified after
+  an in-place model edit) equals the one recorded on main 691a867
+  before the entry was reworked: verdict, clearance, witness, earliest time, stats (except
+  wall time) and every PairResult. Each call is made twice, so the second one runs on warm
+  per-scene caches.
+* The caches that skip work are checked where they could go wrong: the ``Plan.is_current``
+  memo after an in-place edit, the snapshot's memory runs with an edit in a gap and in a
+  watched field, and the trusted constructors against the validating ones.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _engine_entry_cases import _summary, bench_calls, box_calls, calls, pusher_calls  # noqa: E402
+
+GOLDEN = Path(__file__).resolve().parent / "assets" / "engine_entry_golden.json"
+
+
+def _check_all(thunks) -> int:
+    golden = json.loads(GOLDEN.read_text())
+    n = 0
+    for name, run in thunks:
+        want = golden[name]
+        for attempt in range(2):  # cold then warm per-scene caches
+            got = json.loads(json.dumps(_summary(run())))
+            assert got == want, f"{name} (call {attempt + 1}) differs from the recorded certificate"
+        n += 1
+    return n
+
+
+def test_pusher_and_edited_certificates_match_recorded():
+    """Pusher windows (both ongoing rules) and plans built before an in-place edit, certified after it."""
+    n = _check_all(pusher_calls())
+    assert n == 38
+
+
+def test_box_scene_certificates_match_recorded():
+    """Free bodies with translating (extrusion route) and rotating BodyMotions, both methods."""
+    assert _check_all(box_calls()) == 24
+
+
+@pytest.mark.slow
+def test_bench_certificates_match_recorded_sample():
+    """Every bench case once (method auto, margin 0); building the cases takes ~10 s."""
+    n = _check_all(bench_calls(only="auto/0.0"))
+    assert n >= 20
+
+
+@pytest.mark.slow
+def test_all_certificates_match_recorded():
+    n = _check_all(calls())
+    assert n == len(json.loads(GOLDEN.read_text()))
+
+
+def test_plan_structure_fields_are_watched_by_the_scene():
+    """The is_current memo's premise: every array Plan.is_current reads is in Scene.sync's snapshot."""
+    from monitor.motion import plan as plan_mod
+    from monitor.scene import SYNC_FIELDS
+
+    assert set(plan_mod._STRUCT_FIELDS) <= set(SYNC_FIELDS)
+
+
+def _pusher():
+    import gymnasium as gym
+
+    import monitor
+
+    model = gym.make("Pusher-v5").unwrapped.model
+    scene = monitor.Scene.from_model(model, pairs="mujoco")
+    q0 = model.qpos0.copy()
+    rng = np.random.default_rng(5)
+
+    def plan():
+        qs = np.array([q0, q0 + rng.uniform(-0.3, 0.3, model.nq)])
+        return monitor.Plan(np.array([0.0, 0.05]), qs, model)
+
+    return model, scene, plan
+
+
+def test_is_current_memo_does_not_survive_an_edit(monkeypatch):
+    """A plan whose structure matched before an in-place edit is checked (and rebuilt) after it."""
+    from monitor.certify.engine import certify
+    from monitor.motion.plan import Plan
+
+    model, scene, make = _pusher()
+    a, b = make(), make()
+    assert a._st is b._st
+    certify(scene, a, margin=0.0)
+    seen = []
+    orig = Plan.is_current
+    monkeypatch.setattr(Plan, "is_current", lambda self: seen.append(self) or orig(self))
+    certify(scene, b, margin=0.0)
+    assert seen == []                      # memo: same structure object, model unchanged
+    model.jnt_axis[0] = np.array([0.0, 0.6, 0.8])
+    refreshed = []
+    orig_ref = Plan.refreshed
+    monkeypatch.setattr(Plan, "refreshed", lambda self: refreshed.append(self) or orig_ref(self))
+    certify(scene, b, margin=0.0)
+    assert seen == [b] and refreshed == [b]
+    # a plan built after the edit is current: remembered again under the new snapshot
+    c = make()
+    certify(scene, c, margin=0.0)
+    certify(scene, make(), margin=0.0)
+    assert seen == [b, c]
+
+
+def test_snapshot_runs_see_every_watched_edit():
+    """Edits inside a run's gap do not rebuild; watched edits after them are still found."""
+    from monitor.scene import SYNC_FIELDS
+
+    model, scene, _ = _pusher()
+    snap = scene._snapshot
+    assert scene.sync() is False and snap._runs is not None
+    # an unwatched array (rgba) edited: no rebuild, and the references are retaken
+    model.geom_rgba[1, 0] = 0.25
+    assert scene.sync() is False and scene.version == 0
+    assert snap.unchanged()
+    for field in ("geom_size", "body_pos", "geom_contype", "jnt_axis"):
+        assert field in SYNC_FIELDS
+        v = getattr(model, field).reshape(-1)
+        old = v[-1].copy()
+        v[-1] = old + 1
+        assert not scene._snapshot.unchanged() and scene._snapshot.changed() == [field]
+        v[-1] = old
+        assert scene._snapshot.unchanged()
+    model.geom_size.reshape(-1)[-1] *= 2
+    assert scene.sync() is True and scene.version == 1 and scene._hot == {}
+
+
+def test_trusted_constructors_equal_the_validating_ones():
+    from monitor.certify.certificate import Certificate, Witness
+    from monitor.certify.common import Budget
+    from monitor.certify.types import Method, Verdict
+
+    b, ref = Budget.default(10.0), Budget(seconds=10.0)
+    assert (b.seconds, b.tests, b._used_tests) == (ref.seconds, ref.tests, ref._used_tests)
+    assert type(b.seconds) is float and not b.exhausted
+    with pytest.raises(Exception, match="seconds"):
+        Budget.default(float("nan"))
+    w = Witness(0.5, ("a", "b"), np.zeros(3), -0.1)
+    args = ((0.0, 1.0), 0.01, 1e-3)
+    c = Certificate._trusted(Verdict.VIOLATION, *args, Method.AUTO, w, 0.4, float("-inf"), (), {"x": 1}, ())
+    d = Certificate("violation", *args, "auto", w, 0.4, float("-inf"), (), {"x": 1}, ())
+    assert c == d and c.to_dict() == d.to_dict() and c.pairs == ()
+    assert type(c.verdict) is Verdict and type(c.method) is Method
+    # the engine builds kernel witnesses field for field: valid while Witness has exactly
+    # these fields and no __post_init__
+    import dataclasses
+
+    assert [f.name for f in dataclasses.fields(Witness)] == ["time", "geoms", "point", "distance"]
+    assert "__post_init__" not in vars(Witness)
+    assert [f.name for f in dataclasses.fields(Certificate)] == [
+        "verdict", "window", "margin", "epsilon", "method", "witness", "earliest_time", "clearance",
+        "pairs", "stats", "allowed"]

@@ -1,0 +1,128 @@
+"""The braking tail in MuJoCo's C rollout equals the ``mj_step`` loop bit for bit (issue 12, item 5).
+
+``Rollout.brake_rows`` runs the tail's substeps in ``mujoco.rollout`` where that is the same
+computation (no callback, no plugin, no MuJoCo warning in the tail) and in the Python loop
+otherwise. Oracle: an independent ``MjData`` stepped by hand with ``mj_step``, one substep at
+a time, stopping at the first substep whose every ``|qvel| <= vel_tol`` (else ``max_steps``).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from monitor._paths import scene_path
+from monitor.gate import Gate, Rollout
+
+_MOTOR = """
+<mujoco>
+  <option timestep="0.002"/>
+  <worldbody>
+    <body><joint name="hinge" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 .5 0 0" size=".05"/></body>
+  </worldbody>
+  <actuator><motor joint="hinge"/></actuator>
+</mujoco>
+"""
+
+_INTEGRATOR = _MOTOR.replace('<motor joint="hinge"/>',
+                             '<general joint="hinge" dyntype="integrator" gear="100"/>')
+
+
+def _oracle(m, d, ctrl, nstep, brake_fn, max_steps, vel_tol):
+    """Rows (time, qpos, qvel) of the window's end and the tail, by hand on a fresh MjData."""
+    o = mujoco.MjData(m)
+    state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+    mujoco.mj_setState(m, o, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+    o.ctrl[:] = ctrl
+    mujoco.mj_step(m, o, nstep=nstep)
+    brake = np.asarray(brake_fn(o), float)
+    o.ctrl[:] = brake
+    rows = [np.concatenate(([o.time], o.qpos, o.qvel))]
+    for _ in range(max_steps):
+        mujoco.mj_step(m, o)
+        rows.append(np.concatenate(([o.time], o.qpos, o.qvel)))
+        if np.max(np.abs(o.qvel)) <= vel_tol:
+            break
+    return np.array(rows), brake
+
+
+@pytest.mark.parametrize("vel_tol", [1e-4, 0.05, 1.5, 1e3])  # stops: never, midway, early, first substep
+@pytest.mark.parametrize("scene", ["tunnel", "arm"])
+def test_c_tail_equals_the_loop_and_a_hand_oracle(scene, vel_tol):
+    m = mujoco.MjModel.from_xml_path(str(scene_path(scene)))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    rng = np.random.default_rng(11)
+    lo, hi = m.actuator_ctrlrange[:, 0], m.actuator_ctrlrange[:, 1]
+    gate = Gate(m)
+    lengths = set()
+    for _ in range(4):
+        ctrl = rng.uniform(lo, hi)
+        want, brake_want = _oracle(m, d, ctrl, 3, gate._brake_ctrl, 30, vel_tol)
+        for c_tail in (True, False):
+            ro = Rollout(m)
+            ro.c_tail = c_tail
+            ro.states(d, ctrl, 3)
+            rows, brake = ro.brake_rows(d, ctrl, 3, gate._brake_ctrl, 30, vel_tol, window_fresh=True)
+            assert rows.shape == want.shape
+            assert np.array_equal(rows, want)
+            assert np.array_equal(brake, brake_want)
+            rows2, _ = ro.brake_rows(d, ctrl, 3, gate._brake_ctrl, 30, vel_tol)  # again: same scratch
+            assert np.array_equal(rows2, want)
+        lengths.add(len(want))
+        d.ctrl[:] = ctrl
+        mujoco.mj_step(m, d, nstep=3)
+    if vel_tol == 1e3:
+        assert lengths == {2}
+
+
+def test_a_warning_in_the_tail_falls_back_to_the_loop():
+    """mj_step resets the data on a bad velocity and goes on; rollout would stop there.
+
+    A huge brake control integrated into the actuator's activation makes the acceleration
+    exceed MuJoCo's limit a few substeps into the tail (not in the first, which runs as one
+    ``mj_step``): the loop (and the oracle) reset the data (time back to 0, ctrl 0) and keep
+    stepping (the pendulum falls under gravity, so the tail does not stop there); the C path
+    must notice the warning and give the loop's rows.
+    """
+    m = mujoco.MjModel.from_xml_string(_INTEGRATOR)
+    d = mujoco.MjData(m)
+
+    def brake(_d):
+        return np.array([5e9])
+
+    want, _ = _oracle(m, d, np.array([0.0]), 2, brake, 60, 1e-6)
+    assert np.any(np.diff(want[:, 0]) < 0)  # the oracle did reset inside the tail
+    reset = int(np.argmax(np.diff(want[:, 0]) < 0)) + 1
+    assert reset >= 3 and len(want) > reset + 2  # ... inside the rollout's part, and went on after it
+    ro = Rollout(m)
+    ro.states(d, np.array([0.0]), 2)
+    rows, _ = ro.brake_rows(d, np.array([0.0]), 2, brake, 60, 1e-6, window_fresh=True)
+    assert np.array_equal(rows, want)
+
+
+def test_a_control_callback_keeps_the_loop():
+    """A control callback writes ctrl inside mj_step; the rollout would re-set it every substep."""
+    m = mujoco.MjModel.from_xml_string(_MOTOR)
+    d = mujoco.MjData(m)
+
+    def push(_m, dd):
+        dd.ctrl[:] = dd.ctrl + 0.25
+
+    def brake(_d):
+        return np.array([-1.0])
+
+    mujoco.set_mjcb_control(push)
+    try:
+        want, _ = _oracle(m, d, np.array([0.5]), 2, brake, 15, 1e-9)
+        ro = Rollout(m)
+        ro.states(d, np.array([0.5]), 2)
+        rows, _ = ro.brake_rows(d, np.array([0.5]), 2, brake, 15, 1e-9, window_fresh=True)
+    finally:
+        mujoco.set_mjcb_control(None)
+    assert np.array_equal(rows, want)
+    # without the callback the same tail is different (the test can tell the two apart)
+    other, _ = _oracle(m, d, np.array([0.5]), 2, brake, 15, 1e-9)
+    assert not np.array_equal(other, want)
