@@ -668,10 +668,8 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
             checker = np.full(n, "culled", dtype=object)
             mix = f"culled:{n}" if n else ""
         else:
-            names = [str(p.method) for p in cert.pairs]
-            checker = np.empty(len(names), dtype=object)
-            checker[:] = names
-            counts = Counter(names)
+            checker = cert.pair_methods()   # no PairResult built on the compiled path
+            counts = Counter(checker.tolist())
             mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)

@@ -219,6 +219,20 @@ class Certificate:
         object.__setattr__(self, "verdict", as_verdict(self.verdict))
         object.__setattr__(self, "method", as_method(self.method, "Certificate method"))
 
+    def pair_methods(self) -> np.ndarray:
+        """(P,) object array of ``str(p.method)`` for each pair of :attr:`pairs`, in order.
+
+        Without building the :class:`PairResult` tuple when the engine's compiled path left
+        it unbuilt (the gate reads this every step for ``info["safety"]["checker"]``).
+        """
+        v = self.__dict__.get("_pairs_store", ())
+        if not isinstance(v, tuple) and hasattr(v, "methods"):
+            return v.methods()
+        names = [str(p.method) for p in self.pairs]
+        out = np.empty(len(names), dtype=object)
+        out[:] = names
+        return out
+
     @property
     def certified(self) -> bool:
         """True only for the verdict ``"certified"``."""

@@ -536,6 +536,30 @@ class _WindowPairs:
         return PairResult(geoms, bodies, "violation", "toleranced", int(row[KS.R_TESTS]),
                           int(row[KS.R_DEPTH]), ((float(row[KS.R_FIRST_UNRES]), w.time),), float("-inf"), w)
 
+    def methods(self) -> np.ndarray:
+        """(P,) object array: ``str(p.method)`` of each pair :meth:`build_pairs` would make, in order.
+
+        Without building a PairResult: the same precedence as :meth:`build_pairs` /
+        :func:`_build_ordered` (budget-unfinished first; then culled / static-static pairs;
+        then the kernel's decisions, which win over the Python pipeline's results).
+        """
+        KS = _kernels()
+        code = self.code
+        out = np.full(len(self.sel), "culled", dtype=object)   # WK_CULLED and WK_SS
+        if self.results:
+            pos = np.searchsorted(self.sel, np.fromiter(self.results, np.int64, len(self.results)))
+            for k, r in zip(pos.tolist(), self.results.values()):
+                out[k] = str(r.method)
+        if self.surv.size:
+            c = code[self.surv]
+            st = self.surv[(c == KS.WK_STATIC_VIOL) | (c == KS.WK_STATIC_CERT)]
+            tl = self.surv[(c == KS.WK_CERT) | (c == KS.WK_VIOL)]
+            out[st] = "static"
+            out[tl] = "toleranced"
+        if self.unfin.any():
+            out[self.unfin] = "budget"
+        return out
+
     def build_pairs(self) -> tuple:
         KS = _kernels()
 
