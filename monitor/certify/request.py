@@ -176,7 +176,20 @@ class CertifyRequest:
         """A fresh :class:`~monitor.certify.common.Budget` with these limits (its clock starts now)."""
         from monitor.certify.common import Budget
 
-        return Budget(seconds=self.budget.seconds, tests=self.budget.tests)
+        b = self.budget
+        # Budget.default is Budget(seconds=...) field for field, without the dataclass init
+        return Budget.default(b.seconds) if b.tests is None else Budget(seconds=b.seconds, tests=b.tests)
+
+    def _with_pairs(self, pairs: tuple[tuple[str, str], ...] | None) -> CertifyRequest:
+        """A copy with ``pairs`` set, without validating again (internal: the gate's subset calls).
+
+        ``pairs`` must already be what ``__post_init__`` makes of a valid value: a tuple of
+        (str, str) tuples (e.g. names taken from ``scene.candidate_pairs``), or None.
+        """
+        out = object.__new__(type(self))
+        out.__dict__.update(self.__dict__)
+        out.__dict__["pairs"] = pairs
+        return out
 
     def replace(self, **changes: Any) -> CertifyRequest:
         """A copy with ``changes`` applied (validated again)."""
