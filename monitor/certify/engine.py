@@ -250,13 +250,11 @@ def _make_budget(budget: Any) -> Budget:
     raise InvalidInputError(f"budget must be None, a Budget or a dict, got {type(budget).__name__}")
 
 
-_KW_DEFAULTS = (("margin", 0.0), ("epsilon", DEFAULT_EPSILON), ("method", "auto"), ("window", None),
-                ("budget", None), ("tolerances", DEFAULT), ("pairs", None), ("ongoing", "violation"),
-                ("penetration_tol", DEFAULT_PENETRATION_TOL))
-"""``certify``'s keyword settings and their defaults (the ones a ``request=`` replaces)."""
 _REQUESTS: dict[tuple, CertifyRequest] = {}
 """Memo of the requests :func:`_request_of` built from plain keyword values (bounded; see there)."""
 _NO_KEY = object()
+_LAST_REQUEST: list[tuple | None] = [None]
+"""The argument objects of the last memoised keyword call with ``budget=None`` and its request."""
 
 
 def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any, tolerances: Any,
@@ -273,6 +271,15 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
     the validated request completely, so a hit is the request validation would build, and
     a loop certifying many windows with the same settings validates them once.
     """
+    last = _LAST_REQUEST[0]
+    if (budget is None and last is not None and last[0] is margin and last[1] is epsilon
+            and last[2] is method and last[3] is window and last[4] is tolerances and last[5] is pairs
+            and last[6] is ongoing and last[7] is penetration_tol
+            and last[8] == DEFAULT_BUDGET_SECONDS):
+        # the very objects of the previous call (a loop certifying window after window): immutable
+        # values (floats, strings, a frozen Tolerances, a tuple of floats or None) that were
+        # validated into last[9]; a mutable Budget never takes this path
+        return last[9]
     if budget is None:  # the engine's default seconds, read now (tests patch it)
         bkey: Any = DEFAULT_BUDGET_SECONDS
     elif type(budget) is Budget:
@@ -290,6 +297,9 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         except TypeError:  # an unhashable method / ongoing: validation names it below
             hit, key = None, None
         if hit is not None and hit.tolerances is tolerances:
+            if budget is None:
+                _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
+                                    penetration_tol, bkey, hit)
             return hit
     try:
         req = CertifyRequest(margin=margin, epsilon=epsilon, method=method, window=window,
@@ -301,6 +311,9 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         raise InvalidInputError(msg[len("CertifyRequest."):] if msg.startswith("CertifyRequest.")
                                 else msg) from None
     if key is not None:
+        if budget is None:
+            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
+                                bkey, req)
         if len(_REQUESTS) >= 64:
             _REQUESTS.clear()
         _REQUESTS[key] = req
@@ -385,11 +398,23 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
         req = _request_of(margin, epsilon, method, window, budget, tolerances, pairs, ongoing,
                           penetration_tol)
     else:
-        req = _check_no_clash(request, (margin, epsilon, method, window, budget, tolerances, pairs, ongoing,
-                                        penetration_tol))
+        d = _KW_DEFAULT_OBJECTS
+        if (type(request) is CertifyRequest and margin is d[0] and epsilon is d[1] and method is d[2]
+                and window is None and budget is None and tolerances is d[5] and pairs is None
+                and ongoing is d[7] and penetration_tol is d[8]):
+            req = request  # every keyword setting left at its default object (the common case)
+        else:
+            req = _check_no_clash(request, (margin, epsilon, method, window, budget, tolerances, pairs,
+                                            ongoing, penetration_tol))
     # a live Budget keeps its clock (and test count); otherwise the request's limits, fresh clock
-    bud = budget if isinstance(budget, Budget) else req.new_budget()
-    margin, epsilon, method, tol = req.margin, req.epsilon, req.method, req.tolerances
+    lim = req.budget
+    if isinstance(budget, Budget):
+        bud = budget
+    elif lim.tests is None:
+        bud = Budget.default(lim.seconds)  # = req.new_budget(), inlined (per call)
+    else:
+        bud = req.new_budget()
+    margin, epsilon, method, tol = req.margin, req.epsilon, req.method.value, req.tolerances
     ongoing, pen_tol = req.ongoing, req.penetration_tol
     plan = _check_model(scene, plan)
     pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
@@ -428,6 +453,12 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
                       budget=bud, tolerances=tol, penetration_tol=pen_tol)
     cert.__dict__["request"] = req  # not a compared field: certificates stay equal, to_dict unchanged
     return cert
+
+
+_KW_DEFAULTS = (tuple(zip(("margin", "epsilon", "method"), certify.__defaults__))
+                + tuple(kv for kv in certify.__kwdefaults__.items() if kv[0] != "request"))
+"""``certify``'s keyword settings and their default objects (the ones a ``request=`` replaces)."""
+_KW_DEFAULT_OBJECTS = tuple(d for _, d in _KW_DEFAULTS)
 
 
 def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,

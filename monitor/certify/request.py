@@ -25,6 +25,8 @@ import numbers
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+from monitor.certify import common as _common
+from monitor.certify.common import Budget
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, ONGOING_RULES
 from monitor.certify.types import Method, as_method
 from monitor.errors import InvalidInputError
@@ -74,10 +76,8 @@ class BudgetLimits:
     @classmethod
     def of(cls, budget: Any) -> BudgetLimits:
         """Limits from None (the engine's default seconds), a dict, a BudgetLimits or a Budget's limits."""
-        from monitor.certify.common import DEFAULT_BUDGET_SECONDS, Budget
-
         if budget is None:
-            return cls(seconds=DEFAULT_BUDGET_SECONDS)
+            return cls(seconds=_common.DEFAULT_BUDGET_SECONDS)
         if isinstance(budget, BudgetLimits):
             return budget
         if isinstance(budget, Budget):
@@ -174,8 +174,6 @@ class CertifyRequest:
 
     def new_budget(self) -> Any:
         """A fresh :class:`~monitor.certify.common.Budget` with these limits (its clock starts now)."""
-        from monitor.certify.common import Budget
-
         b = self.budget
         # Budget.default is Budget(seconds=...) field for field, without the dataclass init
         return Budget.default(b.seconds) if b.tests is None else Budget(seconds=b.seconds, tests=b.tests)
