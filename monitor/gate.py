@@ -1025,6 +1025,8 @@ class Gate:
         """Work limits per window; reassignable (validated).
 
         None, seconds, tests, a dict or a Budget (its limits: a fresh clock per window).
+        The limits are read once into :attr:`request` (at its first use after an assignment):
+        to change them, assign again (editing a Budget object in place afterwards is not seen).
         """
         return self._budget
 

@@ -222,3 +222,43 @@ def test_a_forged_request_record_is_a_critical_finding(model, tmp_path, forged):
     reasons = [f["reason"] for f in ver["findings"] if f["severity"] == "critical"]
     assert any("request" in r for r in reasons), reasons
     assert ver["critical"] >= 1 and ver["errors"] == []
+
+
+def test_the_request_memo_never_skips_validation(model):
+    """Memo hits only for values validation accepts; a Budget is keyed by its limits."""
+    scene = Scene.from_model(model, pairs="all")
+    plan = _drop(model, -0.005)
+    one = 1.0
+    assert certify(scene, plan, margin=one).request.margin == 1.0
+    for bad in (True, float("nan"), "1.0", -1.0):
+        with pytest.raises(InvalidInputError, match="margin"):
+            certify(scene, plan, margin=bad)
+    assert certify(scene, plan, margin=one).request.margin == 1.0
+    b = Budget(seconds=30.0)
+    assert certify(scene, plan, budget=b).request.budget == BudgetLimits(seconds=30.0)
+    b.tests = 0  # a mutable Budget edited between calls: the new limits apply
+    cert = certify(scene, plan, budget=b)
+    assert cert.request.budget == BudgetLimits(seconds=30.0, tests=0) and cert.verdict == "uncertain"
+    with pytest.raises(InvalidInputError, match="ongoing"):
+        certify(scene, plan, ongoing="ignore")
+
+
+def test_a_forged_request_in_the_file_is_found_by_the_cli(model, tmp_path, capsys):
+    """The request record edited on disk (ongoing rule swapped): CRITICAL, exit 1, no traceback."""
+    from mcap_rewrite import rewrite
+
+    from monitor.cli import main
+    from monitor.log import topics
+
+    path, forged = tmp_path / "ball.mcap", tmp_path / "forged.mcap"
+    _gated_log(model, path, steps=6)
+
+    def edit(name, values):
+        if name == topics.METADATA_RUN:
+            values["request"] = {**values["request"], "penetration_tol": "5 mm"}
+        return values
+
+    rewrite(path, forged, metadata=edit)
+    assert main(["review", "--verify", str(forged)]) == 1
+    out = capsys.readouterr().out
+    assert "request is malformed" in out and "penetration_tol" in out
