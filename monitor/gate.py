@@ -63,6 +63,7 @@ import numpy as np
 
 from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
+from monitor.certify.request import BudgetLimits, CertifyRequest
 from monitor.errors import InvalidInputError
 from monitor.gate_policy import announce, applied_cost, block_reason, describe_gate, safety_keys
 from monitor.tolerances import DEFAULT, Tolerances
@@ -927,12 +928,15 @@ class Gate:
         if int(frame_skip) < 1:
             raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
         _make_budget(budget)  # validate early
+        self._margin, self._epsilon, self._tolerances = 0.0, 1e-3, DEFAULT  # set below (validated)
         _check_log(log)
         self._cache: dict[int, tuple[bytes, PairResult]] = {}
         self._cache_context: tuple[Any, ...] | None = None
         self._pair_bodies_cache: tuple[Any, ...] | None = None
         self._scene_builds = 0
-        self.penetration_tol = check_rule(ongoing, penetration_tol)
+        self._request: CertifyRequest | None = None  # built from the settings below on first use
+        check_rule(ongoing, penetration_tol)  # validate both before either is set
+        self.penetration_tol = penetration_tol
         self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
         self.reference_qpos: np.ndarray | None = None  # allowed="auto": Default's reference pose
         self.model = model
@@ -989,6 +993,7 @@ class Gate:
         if not _is_real(value) or not math.isfinite(float(value)) or value < 0:
             raise InvalidInputError(f"margin must be a finite number >= 0, got {value!r}")
         self._margin = float(value)
+        self._request = None
 
     @property
     def epsilon(self) -> float:
@@ -1000,6 +1005,7 @@ class Gate:
         if not _is_real(value) or not math.isfinite(float(value)) or value <= 0:
             raise InvalidInputError(f"epsilon must be a finite number > 0, got {value!r}")
         self._epsilon = float(value)
+        self._request = None
 
     @property
     def tolerances(self) -> Tolerances:
@@ -1012,6 +1018,62 @@ class Gate:
             raise InvalidInputError(f"tolerances must be a monitor.Tolerances, got {type(value).__name__}")
         self._tolerances = value
         self._scene = None
+        self._request = None
+
+    @property
+    def budget(self) -> Any:
+        """Work limits per window; reassignable (validated).
+
+        None, seconds, tests, a dict or a Budget (its limits: a fresh clock per window).
+        The limits are read once into :attr:`request` (at its first use after an assignment):
+        to change them, assign again (editing a Budget object in place afterwards is not seen).
+        """
+        return self._budget
+
+    @budget.setter
+    def budget(self, value: Any) -> None:
+        _make_budget(value)  # validate
+        self._budget = value
+        self._request = None
+
+    @property
+    def ongoing(self) -> str:
+        """The ongoing-contact rule, ``"deepen"`` or ``"violation"``; reassignable (validated)."""
+        return self._ongoing
+
+    @ongoing.setter
+    def ongoing(self, value: str) -> None:
+        check_rule(value, DEFAULT_PENETRATION_TOL)
+        self._ongoing = value
+        self._request = None
+
+    @property
+    def penetration_tol(self) -> float:
+        """Metres of penetration an ongoing contact may reach; reassignable (validated)."""
+        return self._penetration_tol
+
+    @penetration_tol.setter
+    def penetration_tol(self, value: float) -> None:
+        self._penetration_tol = check_rule("deepen", value)
+        self._request = None
+
+    @property
+    def request(self) -> CertifyRequest:
+        """The :class:`~monitor.certify.request.CertifyRequest` every window is certified with.
+
+        Built once per setting (rebuilt after ``margin``, ``epsilon``, ``tolerances``,
+        ``budget``, ``ongoing`` or ``penetration_tol`` is reassigned); window None (each
+        window's plan span) and pairs None (all candidate pairs). Its budget is the limits of
+        ``budget`` (a fresh clock per window, as before). The log stores it in its metadata.
+        """
+        req = self._request
+        if req is None:
+            b = _make_budget(self._budget)
+            limits = BudgetLimits.of(None) if b is None else BudgetLimits(seconds=b.seconds, tests=b.tests)
+            req = self._request = CertifyRequest(margin=self._margin, epsilon=self._epsilon, budget=limits,
+                                                 tolerances=self._tolerances, ongoing=self._ongoing,
+                                                 penetration_tol=self._penetration_tol)
+        return req
 
     def _reuse_context(self) -> tuple[Any, ...]:
         """Everything a reused pair result depends on besides the two bodies' poses."""
@@ -1068,9 +1130,7 @@ class Gate:
         scene = self.scene
         todo, reused, keys = self._split_reuse(scene, plan)
         if todo is None:  # nothing reusable: one plain call
-            cert = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                           budget=_make_budget(self.budget), tolerances=self.tolerances,
-                           ongoing=self.ongoing, penetration_tol=self.penetration_tol)
+            cert = certify(scene, plan, request=self._request or self.request)
         else:
             cert = self._certify_subset(certify, scene, plan, todo, reused)
         if self.reuse:
@@ -1191,10 +1251,8 @@ class Gate:
         """Certify only ``todo`` and merge in the reused pair results (scene order)."""
         t0, t1 = float(plan.t0), float(plan.t1)
         if todo:
-            names = [scene.candidate_pairs[i] for i in todo]
-            fresh = certify(scene, plan, margin=self.margin, epsilon=self.epsilon,
-                            budget=_make_budget(self.budget), tolerances=self.tolerances, pairs=names,
-                            ongoing=self.ongoing, penetration_tol=self.penetration_tol)
+            names = tuple(tuple(scene.candidate_pairs[i]) for i in todo)
+            fresh = certify(scene, plan, request=self.request._with_pairs(names))
             by_geoms = {p.geoms: p for p in fresh.pairs}
             fresh_pairs = [by_geoms[tuple(scene.candidate_pairs[i])] for i in todo]
         else:
@@ -1209,11 +1267,14 @@ class Gate:
         stats["reused_pairs"] = len(reused)
         stats["pairs"] = len(pairs)
         if fresh is None:
-            return Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
-                               clearance, pairs, stats, scene.allowed_pairs)
-        return Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method, fresh.witness,
-                           fresh.earliest_time, min(clearance, fresh.clearance), pairs, stats,
-                           scene.allowed_pairs)
+            merged = Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
+                                 clearance, pairs, stats, scene.allowed_pairs)
+        else:
+            merged = Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method,
+                                 fresh.witness, fresh.earliest_time, min(clearance, fresh.clearance), pairs,
+                                 stats, scene.allowed_pairs)
+        merged.__dict__["request"] = self.request  # all pairs (reused + fresh): the gate's request
+        return merged
 
     def _remember(self, cert: Certificate, keys: dict[int, bytes]) -> None:
         for i, key in keys.items():
@@ -1481,7 +1542,10 @@ class Gate:
             self.log_path = path
             meta = {"margin": self.margin, "epsilon": self.epsilon, "pairs": str(self.pairs),
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
-                    "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip}
+                    "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,
+                    # every certify setting (ongoing rule, tolerances, budget, ...): review --verify
+                    # re-derives each window with it (CertifyRequest.from_json)
+                    "request": self.request.to_json()}
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True

@@ -25,6 +25,7 @@ import html
 import io
 import math
 from collections import Counter
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -347,6 +348,39 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     return Plan(times, qpos, model=model, **kw)
 
 
+def _logged_request(run: dict[str, Any], tol: Any, find: Callable[..., None],
+                    notes: list[str]) -> Any:
+    """The run's logged :class:`~monitor.certify.request.CertifyRequest`, ready to re-derive with.
+
+    None when the log has none (an old log: re-derived as before, with the plain rule) or
+    when it is malformed or forged (a CRITICAL finding; then also as before). The request's
+    window, budget and pairs are replaced (window: each plan's span; budget: the library
+    default per window; pairs: all of the scene's, the pair policy decides them) and its
+    tolerances by the ones this verification uses (a note says when they differ).
+    """
+    if "request" not in run:
+        return None
+    from monitor.certify.request import BudgetLimits, CertifyRequest
+    from monitor.errors import MonitorError
+
+    raw = run["request"]
+    try:
+        req = CertifyRequest.from_json(raw)
+    except (MonitorError, TypeError, ValueError) as exc:
+        find(CRITICAL, f"run metadata request is malformed: {_short(str(exc), 200)}; re-derived "
+                       f"without it (plain rule)")
+        return None
+    if req.pairs is not None:
+        find(CRITICAL, f"run metadata request restricts the pairs to {len(req.pairs)}: ignored, the "
+                       f"pair policy decides them")
+    if req.tolerances != tol:
+        notes.append("the logged request's tolerances differ from the ones used here; the logged ones "
+                     "were not used")
+    if req.window is not None:
+        notes.append(f"the logged request's window {list(req.window)} was not used (each plan's span is)")
+    return req.replace(window=None, pairs=None, budget=BudgetLimits.of(None), tolerances=tol)
+
+
 def _engine() -> tuple[Any, Any]:
     """(Scene class, certify function); ImportError while the engine is not installed."""
     from monitor.certify.engine import certify
@@ -532,6 +566,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             else:
                 run_claims[key] = float(v)
 
+    logged_req = _logged_request(run, tol, find, notes)
+
     policy: Any = None
     raw_policy = run.get("pairs", run.get("pair_policy"))
     if raw_policy is None:
@@ -635,8 +671,18 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if not (math.isclose(w0, t0, rel_tol=1e-12, abs_tol=1e-12)
                     and math.isclose(w1, t1, rel_tol=1e-12, abs_tol=1e-12)):
                 find(CRITICAL, f"window [{w0!r}, {w1!r}] is not the plan's span [{t0!r}, {t1!r}]", k)
-            new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
-                          method=method, window=(t0, t1), tolerances=tol)
+            if logged_req is None:  # an old log (or a forged request, already critical): as before
+                new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
+                              method=method, window=(t0, t1), tolerances=tol)
+            else:
+                for key in ("margin", "epsilon", "method"):
+                    if c[key] != getattr(logged_req, key):
+                        find(CRITICAL, f"{key}={_short(c[key], 40)} differs from the logged request's "
+                                       f"{getattr(logged_req, key)}", k)
+                # the logged settings (ongoing rule, penetration_tol, ...) with this window's span,
+                # the certificate's margin/epsilon/method and the default budget per window
+                new = certify(scene, plan, request=logged_req.replace(
+                    margin=float(c["margin"]), epsilon=float(c["epsilon"]), method=method, window=(t0, t1)))
         except (MonitorError, ValueError, KeyError, TypeError, IndexError, OverflowError) as exc:
             out["errors"].append({"index": k, "sim_time": c.get("sim_time"),
                                   "error": f"{type(exc).__name__}: {str(exc)[:300]}"})

@@ -179,6 +179,13 @@ class Certificate:
         allowed: ((geom_a, geom_b, reason), ...) candidate pairs that were NOT checked
             because the allowed-contact matrix allows them (reasons ``Adjacent``,
             ``Default``, ``Always``, ``User``; see :mod:`monitor.acm`), for audit.
+        request: the :class:`~monitor.certify.request.CertifyRequest` this certificate
+            answers (set by :func:`monitor.certify`; None for a certificate made otherwise,
+            e.g. by :meth:`from_dict` or ``dataclasses.replace``). It is not a dataclass
+            field, so NOT part of equality, ``repr`` or :meth:`to_dict`: two certificates
+            of the same window compare equal whatever request object made them, and logs
+            and :meth:`from_dict` are unchanged (a log stores the run's request once, in
+            its metadata; see :mod:`monitor.log.writer`).
     """
 
     verdict: Verdict
@@ -192,6 +199,9 @@ class Certificate:
     pairs: tuple[PairResult, ...] = _PairsField()  # type: ignore[assignment]
     stats: dict[str, Any] = field(default_factory=dict)
     allowed: tuple[tuple[str, str, str], ...] = ()
+    # Not a dataclass field (no annotation): outside __init__, ==, repr, to_dict and replace().
+    # monitor.certify sets it in the instance's __dict__ (the dataclass is frozen).
+    request = None
 
     @classmethod
     def _trusted(cls, verdict: Verdict, window: tuple[float, float], margin: float, epsilon: float,

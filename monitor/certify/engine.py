@@ -53,7 +53,8 @@ from monitor.certify.common import (
     PairOutcome,
     active_budget,
 )
-from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule, deepen
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, deepen
+from monitor.certify.request import DEFAULT_EPSILON, BudgetLimits, CertifyRequest
 from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
 from monitor.tolerances import DEFAULT, Tolerances
@@ -249,11 +250,103 @@ def _make_budget(budget: Any) -> Budget:
     raise InvalidInputError(f"budget must be None, a Budget or a dict, got {type(budget).__name__}")
 
 
-def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
+_REQUESTS: dict[tuple, CertifyRequest] = {}
+"""Memo of the requests :func:`_request_of` built from plain keyword values (bounded; see there)."""
+_NO_KEY = object()
+_LAST_REQUEST: list[tuple | None] = [None]
+"""The argument objects of the last memoised keyword call with ``budget=None`` and its request."""
+
+
+def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any, tolerances: Any,
+                pairs: Any, ongoing: Any, penetration_tol: Any) -> CertifyRequest:
+    """The :class:`CertifyRequest` of ``certify``'s keyword arguments.
+
+    Validation happens in ONE place, ``CertifyRequest.__post_init__``; its messages name the
+    field as ``CertifyRequest.<field>`` and here they name the keyword instead (the prefix
+    is dropped: ``margin must be >= 0, got -0.1``), as ``certify`` always said.
+
+    Requests are memoised for plain values only (``margin``, ``epsilon``, ``penetration_tol``
+    exact floats, ``window`` None or a tuple of two floats, ``pairs`` None, ``budget`` None or
+    a :class:`Budget` (keyed by its limits), ``tolerances`` by identity): such a key decides
+    the validated request completely, so a hit is the request validation would build, and
+    a loop certifying many windows with the same settings validates them once.
+    """
+    last = _LAST_REQUEST[0]
+    if (budget is None and last is not None and last[0] is margin and last[1] is epsilon
+            and last[2] is method and last[3] is window and last[4] is tolerances and last[5] is pairs
+            and last[6] is ongoing and last[7] is penetration_tol
+            and last[8] == DEFAULT_BUDGET_SECONDS):
+        # the very objects of the previous call (a loop certifying window after window): immutable
+        # values (floats, strings, a frozen Tolerances, a tuple of floats or None) that were
+        # validated into last[9]; a mutable Budget never takes this path
+        return last[9]
+    if budget is None:  # the engine's default seconds, read now (tests patch it)
+        bkey: Any = DEFAULT_BUDGET_SECONDS
+    elif type(budget) is Budget:
+        bkey = (budget.seconds, budget.tests)
+    else:
+        bkey = _NO_KEY
+    key = None
+    if (bkey is not _NO_KEY and pairs is None and type(margin) is float and type(epsilon) is float
+            and type(penetration_tol) is float
+            and (window is None or (type(window) is tuple and len(window) == 2
+                                    and type(window[0]) is float and type(window[1]) is float))):
+        key = (margin, epsilon, method, window, bkey, id(tolerances), ongoing, penetration_tol)
+        try:
+            hit = _REQUESTS.get(key)
+        except TypeError:  # an unhashable method / ongoing: validation names it below
+            hit, key = None, None
+        if hit is not None and hit.tolerances is tolerances:
+            if budget is None:
+                _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
+                                    penetration_tol, bkey, hit)
+            return hit
+    try:
+        req = CertifyRequest(margin=margin, epsilon=epsilon, method=method, window=window,
+                             budget=BudgetLimits(seconds=bkey) if budget is None else budget,
+                             pairs=pairs, tolerances=tolerances, ongoing=ongoing,
+                             penetration_tol=penetration_tol)
+    except InvalidInputError as exc:
+        msg = str(exc)
+        raise InvalidInputError(msg[len("CertifyRequest."):] if msg.startswith("CertifyRequest.")
+                                else msg) from None
+    if key is not None:
+        if budget is None:
+            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
+                                bkey, req)
+        if len(_REQUESTS) >= 64:
+            _REQUESTS.clear()
+        _REQUESTS[key] = req
+    return req
+
+
+def _check_no_clash(request: Any, given: tuple) -> CertifyRequest:
+    """``request`` itself, after checking that no keyword setting was given alongside it."""
+    if not isinstance(request, CertifyRequest):
+        raise InvalidInputError(f"request must be a CertifyRequest or None, got {type(request).__name__}")
+    clash = []
+    for (name, default), value in zip(_KW_DEFAULTS, given):
+        if value is default:
+            continue
+        try:
+            same = type(value) is type(default) and bool(value == default)
+        except Exception:  # noqa: BLE001 - an array or odd object is not the default
+            same = False
+        if not same:
+            clash.append(name)
+    if clash:
+        raise InvalidInputError(f"certify got request= together with {', '.join(clash)}=: pass the "
+                                f"setting(s) in the request (request.replace({clash[0]}=...)) or as "
+                                "keywords, not both")
+    return request
+
+
+def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT_EPSILON,
             method: Method | str = "auto", *,
             window: tuple[float, float] | None = None, budget: Budget | dict | None = None,
             tolerances: Tolerances = DEFAULT, pairs: list[tuple[str, str]] | None = None,
-            ongoing: str = "violation", penetration_tol: float = DEFAULT_PENETRATION_TOL) -> Certificate:
+            ongoing: str = "violation", penetration_tol: float = DEFAULT_PENETRATION_TOL,
+            request: CertifyRequest | None = None) -> Certificate:
     """Certify that the planned motion keeps every candidate pair at least ``margin`` apart.
 
     Args:
@@ -268,21 +361,30 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
             :class:`Budget`, or {"seconds": .., "tests": ..}. Checked inside every stage
             (motion bounds, broad phase, start pose, checkers, witness search); pairs
             left unfinished are "uncertain" (method ``"budget"`` when no checker ran).
+            A :class:`Budget` object is used as it is (its clock keeps running across
+            calls); a dict or None starts a fresh clock per call.
         tolerances: numerical tolerances.
         pairs: optional subset of candidate pairs (geom-name pairs) to certify.
         ongoing: ``"violation"`` (default: a pair closer than ``margin`` at t0 is a
             violation) or ``"deepen"`` (such a pair is an ongoing contact and only has to
             stay within ``penetration_tol`` of penetration; :mod:`monitor.certify.ongoing`).
         penetration_tol: metres of penetration an ongoing contact may reach (``"deepen"``).
+        request: a :class:`~monitor.certify.request.CertifyRequest` holding all of the
+            settings above (validated once, when it was made; its budget limits start a
+            fresh clock per call). With it, every keyword setting must be left at its
+            default. Without it, ``certify`` builds one from the keywords.
 
     Returns:
-        The :class:`Certificate`. ``stats["pairs"] == 0`` together with
+        The :class:`Certificate`; ``cert.request`` is the request it answers (the given
+        one, or the one built from the keywords; ``window`` None there means the plan's
+        span, which ``cert.window`` holds). ``stats["pairs"] == 0`` together with
         ``stats["nothing_checked"] is True`` means the scene has no candidate pair:
         the verdict is "certified" only because there is nothing to check.
 
     Raises:
         InvalidInputError: bad margin / epsilon / window / method / pairs / budget
-            (NaN, ranges, field types).
+            (NaN, ranges, field types), a ``request`` that is not a CertifyRequest, or a
+            keyword setting given together with ``request`` (the message names it).
         ModelMismatchError: the plan belongs to a different model, or the scene's model
             was edited in place in a way the scene cannot be rebuilt for.
 
@@ -292,39 +394,49 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
     ``margin`` is not added (see :mod:`monitor.scene`): pass ``margin`` explicitly.
     """
     wall0 = time.perf_counter()
-    tol = tolerances
-    margin = _finite("margin", margin)
-    if margin < 0:
-        raise InvalidInputError(f"margin must be >= 0, got {margin}")
-    epsilon = _finite("epsilon", epsilon)
-    if epsilon <= 0:
-        raise InvalidInputError(f"epsilon must be > 0, got {epsilon}")
-    if method not in _METHODS:
-        raise InvalidInputError(f"method must be one of {_METHODS}, got {method!r}")
+    if request is None:
+        req = _request_of(margin, epsilon, method, window, budget, tolerances, pairs, ongoing,
+                          penetration_tol)
+    else:
+        d = _KW_DEFAULT_OBJECTS
+        if (type(request) is CertifyRequest and margin is d[0] and epsilon is d[1] and method is d[2]
+                and window is None and budget is None and tolerances is d[5] and pairs is None
+                and ongoing is d[7] and penetration_tol is d[8]):
+            req = request  # every keyword setting left at its default object (the common case)
+        else:
+            req = _check_no_clash(request, (margin, epsilon, method, window, budget, tolerances, pairs,
+                                            ongoing, penetration_tol))
+    # a live Budget keeps its clock (and test count); otherwise the request's limits, fresh clock
+    lim = req.budget
+    if isinstance(budget, Budget):
+        bud = budget
+    elif lim.tests is None:
+        bud = Budget.default(lim.seconds)  # = req.new_budget(), inlined (per call)
+    else:
+        bud = req.new_budget()
+    margin, epsilon, method, tol = req.margin, req.epsilon, req.method.value, req.tolerances
+    ongoing, pen_tol = req.ongoing, req.penetration_tol
     plan = _check_model(scene, plan)
     pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
-    if window is None:
+    if req.window is None:
         t0, t1 = pt0, pt1
     else:
-        try:
-            t0, t1 = (_finite("window[0]", window[0]), _finite("window[1]", window[1]))
-        except (TypeError, IndexError) as exc:
-            raise InvalidInputError(f"window must be (t0, t1), got {window!r}") from exc
+        t0, t1 = req.window
         if t0 < pt0 or t1 > pt1:
             raise InvalidInputError(f"window ({t0}, {t1}) is not inside the plan span ({pt0}, {pt1})")
     if not t1 > t0:
         raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
-    bud = _make_budget(budget)
-    pen_tol = check_rule(ongoing, penetration_tol)
     allowed = getattr(scene, "allowed_pairs", ())
     if type(allowed) is not tuple:
         allowed = tuple(allowed)
-    sel = _select(scene, pairs)
+    sel = _select(scene, req.pairs)
     if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
-        return Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
+        cert = Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
                            (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                 "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
                                 "budget_exhausted": False, "nothing_checked": True}, allowed)
+        cert.__dict__["request"] = req
+        return cert
     fast = _fast_inputs(scene, plan)
     # the compiled path builds no PairResult objects (cert.pairs is built on first read)
     stage = _stage_budget(bud, len(sel) if fast is None else 0)
@@ -339,7 +451,14 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = 1e-3,
     if ongoing == "deepen" and cert.verdict != "certified":
         cert = deepen(certify, scene, plan, cert, margin=margin, epsilon=epsilon, method=method,
                       budget=bud, tolerances=tol, penetration_tol=pen_tol)
+    cert.__dict__["request"] = req  # not a compared field: certificates stay equal, to_dict unchanged
     return cert
+
+
+_KW_DEFAULTS = (tuple(zip(("margin", "epsilon", "method"), certify.__defaults__))
+                + tuple(kv for kv in certify.__kwdefaults__.items() if kv[0] != "request"))
+"""``certify``'s keyword settings and their default objects (the ones a ``request=`` replaces)."""
+_KW_DEFAULT_OBJECTS = tuple(d for _, d in _KW_DEFAULTS)
 
 
 def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,

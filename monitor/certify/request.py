@@ -25,6 +25,8 @@ import numbers
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+from monitor.certify import common as _common
+from monitor.certify.common import Budget
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, ONGOING_RULES
 from monitor.certify.types import Method, as_method
 from monitor.errors import InvalidInputError
@@ -74,10 +76,8 @@ class BudgetLimits:
     @classmethod
     def of(cls, budget: Any) -> BudgetLimits:
         """Limits from None (the engine's default seconds), a dict, a BudgetLimits or a Budget's limits."""
-        from monitor.certify.common import DEFAULT_BUDGET_SECONDS, Budget
-
         if budget is None:
-            return cls(seconds=DEFAULT_BUDGET_SECONDS)
+            return cls(seconds=_common.DEFAULT_BUDGET_SECONDS)
         if isinstance(budget, BudgetLimits):
             return budget
         if isinstance(budget, Budget):
@@ -174,9 +174,20 @@ class CertifyRequest:
 
     def new_budget(self) -> Any:
         """A fresh :class:`~monitor.certify.common.Budget` with these limits (its clock starts now)."""
-        from monitor.certify.common import Budget
+        b = self.budget
+        # Budget.default is Budget(seconds=...) field for field, without the dataclass init
+        return Budget.default(b.seconds) if b.tests is None else Budget(seconds=b.seconds, tests=b.tests)
 
-        return Budget(seconds=self.budget.seconds, tests=self.budget.tests)
+    def _with_pairs(self, pairs: tuple[tuple[str, str], ...] | None) -> CertifyRequest:
+        """A copy with ``pairs`` set, without validating again (internal: the gate's subset calls).
+
+        ``pairs`` must already be what ``__post_init__`` makes of a valid value: a tuple of
+        (str, str) tuples (e.g. names taken from ``scene.candidate_pairs``), or None.
+        """
+        out = object.__new__(type(self))
+        out.__dict__.update(self.__dict__)
+        out.__dict__["pairs"] = pairs
+        return out
 
     def replace(self, **changes: Any) -> CertifyRequest:
         """A copy with ``changes`` applied (validated again)."""

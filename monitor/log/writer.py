@@ -4,7 +4,9 @@ File layout (one MCAP file per run; timestamps and payload fields: :mod:`monitor
 
 * header, then the ``monitor.run`` metadata (package and MuJoCo versions, margin,
   epsilon, pair policy, predictor, ...; strings stored as is, other values as JSON
-  text listed under ``_json_keys``) and the model attachments (``model.xml`` +
+  text listed under ``_json_keys``; a gate's log also holds ``"request"``, its
+  :meth:`monitor.certify.request.CertifyRequest.to_json`, which ``review --verify``
+  re-derives every window with) and the model attachments (``model.xml`` +
   ``assets/*.stl`` + ``model.mjb``, ``log_time``/``create_time`` = wall clock at open)
   **first**, so that even a killed writer leaves a log that review can re-verify;
 * per window: ``/monitor/plan``, ``/monitor/certificate``, ``/monitor/violation``
