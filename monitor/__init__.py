@@ -35,6 +35,8 @@ _LAZY = {
     "Witness": "monitor.certify.certificate",
     "Verdict": "monitor.certify.types",
     "Method": "monitor.certify.types",
+    "CertifyRequest": "monitor.certify.request",
+    "BudgetLimits": "monitor.certify.request",
     "Gate": "monitor.gate",
     "StepReport": "monitor.gate",
     "SafetyGate": "monitor.gym_gate",
@@ -57,7 +59,13 @@ def __getattr__(name: str) -> Any:
     mod = _LAZY.get(name)
     if mod is None:
         raise AttributeError(f"module 'monitor' has no attribute {name!r}")
-    value = getattr(importlib.import_module(mod), name)
+    if name == "certify":
+        # the callable subpackage (forwards to engine.certify), never the bare function:
+        # binding the function here would shadow the package, and a later
+        # ``import monitor.certify.engine as e`` would then fail
+        value = importlib.import_module("monitor.certify")
+    else:
+        value = getattr(importlib.import_module(mod), name)
     globals()[name] = value
     return value
 

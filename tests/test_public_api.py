@@ -44,3 +44,19 @@ def test_certify_is_callable_after_submodule_import(tmp_path):
     assert certify is engine_certify
     with pytest.raises(monitor.InvalidInputError):
         monitor.certify(None, None, epsilon=-1.0)
+
+
+def test_from_monitor_import_certify_does_not_shadow_the_subpackage():
+    """Regression: ``from monitor import certify`` bound the bare function to ``monitor.certify``,
+    so a later ``import monitor.certify.engine as e`` failed (a test file that did so errored at
+    collection when run after one that imported ``certify`` first). Fresh interpreter: import order."""
+    import subprocess
+    import sys
+
+    code = ("from monitor import certify\n"
+            "import monitor.certify.engine as engine\n"
+            "import monitor\n"
+            "assert callable(certify) and monitor.certify is certify\n"
+            "assert engine.certify.__module__ == 'monitor.certify.engine'\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
