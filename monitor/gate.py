@@ -1545,7 +1545,10 @@ class Gate:
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,
                     # every certify setting (ongoing rule, tolerances, budget, ...): review --verify
                     # re-derives each window with it (CertifyRequest.from_json)
-                    "request": self.request.to_json()}
+                    "request": self.request.to_json(),
+                    # candidate pairs the allowed-contact matrix took out (never certified):
+                    # review --verify rebuilds the scene with them
+                    "allowed_pairs": [list(a) for a in self.scene.allowed_pairs]}
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True

@@ -348,6 +348,36 @@ def _rebuild_plan(model: Any, msg: dict[str, Any]) -> Any:
     return Plan(times, qpos, model=model, **kw)
 
 
+_ALLOWED_REASONS = ("Adjacent", "Default", "Always", "User")
+
+
+def _logged_allowed(run: dict[str, Any], find: Callable[..., None], notes: list[str]) -> list | None:
+    """The run's allowed (never certified) candidate pairs as (geom_a, geom_b, reason) triples, or None.
+
+    A gate logs the pairs its allowed-contact matrix took out of the candidate set
+    (``allowed_pairs``, issue 13: e.g. ``allowed="auto"`` frees a resting contact at the first
+    state); the scene is rebuilt with them so the re-derived pair set is the run's. Each one
+    is listed in a note (an auditor sees what was not certified). Malformed: a CRITICAL finding
+    and the scene is rebuilt without them (then the pair sets differ, also CRITICAL).
+    """
+    raw = run.get("allowed_pairs")
+    if raw is None:
+        return None
+    ok = isinstance(raw, list) and all(
+        isinstance(r, list) and len(r) == 3 and all(isinstance(x, str) for x in r)
+        and r[2] in _ALLOWED_REASONS for r in raw)
+    if not ok:
+        find(CRITICAL, f"run metadata allowed_pairs is malformed (want [[geom_a, geom_b, reason], ...] with "
+                       f"reason in {_ALLOWED_REASONS}): {_short(raw, 120)}")
+        return None
+    if raw:
+        reasons = Counter(r[2] for r in raw)
+        shown = ", ".join(f"{a}/{b} ({why})" for a, b, why in raw[:8]) + (" ..." if len(raw) > 8 else "")
+        notes.append(f"the run allowed {len(raw)} candidate pair(s) ({dict(sorted(reasons.items()))}); "
+                     f"they were not certified, in the log nor here: {shown}")
+    return [tuple(r) for r in raw]
+
+
 def _logged_request(run: dict[str, Any], tol: Any, find: Callable[..., None],
                     notes: list[str]) -> Any:
     """The run's logged :class:`~monitor.certify.request.CertifyRequest`, ready to re-derive with.
@@ -585,9 +615,11 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            f"{expect_pairs!r}")
         policy = expect_pairs
     scene = None
+    allowed = _logged_allowed(run, find, notes)
     if policy is not None:
         try:
-            scene = scene_cls.from_model(model, pairs=policy, tolerances=tol)
+            scene = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                         **({"allowed": allowed} if allowed else {}))
         except (MonitorError, ValueError, TypeError) as exc:
             find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not valid for the attached "
                            f"model: {exc}")

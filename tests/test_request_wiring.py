@@ -262,3 +262,32 @@ def test_a_forged_request_in_the_file_is_found_by_the_cli(model, tmp_path, capsy
     assert main(["review", "--verify", str(forged)]) == 1
     out = capsys.readouterr().out
     assert "request is malformed" in out and "penetration_tol" in out
+
+
+def test_review_of_a_default_gate_knows_its_allowed_resting_contact(model, tmp_path):
+    """Regression: with the default ``allowed="auto"`` the ball resting on the floor at the first
+    state is an allowed pair (never certified); review rebuilt the scene without it, so every
+    window was a CRITICAL "certificate pairs differ". The log now carries the allowed pairs."""
+    from monitor import review
+    from monitor.gate import Gate
+    from monitor.log import read_log
+
+    path = tmp_path / "ball_auto.mcap"
+    data = mujoco.MjData(model)
+    with Gate(model, pairs="all", log=path, frame_skip=5) as gate:
+        for _ in range(10):
+            gate.step(data, np.zeros(0))
+        allowed = gate.scene.allowed_pairs
+    assert [tuple(a[:2]) for a in allowed] in ([("floor", "ball")], [("ball", "floor")])
+    contents = read_log(path)
+    ver = review.verify(contents)
+    assert ver["checked"] >= 10 and ver["critical"] == 0, ver["findings"]
+    assert any("allowed 1 candidate pair" in n for n in ver["notes"]), ver["notes"]
+    # without the record (a log from before): the pair sets differ on every window, as before
+    old = read_log(path)
+    old.run.pop("allowed_pairs")
+    assert review.verify(old)["critical"] >= 10
+    # a forged record (unknown reason) is a critical finding, never a traceback
+    bad = read_log(path)
+    bad.run["allowed_pairs"] = [["floor", "ball", "Because"]]
+    assert review.verify(bad)["critical"] > 0
