@@ -95,7 +95,7 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import body_bound, body_pose, tree_bounds
+from monitor.motion.kernel import body_pose, pair_bound, pair_workspace, tree_bounds
 
 # ---------------------------------------------------------------------------- codes
 
@@ -448,12 +448,17 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
 # callers still get a compiled pair_window. Small helpers stay separate functions (inlining them
 # per call site costs more compile time), and nothing Python never calls gets a CPython wrapper.
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
-def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad):
+def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
     Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
     precomputed max |v - ref| of A and B. ``stats[0]`` is incremented when a paper
     ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
+    ``pws``: :func:`monitor.motion.kernel.pair_workspace` scratch (allocated once per search).
+
+    Both bodies' motion bounds come from ONE :func:`monitor.motion.kernel.pair_bound` pass
+    (the same numbers as two ``body_bound`` calls, without the second FK of their common
+    ancestors and without per-call allocations; issue 12, long windows).
 
     A body the motion does not move (``mp.body_moving[b] == 0``: no coordinate on its
     chain changes anywhere in the trajectory) has bound (0, 0) and the same pose at
@@ -462,14 +467,10 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     the caller must have written it into (pA, RA) / (pB, RB) (:func:`pair_window` does).
     """
     ba, bb = gp.body[ga], gp.body[gb]
-    if mp.body_moving[ba] != 0:
-        TA, angA = body_bound(mp, ba, ta, tb, pA, RA)
-    else:
-        TA, angA = 0.0, 0.0
-    if mp.body_moving[bb] != 0:
-        TB, angB = body_bound(mp, bb, ta, tb, pB, RB)
-    else:
-        TB, angB = 0.0, 0.0
+    TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
+    mva, mvb = mp.body_moving[ba] != 0, mp.body_moving[bb] != 0
+    if mva or mvb:
+        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws)
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
     hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
@@ -557,6 +558,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
+    pws = pair_workspace(mp)
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     if gp.kind[ga] != -1:
@@ -633,7 +635,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             if b > a:
                 depth = max(0.0, math.ceil(math.log2(W / (b - a)) - 1e-9))
         m = 0.5 * (a + b)
-        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad)
+        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws)
         spent += 1
         res[R_TESTS] += 1.0
         if depth > res[R_DEPTH]:
