@@ -135,6 +135,8 @@ _STEP_SAFETY = 0.85
 """Adaptive sub-intervals: aim the next interval's bound at this share of the predicted gap."""
 _STEP_GROW = 4.0
 """Adaptive sub-intervals: at most this growth of the step after an exclusion."""
+_PROF_RETRY_MIN = 1.0 / 32.0
+"""Adaptive sub-intervals: a retry guided by the motion profile may shrink the prefix down to this share."""
 _STEP_HEADROOM = 4.0
 """Adaptive sub-intervals: the early-exit GJK is asked to prove this many bounds of clearance
 (a better distance estimate for the next step; exclusion still needs one bound)."""
@@ -511,6 +513,85 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _path_profile(body_parent, body_moving, body_jntadr, body_jntnum, jnt_type, jnt_qposadr, jnt_track, qpos,
+                  qt_phi, ba, bb, cum):
+    """Step-control profile of a pair: cum (K,) = joint path length up to waypoint k (heuristic only).
+
+    The sum over the joints on the chains root -> ba and root -> bb (moving bodies only) of
+    the path length of their coordinates from the first waypoint to waypoint k: hinge and
+    slide |dq| (rad and m, unweighted), free-joint positions |dp| (m), ball / free rotations
+    the slerp angle of each segment (rad). Piecewise linear in t between waypoints, like the
+    interpolated motion; its increase over an interval is a rough, uncalibrated measure of
+    how much the pair moves there. Takes the pack's arrays, not the pack (compile cost).
+    """
+    K = qpos.shape[0]
+    for k in range(K):
+        cum[k] = 0.0
+    seen = np.zeros(body_parent.shape[0], np.int64)
+    for body in (ba, bb):
+        c = body
+        while c != 0 and seen[c] == 0:
+            seen[c] = 1
+            if body_moving[c] != 0:
+                for j in range(body_jntadr[c], body_jntadr[c] + body_jntnum[c]):
+                    typ = jnt_type[j]
+                    adr = jnt_qposadr[j]
+                    if typ == 0 or typ == 1:
+                        tr = jnt_track[j]
+                        for i in range(K - 1):
+                            cum[i + 1] += qt_phi[tr, i]
+                    if typ == 0:
+                        for i in range(K - 1):
+                            cum[i + 1] += _norm3(qpos[i + 1, adr] - qpos[i, adr],
+                                                 qpos[i + 1, adr + 1] - qpos[i, adr + 1],
+                                                 qpos[i + 1, adr + 2] - qpos[i, adr + 2])
+                    elif typ >= 2:
+                        for i in range(K - 1):
+                            cum[i + 1] += abs(qpos[i + 1, adr] - qpos[i, adr])
+            c = body_parent[c]
+    for k in range(1, K):
+        cum[k] += cum[k - 1]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _profile_at(times, cum, t):
+    """The profile of :func:`_path_profile` at time t (linear between waypoints, clamped)."""
+    K = times.shape[0]
+    if not t > times[0]:
+        return cum[0]
+    if not t < times[K - 1]:
+        return cum[K - 1]
+    lo, hi = 0, K - 1        # times[lo] < t < times[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if times[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    s = (t - times[lo]) / (times[hi] - times[lo])
+    return cum[lo] + s * (cum[hi] - cum[lo])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _profile_inv(times, cum, v):
+    """The first time at which the profile reaches v (times[-1] when it never does)."""
+    K = times.shape[0]
+    if not v > cum[0]:
+        return times[0]
+    if not v < cum[K - 1]:
+        return times[K - 1]
+    lo, hi = 0, K - 1        # cum[lo] < v <= cum[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if cum[mid] < v:
+            lo = mid
+        else:
+            hi = mid
+    s = (v - cum[lo]) / (cum[hi] - cum[lo])
+    return times[lo] + s * (times[hi] - times[lo])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _push(stack, sp, a, b, depth):
     stack[sp, 0] = a
     stack[sp, 1] = b
@@ -559,6 +640,10 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
     pws = pair_workspace(mp)
+    times = mp.times
+    cum = np.empty(times.shape[0])      # step control only (see _path_profile)
+    _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum, mp.jnt_type, mp.jnt_qposadr,
+                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     if gp.kind[ga] != -1:
@@ -603,6 +688,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
             spent += 1
             res[R_TESTS] += 1.0
+            res[R_START_LO] = lo        # (the step control's gap at t0, as window_kernel's row)
             if up + approx < margin:
                 res[R_WTIME] = t0
                 for r in range(3):
@@ -702,8 +788,11 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 excluded = True
         # -- step control (heuristic only: coverage and soundness never depend on it) -------
         slope = 0.0
+        gap_a = res[R_START_LO] - margin if a == t0 else np.nan   # gap at a, when known (> 0 only)
         if stack[mem, 2] == 1.0 and m != stack[mem, 0]:
             slope = (gap - stack[mem, 1]) / (m - stack[mem, 0])
+            if not gap_a == gap_a:
+                gap_a = stack[mem, 1]          # the last test's (its midpoint is before a)
         if gap == gap and abs(gap) < np.inf:
             stack[mem, 0] = m
             stack[mem, 1] = gap
@@ -732,11 +821,27 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             continue
         if sweep:
             if bound >= epsilon and depth < max_depth and a < m < b:
+                # Retry with the motion profile (_path_profile): bound ~ ratio x (profile increase),
+                # calibrated on this test. A long window whose motion is fast at its start (the
+                # window, the start of a braking tail) and slow after it has a bound that does not
+                # shrink in proportion to the prefix; the linear model (rate) then retries prefixes
+                # that still fail.
+                Aa = _profile_at(times, cum, a)
+                Ab = _profile_at(times, cum, b)
+                ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
+                prof = ratio > 0.0 and ratio < np.inf
                 L_new = 0.5 * L_old
-                if den > 0.0 and gap > 0.0:
+                # a shorter prefix's midpoint lies between a and m: the smaller known gap
+                g_pre = min(gap, gap_a) if gap_a > 0.0 else gap
+                if prof and g_pre > 0.0:
+                    L_new = _profile_inv(times, cum, Aa + _STEP_SAFETY * g_pre / ratio) - a
+                elif den > 0.0 and gap > 0.0:
                     L_new = _STEP_SAFETY * gap / den
-                L_new = min(max(L_new, 0.125 * L_old), 0.5 * L_old)
-                if rate * L_new >= epsilon and L_new >= Lmin:
+                L_new = min(max(L_new, (_PROF_RETRY_MIN if prof else 0.125) * L_old), 0.5 * L_old)
+                pred = rate * L_new                 # the retry's predicted bound
+                if prof:
+                    pred = ratio * (_profile_at(times, cum, a + L_new) - Aa)
+                if pred >= epsilon and L_new >= Lmin:
                     sp = _push(stack, sp, a, e, -L_new)     # retry a shorter prefix of [a, e]
                     continue
             if b < e:
