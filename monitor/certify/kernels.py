@@ -95,7 +95,7 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import body_pose, pair_bound, pair_workspace, tree_bounds
+from monitor.motion.kernel import _search_right, body_pose, pair_bound, pair_workspace, tree_bounds
 
 # ---------------------------------------------------------------------------- codes
 
@@ -826,10 +826,16 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 # window, the start of a braking tail) and slow after it has a bound that does not
                 # shrink in proportion to the prefix; the linear model (rate) then retries prefixes
                 # that still fail.
-                Aa = _profile_at(times, cum, a)
-                Ab = _profile_at(times, cum, b)
-                ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
-                prof = ratio > 0.0 and ratio < np.inf
+                # Only across waypoints: inside one segment the motion is one smooth piece and the
+                # linear model is kept (same steps as before on single-segment motions).
+                ia = _search_right(times, a)
+                prof = False
+                Aa, ratio = 0.0, np.nan
+                if ia < times.shape[0] and times[ia] < b:
+                    Aa = _profile_at(times, cum, a)
+                    Ab = _profile_at(times, cum, b)
+                    ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
+                    prof = ratio > 0.0 and ratio < np.inf
                 L_new = 0.5 * L_old
                 # a shorter prefix's midpoint lies between a and m: the smaller known gap
                 g_pre = min(gap, gap_a) if gap_a > 0.0 else gap
@@ -838,10 +844,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 elif den > 0.0 and gap > 0.0:
                     L_new = _STEP_SAFETY * gap / den
                 L_new = min(max(L_new, (_PROF_RETRY_MIN if prof else 0.125) * L_old), 0.5 * L_old)
-                pred = rate * L_new                 # the retry's predicted bound
-                if prof:
-                    pred = ratio * (_profile_at(times, cum, a + L_new) - Aa)
-                if pred >= epsilon and L_new >= Lmin:
+                if rate * L_new >= epsilon and L_new >= Lmin:
                     sp = _push(stack, sp, a, e, -L_new)     # retry a shorter prefix of [a, e]
                     continue
             if b < e:
