@@ -1001,6 +1001,20 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
     not move are decided by it (certified if ``lower > margin``, else left to Python);
     the rest run :func:`pair_window` (MODE_CERTIFY_ONLY) unless routed to Python.
+    Long windows (the window and its braking tail in one call; at least T waypoints inside
+    the window, so single-segment motions keep the whole-window search): a pair of two cores runs
+    :func:`pair_window` only over ``[ta_f, tb_l]``, from the first to the last of the T
+    sub-ranges where its swept spheres are NOT further apart than the margin. Every other
+    sub-range ``[ta_j, tb_j]`` (the same edges as stage 0, bit for bit) is clear: geom g's
+    swept sphere of sub-range j (centre at the sub-range midpoint pose, radius = bounding
+    radius + the motion bound ``trans + chord(angle) (|c_g - ref| + r_g)``, padded) contains
+    every posture of the geom on ``[ta_j, tb_j]`` (the motion-bound contract), so a sphere
+    gap > margin (after the rounding pad, as the broad phase culls) proves the distance
+    > margin there. The narrow phase's exclusion test is a whole-solid test, so a sub-window
+    that starts after t0 needs no start-pose argument (module docstring). A certificate's
+    clearance is the smaller of the narrow phase's and the cleared sub-ranges' sphere gaps;
+    a witness (earliest in ``[ta_f, tb_l]``) is the earliest one, as everything before
+    ``ta_f`` is clear.
 
     Returns:
         S (stage 0) or the number of survivor slots processed (stage 1).
@@ -1123,6 +1137,13 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         k0 = 0
         k1 = min(k1, S)
     # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
+    # a long window: at least as many waypoints inside [t0, t1] as sub-ranges (a window and its
+    # braking tail); single-segment motions keep the whole-window search
+    n_in = 0
+    for i in range(mp.times.shape[0]):
+        if t0 < mp.times[i] < t1:
+            n_in += 1
+    long_window = n_in >= sc.shape[0]
     stack = np.empty((max_depth + 2, 3))
     out = np.empty(OUT_SIZE)
     w = np.empty(3)
@@ -1167,8 +1188,33 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         if route.shape[0] > 0 and route[s] == 0:
             continue                   # extrusion route: the Python pipeline
         row[R_STARTED] = 2.0
-        v = pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
+        # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
+        # windows): only the span from the first to the last sub-range where they are not goes
+        # to the narrow phase (see the docstring: "Stage 1").
+        ta_s, tb_s, sph = t0, t1, np.inf
+        if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
+            T = sc.shape[0]
+            step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
+            jf, jl = -1, -1
+            gaps = np.empty(T)
+            for t in range(T):
+                d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
+                            sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
+                gaps[t] = d
+                if not (d > margin and d < np.inf):
+                    if jf < 0:
+                        jf = t
+                    jl = t
+            if jf >= 0:
+                ta_s = t0 if jf == 0 else jf * step + t0
+                tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                for t in range(T):
+                    if (t < jf or t > jl) and gaps[t] < sph:
+                        sph = gaps[t]
+        v = pair_window(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
                         rel_pad, abs_pad, stack, row)
+        if v == CERTIFIED and sph < row[R_CLEAR]:
+            row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
         info[WI_TESTS] += row[R_TESTS]
         row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
         if row[R_DEPTH] > info[WI_DEPTH]:
