@@ -44,7 +44,11 @@ with a step L chosen so that the next bound is about ``_STEP_SAFETY`` x the gap 
 at its midpoint (distance estimate and slope from the last two tests, bound per second
 from the last test; at most ``_STEP_GROW`` x, at least half the last step and a bound of
 about ``epsilon``). A prefix that is not excluded is retried shorter while its bound
-stays >= epsilon; once the step would go below the epsilon scale (or at ``max_depth``)
+stays >= epsilon (a prefix that crosses a waypoint: the length at which the pair's motion
+profile, its cumulative joint path length calibrated by this test's bound, predicts
+``_STEP_SAFETY`` x the smaller known gap; long windows are fast at the start and slow in
+their braking tail, where a bound proportional to the prefix is far off); once the step
+would go below the epsilon scale (or at ``max_depth``)
 the whole rest ``[a, e]`` is bisected as before (so witnesses are looked for at the
 midpoints of the open region, and ``uncertain`` keeps its epsilon / depth meaning: only
 an interval with bound < epsilon or at ``max_depth`` is ever unresolved). Coverage: an
