@@ -44,7 +44,11 @@ with a step L chosen so that the next bound is about ``_STEP_SAFETY`` x the gap 
 at its midpoint (distance estimate and slope from the last two tests, bound per second
 from the last test; at most ``_STEP_GROW`` x, at least half the last step and a bound of
 about ``epsilon``). A prefix that is not excluded is retried shorter while its bound
-stays >= epsilon; once the step would go below the epsilon scale (or at ``max_depth``)
+stays >= epsilon (a prefix that crosses a waypoint: the length at which the pair's motion
+profile, its cumulative joint path length calibrated by this test's bound, predicts
+``_STEP_SAFETY`` x the smaller known gap; long windows are fast at the start and slow in
+their braking tail, where a bound proportional to the prefix is far off); once the step
+would go below the epsilon scale (or at ``max_depth``)
 the whole rest ``[a, e]`` is bisected as before (so witnesses are looked for at the
 midpoints of the open region, and ``uncertain`` keeps its epsilon / depth meaning: only
 an interval with bound < epsilon or at ``max_depth`` is ever unresolved). Coverage: an
@@ -95,7 +99,7 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import body_bound, body_pose, tree_bounds
+from monitor.motion.kernel import _search_right, body_pose, pair_bound, pair_workspace, tree_bounds
 
 # ---------------------------------------------------------------------------- codes
 
@@ -135,6 +139,8 @@ _STEP_SAFETY = 0.85
 """Adaptive sub-intervals: aim the next interval's bound at this share of the predicted gap."""
 _STEP_GROW = 4.0
 """Adaptive sub-intervals: at most this growth of the step after an exclusion."""
+_PROF_RETRY_MIN = 1.0 / 32.0
+"""Adaptive sub-intervals: a retry guided by the motion profile may shrink the prefix down to this share."""
 _STEP_HEADROOM = 4.0
 """Adaptive sub-intervals: the early-exit GJK is asked to prove this many bounds of clearance
 (a better distance estimate for the next step; exclusion still needs one bound)."""
@@ -448,12 +454,17 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
 # callers still get a compiled pair_window. Small helpers stay separate functions (inlining them
 # per call site costs more compile time), and nothing Python never calls gets a CPython wrapper.
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
-def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad):
+def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
     Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
     precomputed max |v - ref| of A and B. ``stats[0]`` is incremented when a paper
     ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
+    ``pws``: :func:`monitor.motion.kernel.pair_workspace` scratch (allocated once per search).
+
+    Both bodies' motion bounds come from ONE :func:`monitor.motion.kernel.pair_bound` pass
+    (the same numbers as two ``body_bound`` calls, without the second FK of their common
+    ancestors and without per-call allocations; issue 12, long windows).
 
     A body the motion does not move (``mp.body_moving[b] == 0``: no coordinate on its
     chain changes anywhere in the trajectory) has bound (0, 0) and the same pose at
@@ -462,14 +473,10 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     the caller must have written it into (pA, RA) / (pB, RB) (:func:`pair_window` does).
     """
     ba, bb = gp.body[ga], gp.body[gb]
-    if mp.body_moving[ba] != 0:
-        TA, angA = body_bound(mp, ba, ta, tb, pA, RA)
-    else:
-        TA, angA = 0.0, 0.0
-    if mp.body_moving[bb] != 0:
-        TB, angB = body_bound(mp, bb, ta, tb, pB, RB)
-    else:
-        TB, angB = 0.0, 0.0
+    TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
+    mva, mvb = mp.body_moving[ba] != 0, mp.body_moving[bb] != 0
+    if mva or mvb:
+        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws)
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
     hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
@@ -507,6 +514,85 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     S += _norm3(cA[0], cA[1], cA[2]) + _norm3(cB[0], cB[1], cB[2])
     pad = 8.0 * rel_pad * (best + (chA + chB) * S)
     return best * (1.0 + 8.0 * rel_pad) + pad
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _path_profile(body_parent, body_moving, body_jntadr, body_jntnum, jnt_type, jnt_qposadr, jnt_track, qpos,
+                  qt_phi, ba, bb, cum):
+    """Step-control profile of a pair: cum (K,) = joint path length up to waypoint k (heuristic only).
+
+    The sum over the joints on the chains root -> ba and root -> bb (moving bodies only) of
+    the path length of their coordinates from the first waypoint to waypoint k: hinge and
+    slide |dq| (rad and m, unweighted), free-joint positions |dp| (m), ball / free rotations
+    the slerp angle of each segment (rad). Piecewise linear in t between waypoints, like the
+    interpolated motion; its increase over an interval is a rough, uncalibrated measure of
+    how much the pair moves there. Takes the pack's arrays, not the pack (compile cost).
+    """
+    K = qpos.shape[0]
+    for k in range(K):
+        cum[k] = 0.0
+    seen = np.zeros(body_parent.shape[0], np.int64)
+    for body in (ba, bb):
+        c = body
+        while c != 0 and seen[c] == 0:
+            seen[c] = 1
+            if body_moving[c] != 0:
+                for j in range(body_jntadr[c], body_jntadr[c] + body_jntnum[c]):
+                    typ = jnt_type[j]
+                    adr = jnt_qposadr[j]
+                    if typ == 0 or typ == 1:
+                        tr = jnt_track[j]
+                        for i in range(K - 1):
+                            cum[i + 1] += qt_phi[tr, i]
+                    if typ == 0:
+                        for i in range(K - 1):
+                            cum[i + 1] += _norm3(qpos[i + 1, adr] - qpos[i, adr],
+                                                 qpos[i + 1, adr + 1] - qpos[i, adr + 1],
+                                                 qpos[i + 1, adr + 2] - qpos[i, adr + 2])
+                    elif typ >= 2:
+                        for i in range(K - 1):
+                            cum[i + 1] += abs(qpos[i + 1, adr] - qpos[i, adr])
+            c = body_parent[c]
+    for k in range(1, K):
+        cum[k] += cum[k - 1]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _profile_at(times, cum, t):
+    """The profile of :func:`_path_profile` at time t (linear between waypoints, clamped)."""
+    K = times.shape[0]
+    if not t > times[0]:
+        return cum[0]
+    if not t < times[K - 1]:
+        return cum[K - 1]
+    lo, hi = 0, K - 1        # times[lo] < t < times[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if times[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    s = (t - times[lo]) / (times[hi] - times[lo])
+    return cum[lo] + s * (cum[hi] - cum[lo])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _profile_inv(times, cum, v):
+    """The first time at which the profile reaches v (times[-1] when it never does)."""
+    K = times.shape[0]
+    if not v > cum[0]:
+        return times[0]
+    if not v < cum[K - 1]:
+        return times[K - 1]
+    lo, hi = 0, K - 1        # cum[lo] < v <= cum[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if cum[mid] < v:
+            lo = mid
+        else:
+            hi = mid
+    s = (v - cum[lo]) / (cum[hi] - cum[lo])
+    return times[lo] + s * (times[hi] - times[lo])
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -557,6 +643,11 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
+    pws = pair_workspace(mp)
+    times = mp.times
+    cum = np.empty(times.shape[0])      # step control only (see _path_profile)
+    _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum, mp.jnt_type, mp.jnt_qposadr,
+                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     if gp.kind[ga] != -1:
@@ -601,6 +692,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
             spent += 1
             res[R_TESTS] += 1.0
+            res[R_START_LO] = lo        # (the step control's gap at t0, as window_kernel's row)
             if up + approx < margin:
                 res[R_WTIME] = t0
                 for r in range(3):
@@ -633,7 +725,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             if b > a:
                 depth = max(0.0, math.ceil(math.log2(W / (b - a)) - 1e-9))
         m = 0.5 * (a + b)
-        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad)
+        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws)
         spent += 1
         res[R_TESTS] += 1.0
         if depth > res[R_DEPTH]:
@@ -700,8 +792,11 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 excluded = True
         # -- step control (heuristic only: coverage and soundness never depend on it) -------
         slope = 0.0
+        gap_a = res[R_START_LO] - margin if a == t0 else np.nan   # gap at a, when known (> 0 only)
         if stack[mem, 2] == 1.0 and m != stack[mem, 0]:
             slope = (gap - stack[mem, 1]) / (m - stack[mem, 0])
+            if not gap_a == gap_a:
+                gap_a = stack[mem, 1]          # the last test's (its midpoint is before a)
         if gap == gap and abs(gap) < np.inf:
             stack[mem, 0] = m
             stack[mem, 1] = gap
@@ -730,10 +825,29 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             continue
         if sweep:
             if bound >= epsilon and depth < max_depth and a < m < b:
+                # Retry with the motion profile (_path_profile): bound ~ ratio x (profile increase),
+                # calibrated on this test. A long window whose motion is fast at its start (the
+                # window, the start of a braking tail) and slow after it has a bound that does not
+                # shrink in proportion to the prefix; the linear model (rate) then retries prefixes
+                # that still fail.
+                # Only across waypoints: inside one segment the motion is one smooth piece and the
+                # linear model is kept (same steps as before on single-segment motions).
+                ia = _search_right(times, a)
+                prof = False
+                Aa, ratio = 0.0, np.nan
+                if ia < times.shape[0] and times[ia] < b:
+                    Aa = _profile_at(times, cum, a)
+                    Ab = _profile_at(times, cum, b)
+                    ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
+                    prof = ratio > 0.0 and ratio < np.inf
                 L_new = 0.5 * L_old
-                if den > 0.0 and gap > 0.0:
+                # a shorter prefix's midpoint lies between a and m: the smaller known gap
+                g_pre = min(gap, gap_a) if gap_a > 0.0 else gap
+                if prof and g_pre > 0.0:
+                    L_new = _profile_inv(times, cum, Aa + _STEP_SAFETY * g_pre / ratio) - a
+                elif den > 0.0 and gap > 0.0:
                     L_new = _STEP_SAFETY * gap / den
-                L_new = min(max(L_new, 0.125 * L_old), 0.5 * L_old)
+                L_new = min(max(L_new, (_PROF_RETRY_MIN if prof else 0.125) * L_old), 0.5 * L_old)
                 if rate * L_new >= epsilon and L_new >= Lmin:
                     sp = _push(stack, sp, a, e, -L_new)     # retry a shorter prefix of [a, e]
                     continue
@@ -891,6 +1005,20 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
     not move are decided by it (certified if ``lower > margin``, else left to Python);
     the rest run :func:`pair_window` (MODE_CERTIFY_ONLY) unless routed to Python.
+    Long windows (the window and its braking tail in one call; at least T waypoints inside
+    the window, so single-segment motions keep the whole-window search): a pair of two cores runs
+    :func:`pair_window` only over ``[ta_f, tb_l]``, from the first to the last of the T
+    sub-ranges where its swept spheres are NOT further apart than the margin. Every other
+    sub-range ``[ta_j, tb_j]`` (the same edges as stage 0, bit for bit) is clear: geom g's
+    swept sphere of sub-range j (centre at the sub-range midpoint pose, radius = bounding
+    radius + the motion bound ``trans + chord(angle) (|c_g - ref| + r_g)``, padded) contains
+    every posture of the geom on ``[ta_j, tb_j]`` (the motion-bound contract), so a sphere
+    gap > margin (after the rounding pad, as the broad phase culls) proves the distance
+    > margin there. The narrow phase's exclusion test is a whole-solid test, so a sub-window
+    that starts after t0 needs no start-pose argument (module docstring). A certificate's
+    clearance is the smaller of the narrow phase's and the cleared sub-ranges' sphere gaps;
+    a witness (earliest in ``[ta_f, tb_l]``) is the earliest one, as everything before
+    ``ta_f`` is clear.
 
     Returns:
         S (stage 0) or the number of survivor slots processed (stage 1).
@@ -1013,6 +1141,13 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         k0 = 0
         k1 = min(k1, S)
     # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
+    # a long window: at least as many waypoints inside [t0, t1] as sub-ranges (a window and its
+    # braking tail); single-segment motions keep the whole-window search
+    n_in = 0
+    for i in range(mp.times.shape[0]):
+        if t0 < mp.times[i] < t1:
+            n_in += 1
+    long_window = n_in >= sc.shape[0]
     stack = np.empty((max_depth + 2, 3))
     out = np.empty(OUT_SIZE)
     w = np.empty(3)
@@ -1057,8 +1192,33 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         if route.shape[0] > 0 and route[s] == 0:
             continue                   # extrusion route: the Python pipeline
         row[R_STARTED] = 2.0
-        v = pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
+        # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
+        # windows): only the span from the first to the last sub-range where they are not goes
+        # to the narrow phase (see the docstring: "Stage 1").
+        ta_s, tb_s, sph = t0, t1, np.inf
+        if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
+            T = sc.shape[0]
+            step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
+            jf, jl = -1, -1
+            gaps = np.empty(T)
+            for t in range(T):
+                d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
+                            sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
+                gaps[t] = d
+                if not (d > margin and d < np.inf):
+                    if jf < 0:
+                        jf = t
+                    jl = t
+            if jf >= 0:
+                ta_s = t0 if jf == 0 else jf * step + t0
+                tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                for t in range(T):
+                    if (t < jf or t > jl) and gaps[t] < sph:
+                        sph = gaps[t]
+        v = pair_window(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
                         rel_pad, abs_pad, stack, row)
+        if v == CERTIFIED and sph < row[R_CLEAR]:
+            row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
         info[WI_TESTS] += row[R_TESTS]
         row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
         if row[R_DEPTH] > info[WI_DEPTH]:

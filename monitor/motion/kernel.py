@@ -577,11 +577,15 @@ def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
-                 trans: np.ndarray, angle: np.ndarray) -> None:
+                 trans: np.ndarray, angle: np.ndarray, ws) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
 
     ``need`` must be closed under ancestors. Fills xpos (nbody, 3), xmat (nbody, 3, 3),
     trans (nbody,) m and angle (nbody,) rad for those bodies (0 for static ones).
+    ``ws``: the scratch arrays of :func:`bounds_workspace` (contents on entry do not matter:
+    the arrays that must start at zero are zeroed here), so a caller that evaluates many
+    sub-intervals allocates them once (issue 12, long windows: the ~20 allocations were
+    about half of a bound's cost). The results are the same numbers as with fresh arrays.
     """
     rel = mp.tol[TOL_REL]
     abs_pad = mp.tol[TOL_ABS]
@@ -591,8 +595,6 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     pathmag = mp.tol[TOL_PATHMAG]
     times = mp.times
     nbody = xpos.shape[0]
-    njnt = mp.jnt_type.shape[0]
-    nq = mp.qpos.shape[1]
 
     tm = 0.5 * (ta + tb)
     la = _locate(times, ta)
@@ -600,12 +602,9 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     lm = _locate(times, tm)
     lo = _search_right(times, ta)
     hi = _search_left(times, tb)
-    qm = np.empty(nq)
+    (qm, xquat, janchor, jaxis, jframe, vkind, vanchor, vaxis, vcoef, vang, vrate, qu, om, chain, stack,
+     p_ref, D, r0, suffix, rmax) = ws
     _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, lm[0], lm[1], lm[2], qm)
-    xquat = np.empty((nbody, 4))
-    janchor = np.empty((njnt, 3))
-    jaxis = np.empty((njnt, 3))
-    jframe = np.empty((njnt, 4))
     _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
         mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
         qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
@@ -620,15 +619,12 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
         h = max(max(s_b - lm[1], lm[1] - la[1]), 0.0)
 
     # Virtual joints (2 slots per joint: [2j] translation / single, [2j+1] free rotation).
-    nv = 2 * njnt
-    vkind = np.empty(nv, dtype=np.int64)
-    vanchor = np.zeros((nv, 3))
-    vaxis = np.zeros((nv, 3))
-    vcoef = np.zeros(nv)
-    vang = np.zeros(nv)
-    vrate = np.zeros((nv, 3))
-    qu = np.empty(4)
-    om = np.empty(4)
+    # (the slots of joints that are not set below must read 0, as fresh np.zeros)
+    vanchor[:] = 0.0
+    vaxis[:] = 0.0
+    vcoef[:] = 0.0
+    vang[:] = 0.0
+    vrate[:] = 0.0
     for b in range(1, nbody):
         if need[b] == 0 or mp.body_moving[b] == 0:
             continue
@@ -686,13 +682,6 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
                         vrate[v, c] = rate * jaxis[j, c]
 
     # Per body: chain root -> body over the moving bodies.
-    chain = np.empty(nv, dtype=np.int64)
-    stack = np.empty(nbody, dtype=np.int64)
-    p_ref = np.empty((nbody, 3))
-    D = np.empty((nv, 3))
-    r0 = np.empty(nv)
-    suffix = np.empty(nv)
-    rmax = np.empty(nv)
     for b in range(nbody):
         if need[b] == 0:
             continue
@@ -781,6 +770,69 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
 
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
+def bounds_workspace(mp):
+    """Scratch arrays of :func:`_bounds_core` for the pack ``mp`` (a tuple; see there)."""
+    nbody = mp.body_parent.shape[0]
+    njnt = mp.jnt_type.shape[0]
+    nq = mp.qpos.shape[1]
+    nv = 2 * njnt
+    return (np.empty(nq), np.empty((nbody, 4)), np.empty((njnt, 3)), np.empty((njnt, 3)), np.empty((njnt, 4)),
+            np.empty(nv, dtype=np.int64), np.zeros((nv, 3)), np.zeros((nv, 3)), np.zeros(nv), np.zeros(nv),
+            np.zeros((nv, 3)), np.empty(4), np.empty(4), np.empty(nv, dtype=np.int64),
+            np.empty(nbody, dtype=np.int64), np.empty((nbody, 3)), np.empty((nv, 3)), np.empty(nv),
+            np.empty(nv), np.empty(nv))
+
+
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
+def pair_workspace(mp):
+    """Scratch of :func:`pair_bound`: (need, xpos, xmat, trans, angle, :func:`bounds_workspace`)."""
+    nbody = mp.body_parent.shape[0]
+    return (np.empty(nbody, dtype=np.int64), np.empty((nbody, 3)), np.empty((nbody, 3, 3)), np.zeros(nbody),
+            np.zeros(nbody), bounds_workspace(mp))
+
+
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
+def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
+               pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
+    """:func:`body_bound` of two bodies in ONE pass over the union of their chains.
+
+    Returns (trans_a m, angle_a rad, trans_b, angle_b) and writes each body's pose at
+    m = (ta + tb) / 2 into (pA_out, RA_out) / (pB_out, RB_out). A body index < 0 is
+    skipped: (0, 0) and its outputs left as they are (the caller's constant pose of a body
+    the motion does not move). ``pws``: :func:`pair_workspace` (allocated once per caller).
+
+    Same numbers as two :func:`body_bound` calls: in :func:`_bounds_core` a body's pose and
+    bound depend only on its own ancestors (FK root first, the chain terms, the parent's
+    bound), never on which other bodies are in ``need``; the union is closed under ancestors.
+    """
+    need, xpos, xmat, trans, angle, ws = pws
+    need[:] = 0
+    for body in (ba, bb):
+        if body >= 0:
+            c = body
+            while True:
+                need[c] = 1
+                if c == 0:
+                    break
+                c = mp.body_parent[c]
+    _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle, ws)
+    TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
+    if ba >= 0:
+        TA, angA = trans[ba], angle[ba]
+        for r in range(3):
+            pA_out[r] = xpos[ba, r]
+            for c in range(3):
+                RA_out[r, c] = xmat[ba, r, c]
+    if bb >= 0:
+        TB, angB = trans[bb], angle[bb]
+        for r in range(3):
+            pB_out[r] = xpos[bb, r]
+            for c in range(3):
+                RB_out[r, c] = xmat[bb, r, c]
+    return TA, angA, TB, angB
+
+
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
 def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
                R_WB_out: np.ndarray) -> tuple[float, float]:
     """Pose of ``body`` at m = (ta + tb) / 2 and its certified (trans m, angle rad) over [ta, tb].
@@ -795,7 +847,7 @@ def body_bound(mp, body: int, ta: float, tb: float, p_W_out: np.ndarray,
     xmat = np.empty((nbody, 3, 3))
     trans = np.zeros(nbody)
     angle = np.zeros(nbody)
-    _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle)
+    _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle, bounds_workspace(mp))
     for r in range(3):
         p_W_out[r] = xpos[body, r]
         for c in range(3):
@@ -812,7 +864,7 @@ def tree_bounds(mp, ta: float, tb: float, p_W_out: np.ndarray, R_WB_out: np.ndar
     """
     nbody = mp.body_parent.shape[0]
     need = np.ones(nbody, dtype=np.int64)
-    _bounds_core(mp, ta, tb, need, p_W_out, R_WB_out, trans_out, angle_out)
+    _bounds_core(mp, ta, tb, need, p_W_out, R_WB_out, trans_out, angle_out, bounds_workspace(mp))
 
 
 BATCH_BOUNDS = 0
