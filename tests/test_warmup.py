@@ -269,7 +269,8 @@ def test_parallel_warmup_from_an_empty_cache_compiles_each_function_once(tmp_pat
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "child motion" in r.stdout and "child geometry" in r.stdout and "failed" not in r.stdout, r.stdout
-    entry = [x.split()[0] for x in r.stdout.split("entry points:")[1].splitlines()[1:] if x.startswith("    ")]
+    lines = r.stdout.split("entry points:")[1].splitlines()[1:]
+    entry = [x.split()[0] for x in lines if x.startswith("    ")]
     assert entry == ["monitor.certify.kernels.window_kernel"], r.stdout
     r2 = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
     assert r2.returncode == 0 and "nothing compiled" in r2.stdout and "child" not in r2.stdout, r2.stdout
