@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -303,6 +304,11 @@ def _run_children(n: int) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     todo = list(_CHILD_TASKS)
     running: dict[str, tuple[subprocess.Popen, Any]] = {}
+    def terminated(signum: int, frame: Any) -> None:
+        raise SystemExit(128 + signum)   # runs the finally below: the children are killed too
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, terminated) if main else None
     with tempfile.TemporaryDirectory(prefix="monitor-warmup-") as shared:
         try:
             while todo or running:
@@ -328,11 +334,13 @@ def _run_children(n: int) -> dict[str, dict[str, Any]]:
                         out[task] = dict(json.loads(line[-1].split(" ", 1)[1]), ok=True, error="")
                     else:
                         out[task] = {"ok": False, "error": f"exit {proc.returncode}: " + text.strip()[-400:]}
-        finally:   # interrupted: do not leave children compiling
+        finally:   # interrupted (an exception, Ctrl-C, SIGTERM): do not leave children compiling
             for proc, log in running.values():
                 proc.kill()
                 proc.wait()
                 log.close()
+            if main:
+                signal.signal(signal.SIGTERM, previous)
     return out
 
 
