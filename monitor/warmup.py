@@ -16,6 +16,17 @@ budget counts compilation as the caller's time (call :func:`ensure_warm`, or
 ``python -m monitor warmup``, first). Idempotent and cheap after the first call
 (a few hundred milliseconds when the kernels load from the on-disk cache).
 
+:func:`warm_up` (``python -m monitor warmup``) does the same with an empty cache on several
+cores: first the independent entry points in child processes (the geometry of the Scene build
+and the null-set LP kernels in one, the motion packer and then the per-pair search kernel in
+another), then :func:`ensure_warm` in this process, which loads what the children cached and
+compiles only the whole-window kernel on top (numba links a cached callee's stored LLVM module
+into its caller without typing or lowering it again). numba writes each cache file by an atomic
+rename, but its index update (read the index, take the first free data-file number, write the
+index, write the data) is not atomic across processes: two processes adding different
+signatures of one function can leave the index naming the other's data file. During the
+warm-up every save takes an exclusive lock on a file next to the index (:func:`serialise_cache_saves`).
+
 The report says what was compiled: numba's ``numba:compile`` events during the warm-up
 (every function compiled in this process, nested ones included; a function loaded from
 the on-disk cache raises none), the entry points that were compiled and their inclusive
@@ -24,6 +35,11 @@ seconds.
 
 from __future__ import annotations
 
+import json
+import os
+import signal
+import subprocess
+import sys
 import threading
 import time
 from typing import Any
@@ -113,6 +129,229 @@ def ensure_warm() -> dict[str, Any]:
         return _REPORT
 
 
+_SAVE_LOCK_NAME = "monitor-cache-save.lock"
+_SAVES_SERIALISED = False
+
+
+def serialise_cache_saves() -> bool:
+    """Make this process's numba cache saves exclusive per cache folder (idempotent; True if active).
+
+    Wraps ``numba.core.caching.IndexDataCacheFile.save`` (read index, pick a data-file number,
+    write index, write data) in ``fcntl.flock`` on ``<cache folder>/monitor-cache-save.lock``,
+    so a process that also does this never interleaves its index update with another's. False
+    (nothing changed) when numba's internals differ from what this expects or ``fcntl`` is
+    missing: callers then do not compile in parallel.
+    """
+    global _SAVES_SERIALISED
+    if _SAVES_SERIALISED:
+        return True
+    try:
+        import fcntl
+
+        from numba.core import caching
+        cls = caching.IndexDataCacheFile
+        original = cls.save
+        probe = cls.__init__.__code__.co_names
+    except (ImportError, AttributeError):
+        return False
+    if "_cache_path" not in probe:
+        return False
+
+    def save(self, key, data):
+        lock_path = os.path.join(self._cache_path, _SAVE_LOCK_NAME)
+        with open(lock_path, "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                return original(self, key, data)
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    save.__wrapped__ = original
+    cls.save = save
+    _SAVES_SERIALISED = True
+    return True
+
+
+# Child tasks of the parallel warm-up, longest first. They compile disjoint sets of functions:
+# "motion" builds the warm-up Scene (core_distance) only once "geometry" has built it (the file
+# SCENE_READY in the shared folder, written by "geometry" or by the parent when "geometry"
+# exits), so it loads core_distance from the cache instead of compiling it a second time.
+_CHILD_TASKS = ("motion", "geometry")
+_SCENE_READY = "scene-ready"
+
+
+def _wait_for(path: str, parent: int, timeout: float = 900.0) -> None:
+    """Sleep until ``path`` exists, the parent process ``parent`` is gone, or ``timeout`` s passed."""
+    t_end = time.monotonic() + timeout
+    while not os.path.exists(path) and os.getppid() == parent and time.monotonic() < t_end:
+        time.sleep(0.05)
+
+
+def _child_task(task: str, shared: str | None = None) -> None:
+    """Compile one group of independent entry points (in a child process of :func:`warm_up`).
+
+    ``shared``: a folder for the children's "scene built" signal (None: no waiting).
+    """
+    import mujoco
+    import numpy as np
+
+    from monitor.scene import Scene
+
+    model = mujoco.MjModel.from_xml_string(_XML)
+    if task == "geometry":        # Scene build: halfspace_distance, core_distance; then the LP kernels
+        Scene.from_model(model, pairs="all")
+        if shared is not None:
+            open(os.path.join(shared, _SCENE_READY), "w").close()
+        from monitor.certify.extrusion_null import warm_small_lp
+
+        warm_small_lp()
+    elif task == "motion":        # the motion packer (derive, batch), then the per-pair search kernel
+        from monitor.certify import kernels
+        from monitor.motion.plan import Plan
+
+        parent = os.getppid()
+        plan = Plan(np.array([0.0, 0.1]), np.array(_CASES["rotating clear"]), model)
+        mp = kernels.trajectory_pack(plan)
+        if shared is not None:
+            _wait_for(os.path.join(shared, _SCENE_READY), parent)
+        scene = Scene.from_model(model, pairs="all")
+        if mp is not None:
+            ga, gb = (int(g) for g in scene.pair_ids[0])
+            kernels.check_pair_window(kernels.scene_pack(scene).geoms, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3,
+                                      max_tests=8)
+    else:
+        raise ValueError(f"task: unknown warm-up task {task!r}")
+
+
+_CHILD_CODE = """
+import json, resource, sys, time
+sys.path[:] = json.loads(sys.argv[3])
+from numba.core import event
+import monitor.warmup as w
+assert w.serialise_cache_saves()
+log = w._compile_log()
+t = time.perf_counter()
+with event.install_listener("numba:compile", log):
+    w._child_task(sys.argv[1], sys.argv[2])
+ru = resource.getrusage(resource.RUSAGE_SELF)
+print("WARMUP-CHILD " + json.dumps({"seconds": time.perf_counter() - t, "cpu": ru.ru_utime + ru.ru_stime,
+                                    "compiled": log.report()}))
+"""
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def warm_up(processes: int | str = "auto") -> dict[str, Any]:
+    """:func:`ensure_warm`, with the independent entry points first compiled in child processes.
+
+    Args:
+        processes: child processes run at once (``"auto"``: the usable cores, at most
+            ``len(_CHILD_TASKS)``); 0 or 1, a single usable core, or numba internals that
+            :func:`serialise_cache_saves` cannot wrap: no children, plain :func:`ensure_warm`.
+
+    Returns:
+        :func:`ensure_warm`'s report plus ``"children"``: ``{task: {"seconds", "cpu",
+        "compiled", "ok", "error"}}`` (empty when none ran) and ``"total_seconds"``, the wall
+        time of children and this process together. A failed child is reported, not raised:
+        this process then compiles what it left.
+    """
+    if processes == "auto":
+        n = min(_cores(), len(_CHILD_TASKS))
+    elif isinstance(processes, int) and not isinstance(processes, bool) and processes >= 0:
+        n = min(processes, len(_CHILD_TASKS))
+    else:
+        from monitor.errors import InvalidInputError
+
+        raise InvalidInputError(f"processes: expected 'auto' or an int >= 0, got {processes!r}")
+    t0 = time.perf_counter()
+    children: dict[str, dict[str, Any]] = {}
+    if n >= 2 and _REPORT is None and not _children_cached() and serialise_cache_saves():
+        children = _run_children(n)
+    rep = dict(ensure_warm())
+    rep["children"] = children
+    rep["total_seconds"] = time.perf_counter() - t0
+    return rep
+
+
+def _children_cached() -> bool:
+    """True when every entry point the children compile has an on-disk cache entry of this source.
+
+    Then the children would only load (about 2 s of CPU each to import and load): skipped. A
+    cache this cannot read counts as not cached (the children run; nothing is lost but time).
+    """
+    try:
+        from monitor.certify import extrusion_kernels, extrusion_null, kernels
+        from monitor.geometry import _gjk
+        from monitor.motion import kernel as motion_kernel
+
+        entry_points = (_gjk.core_distance, _gjk.halfspace_distance, motion_kernel.batch,
+                        motion_kernel.derive, kernels.pair_window, extrusion_null._dual_simplex_kernel,
+                        extrusion_kernels.min_norm_kernel, extrusion_kernels.first_time_kernel)
+        return all(bool(d._cache._cache_file._load_index()) for d in entry_points)
+    except Exception:  # noqa: BLE001 - numba internals differ: assume cold
+        return False
+
+
+def _run_children(n: int) -> dict[str, dict[str, Any]]:
+    """Run :data:`_CHILD_TASKS` in at most ``n`` child processes at once; their reports."""
+    import tempfile
+
+    out: dict[str, dict[str, Any]] = {}
+    todo = list(_CHILD_TASKS)
+    running: dict[str, tuple[subprocess.Popen, Any]] = {}
+    def terminated(signum: int, frame: Any) -> None:
+        raise SystemExit(128 + signum)   # runs the finally below: the children are killed too
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, terminated) if main else None
+    with tempfile.TemporaryDirectory(prefix="monitor-warmup-") as shared:
+        try:
+            while todo or running:
+                while todo and len(running) < n:
+                    task = todo.pop(0)
+                    log = tempfile.TemporaryFile("w+")   # a file, not a pipe: a chatty child never blocks
+                    argv = [sys.executable, "-c", _CHILD_CODE, task, shared, json.dumps(sys.path)]
+                    proc = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, text=True)
+                    running[task] = (proc, log)
+                done = [task for task, (proc, _) in running.items() if proc.poll() is not None]
+                if not done:
+                    time.sleep(0.05)
+                    continue
+                for task in done:
+                    proc, log = running.pop(task)
+                    if task == "geometry":  # whatever happened, nobody waits for the Scene any more
+                        open(os.path.join(shared, _SCENE_READY), "a").close()
+                    log.seek(0)
+                    text = log.read()
+                    log.close()
+                    line = [x for x in text.splitlines() if x.startswith("WARMUP-CHILD ")]
+                    if proc.returncode == 0 and line:
+                        out[task] = dict(json.loads(line[-1].split(" ", 1)[1]), ok=True, error="")
+                    else:
+                        out[task] = {"ok": False, "error": f"exit {proc.returncode}: " + text.strip()[-400:]}
+        finally:   # interrupted (an exception, Ctrl-C, SIGTERM): do not leave children compiling
+            for proc, log in running.values():
+                proc.kill()
+                proc.wait()
+                log.close()
+            if main:
+                signal.signal(signal.SIGTERM, previous)
+    return out
+
+
+_CASES = {
+    "rotating clear": [[-1.0, 0.0, -0.5], [-0.3, 0.0, -0.5]],   # stops short of the post
+    "colliding swing": [[-0.6, 0.0, -0.5], [0.6, 0.0, -0.5]],  # the link hits the post
+    "translating": [[-1.0, 0.0, -0.3], [-1.0, 0.0, 0.3]],      # the ball passes over it
+}
+"""Joint waypoints (yaw, pitch, slide) of the warm-up motions, at t = 0 and 0.1 s."""
+
+
 def _run_cases() -> dict[str, tuple[str, float]]:
     """Certify the warm-up motions and compile the null-set LP: ``{case: (verdict, seconds)}``."""
     import mujoco
@@ -126,15 +365,10 @@ def _run_cases() -> dict[str, tuple[str, float]]:
     model = mujoco.MjModel.from_xml_string(_XML)
     scene = Scene.from_model(model, pairs="all")
     q0 = np.zeros(model.nq)
-    cases = {
-        "rotating clear": np.array([[-1.0, 0.0, -0.5], [-0.3, 0.0, -0.5]]),   # stops short of the post
-        "colliding swing": np.array([[-0.6, 0.0, -0.5], [0.6, 0.0, -0.5]]),  # the link hits the post
-        "translating": np.array([[-1.0, 0.0, -0.3], [-1.0, 0.0, 0.3]]),      # the ball passes over it
-    }
     out = {}
-    for name, q in cases.items():
+    for name, q in _CASES.items():
         t = time.perf_counter()
-        plan = Plan(np.array([0.0, 0.1]), q0 + q, model)
+        plan = Plan(np.array([0.0, 0.1]), q0 + np.array(q), model)
         cert = certify(scene, plan, margin=0.001, epsilon=1e-3, budget=Budget())
         out[name] = (str(cert.verdict), time.perf_counter() - t)
     # the per-pair search entry, called from Python by the engine when the window kernel leaves a
@@ -155,4 +389,4 @@ def _run_cases() -> dict[str, tuple[str, float]]:
     return out
 
 
-__all__ = ["ensure_warm"]
+__all__ = ["ensure_warm", "serialise_cache_saves", "warm_up"]
