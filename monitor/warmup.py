@@ -219,6 +219,9 @@ def _child_task(task: str, shared: str | None = None) -> None:
             ga, gb = (int(g) for g in scene.pair_ids[0])
             kernels.check_pair_window(kernels.scene_pack(scene).geoms, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3,
                                       max_tests=8)
+        from monitor.certify.toleranced import warm_kernels  # the fat-feature stage (fat_kernels)
+
+        warm_kernels()
     else:
         raise ValueError(f"task: unknown warm-up task {task!r}")
 
@@ -285,13 +288,14 @@ def _children_cached() -> bool:
     cache this cannot read counts as not cached (the children run; nothing is lost but time).
     """
     try:
-        from monitor.certify import extrusion_kernels, extrusion_null, kernels
+        from monitor.certify import extrusion_kernels, extrusion_null, fat_kernels, kernels
         from monitor.geometry import _gjk
         from monitor.motion import kernel as motion_kernel
 
         entry_points = (_gjk.core_distance, _gjk.halfspace_distance, motion_kernel.batch,
                         motion_kernel.derive, kernels.pair_window, extrusion_null._dual_simplex_kernel,
-                        extrusion_kernels.min_norm_kernel, extrusion_kernels.first_time_kernel)
+                        extrusion_kernels.min_norm_kernel, extrusion_kernels.first_time_kernel,
+                        fat_kernels.fat_level, fat_kernels.traj_balls, fat_kernels.screw_poses_bounds)
         return all(bool(d._cache._cache_file._load_index()) for d in entry_points)
     except Exception:  # noqa: BLE001 - numba internals differ: assume cold
         return False
@@ -386,6 +390,11 @@ def _run_cases() -> dict[str, tuple[str, float]]:
     t = time.perf_counter()
     warm_small_lp()
     out["null-set LP kernel"] = ("compiled", time.perf_counter() - t)
+    from monitor.certify.toleranced import warm_kernels  # fat-feature levels, trajectory balls, screw bounds
+
+    t = time.perf_counter()
+    warm_kernels()
+    out["fat-feature kernels"] = ("compiled", time.perf_counter() - t)
     return out
 
 
