@@ -187,6 +187,25 @@ def _wait_for(path: str, parent: int, timeout: float = 900.0) -> None:
         time.sleep(0.05)
 
 
+def _warm_distance_batch(scene: Any = None) -> None:
+    """Compile ``core_distance_batch`` (many poses of one pair: witness confirmation, sampling).
+
+    A box against a sphere (both compiled cores; a half-space pair would take the per-pose
+    path), one pose broadcast against two, so the arrays are the C, writable copies
+    :func:`monitor.geometry.distance.shape_distance_batch` always passes: the specialisation
+    every scene uses. ``scene`` is unused (kept for the call sites' symmetry).
+    """
+    import numpy as np
+
+    from monitor.geometry.distance import shape_distance_batch
+    from monitor.geometry.polytope import box_polytope, sphere_shape
+
+    R = np.repeat(np.eye(3)[None], 2, axis=0)
+    p = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.3]])
+    shape_distance_batch(box_polytope(np.array([0.1, 0.1, 0.1])), (np.eye(3), np.zeros(3)), sphere_shape(0.1),
+                         (R, p))
+
+
 def _child_task(task: str, shared: str | None = None) -> None:
     """Compile one group of independent entry points (in a child process of :func:`warm_up`).
 
@@ -199,7 +218,7 @@ def _child_task(task: str, shared: str | None = None) -> None:
 
     model = mujoco.MjModel.from_xml_string(_XML)
     if task == "geometry":        # Scene build: halfspace_distance, core_distance; then the LP kernels
-        Scene.from_model(model, pairs="all")
+        _warm_distance_batch(Scene.from_model(model, pairs="all"))
         if shared is not None:
             open(os.path.join(shared, _SCENE_READY), "w").close()
         from monitor.certify.extrusion_null import warm_small_lp
@@ -292,9 +311,10 @@ def _children_cached() -> bool:
         from monitor.geometry import _gjk
         from monitor.motion import kernel as motion_kernel
 
-        entry_points = (_gjk.core_distance, _gjk.halfspace_distance, motion_kernel.batch,
-                        motion_kernel.derive, kernels.pair_window, extrusion_null._dual_simplex_kernel,
-                        extrusion_kernels.min_norm_kernel, extrusion_kernels.first_time_kernel,
+        entry_points = (_gjk.core_distance, _gjk.core_distance_batch, _gjk.halfspace_distance,
+                        motion_kernel.batch, motion_kernel.derive, kernels.pair_window,
+                        extrusion_null._dual_simplex_kernel, extrusion_kernels.min_norm_kernel,
+                        extrusion_kernels.first_time_kernel,
                         fat_kernels.fat_level, fat_kernels.traj_balls, fat_kernels.screw_poses_bounds)
         return all(bool(d._cache._cache_file._load_index()) for d in entry_points)
     except Exception:  # noqa: BLE001 - numba internals differ: assume cold
@@ -390,6 +410,9 @@ def _run_cases() -> dict[str, tuple[str, float]]:
     t = time.perf_counter()
     warm_small_lp()
     out["null-set LP kernel"] = ("compiled", time.perf_counter() - t)
+    t = time.perf_counter()
+    _warm_distance_batch(scene)
+    out["distance batch"] = ("compiled", time.perf_counter() - t)
     from monitor.certify.toleranced import warm_kernels  # fat-feature levels, trajectory balls, screw bounds
 
     t = time.perf_counter()

@@ -525,10 +525,13 @@ def shape_distance_batch(shape_a: ConvexShape, Xs_a, shape_b: ConvexShape, Xs_b,
     for arr, nm in ((Ra, "Xs_a R"), (pa, "Xs_a p"), (Rb, "Xs_b R"), (pb, "Xs_b p")):
         if len(arr) not in (1, T):
             raise InvalidInputError(f"{nm}: length {len(arr)} does not broadcast to {T}")
-    Ra = np.ascontiguousarray(np.broadcast_to(Ra, (T, 3, 3)))
-    Rb = np.ascontiguousarray(np.broadcast_to(Rb, (T, 3, 3)))
-    pa = np.ascontiguousarray(np.broadcast_to(pa, (T, 3)))
-    pb = np.ascontiguousarray(np.broadcast_to(pb, (T, 3)))
+    # C-contiguous AND writable copies where needed: numba compiles one specialisation per
+    # readonly flag, and np.broadcast_to returns a readonly view even when nothing broadcasts
+    # (a second ~10 s compile of core_distance_batch in a fresh process otherwise)
+    Ra = np.require(np.broadcast_to(Ra, (T, 3, 3)), np.float64, ("C", "W"))
+    Rb = np.require(np.broadcast_to(Rb, (T, 3, 3)), np.float64, ("C", "W"))
+    pa = np.require(np.broadcast_to(pa, (T, 3)), np.float64, ("C", "W"))
+    pb = np.require(np.broadcast_to(pb, (T, 3)), np.float64, ("C", "W"))
     tol = tolerances
     if ca_.code < 0 or cb_.code < 0:
         lo = np.empty(T)
