@@ -47,3 +47,34 @@ def test_distance_batch_arrays_are_typed_alike_with_or_without_broadcasting():
     R_ro.flags.writeable = p_ro.flags.writeable = False                 # a caller's read-only arrays
     shape_distance_batch(box, (R_ro, p_ro), ball, (np.eye(3), np.zeros(3)))
     assert len(_gjk.core_distance_batch.signatures) == n, _gjk.core_distance_batch.signatures
+
+
+_BALL = """
+<mujoco>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 .1"/>
+    <body name="ball" pos="0 0 .049"><freejoint/><geom name="ball" type="sphere" size=".05"/></body>
+    <body name="box" pos=".5 0 .2"><freejoint/><geom name="box" type="box" size=".05 .05 .05"/></body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_the_ongoing_contact_rule_uses_the_same_window_kernel():
+    """Regression: the ongoing-contact rule (``ongoing="deepen"``, a resting ball 1 mm deep)
+    certifies pair subsets whose pair array was writable: a second window_kernel compile."""
+    model = mujoco.MjModel.from_xml_string(_XML)
+    scene = Scene.from_model(model, pairs="all")
+    certify(scene, Plan(np.array([0.0, 0.1]), np.array([[-1.0, 0.0, -0.5], [-0.3, 0.0, -0.5]]), model))
+    n = len(kernels.window_kernel.signatures)
+    ball = mujoco.MjModel.from_xml_string(_BALL)
+    q0 = np.array(ball.qpos0)
+    q1 = q0.copy()
+    q1[0] += 0.02          # the ball slides 2 cm along x while resting 1 mm deep
+    q1[7 + 2] -= 0.05      # the box drops 5 cm
+    plan = Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), ball)
+    bscene = Scene.from_model(ball, pairs="all")
+    cert = certify(bscene, plan, ongoing="deepen")
+    assert cert.stats.get("ongoing", 0) >= 1  # the rule ran
+    certify(bscene, plan)
+    assert len(kernels.window_kernel.signatures) == n, kernels.window_kernel.signatures

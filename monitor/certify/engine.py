@@ -732,12 +732,12 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     sp, mp = fast
     moving = np.asarray(plan.moving_bodies(), bool)
     P = len(sel)
-    if P == len(sp.pair_ids):
-        pid = sp.pair_ids           # the pack's own (read-only) array
-    else:  # a subset (the gate's reuse cache): read-only too, so that window_kernel keeps ONE
-        # specialisation (numba types the readonly flag: a second ~20 s compile otherwise)
-        pid = np.ascontiguousarray(sp.pair_ids[sel])
-        pid.flags.writeable = sp.pair_ids.flags.writeable
+    pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
+    if pid.flags.writeable:
+        # always a read-only array (a subset copy, a pack built writable): window_kernel keeps
+        # ONE specialisation (numba types the readonly flag: a second ~20 s compile otherwise)
+        pid = pid.view()
+        pid.flags.writeable = False
     fixed, mov = _body_flags(scene, moving)
     # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
     # every surviving pair takes the Python route, which calls the replacement
