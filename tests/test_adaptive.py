@@ -20,6 +20,9 @@ Seeded; no timings.
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -29,6 +32,9 @@ from monitor.bench.cases import PairCase, ShapeSpec, _place, _random_shape
 from monitor.certify import kernels as K
 from monitor.certify.packed import pack_shapes
 from monitor.motion.pack import pack_trajectory
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _intervals import minus  # noqa: E402
 
 REL, ABS = 64 * 2.0**-52, 1e-12
 
@@ -91,22 +97,6 @@ def _pending(stack, sp):
     return out
 
 
-def _minus(U, V):
-    """Pieces of the interval union U not covered by the union V (both sorted, disjoint)."""
-    out = []
-    for a, b in U:
-        cur = a
-        for c, d in V:
-            if d <= cur or c >= b:
-                continue
-            if c > cur:
-                out.append((cur, c))
-            cur = max(cur, d)
-        if cur < b:
-            out.append((cur, b))
-    return out
-
-
 def _trace(gp, mp, window, margin=0.0, eps=1e-3, max_depth=40, mode=K.MODE_FULL, max_steps=5000):
     """Step pair_window one test at a time; returns (verdict code, excluded pieces, result row)."""
     stack = np.empty((max_depth + 2, 3))
@@ -133,7 +123,7 @@ def _trace(gp, mp, window, margin=0.0, eps=1e-3, max_depth=40, mode=K.MODE_FULL,
             # while refining a witness, an unresolved interval at or after the first unresolved
             # time changes no state: such pieces are not counted (they may not be excluded)
             fu = state[2]
-            removed = _minus(before, after)
+            removed = minus(before, after)
             # coverage: a step drops nothing (split, retry) or exactly the interval it tested
             assert removed == [] or (state[0] == state[0] and tested[0] >= wt_prev) or removed == [tested], \
                 (removed, tested)

@@ -19,6 +19,9 @@ Seeded; no timings.
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -26,6 +29,9 @@ import pytest
 from monitor import Plan, Scene
 from monitor.certify import kernels as K
 from monitor.certify.kernels import scene_pack, trajectory_pack
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _intervals import minus  # noqa: E402
 
 MODEL = "models/arm/scene.xml"
 REL, ABS = 64 * 2.0**-52, 1e-12
@@ -69,7 +75,7 @@ def _trace(gp, mp, ga, gb, window, margin, eps=1e-3, max_depth=40):
         same = all(x == y or (x != x and y != y) for x, y in zip(state, (res[K.R_WTIME], res[K.R_UNRES]),
                                                                     strict=True))
         if same and res[K.R_WTIME] != res[K.R_WTIME]:
-            gone = _minus(pending, after)
+            gone = minus(pending, after)
             assert gone == [] or gone == [tested], (gone, tested)
             excluded += gone
             if not gone and sp and stack[sp - 1, 2] < 0.0 and stack[sp - 1, 0] == tested[0]:
@@ -84,22 +90,6 @@ def _trace(gp, mp, ga, gb, window, margin, eps=1e-3, max_depth=40):
             b = b if not a - d < b + 0.05 * d else a - d
         tested = (a, b)
     raise AssertionError("pair_window did not finish")
-
-
-def _minus(U, V):
-    """Pieces of the interval union U not covered by the union V (both sorted, disjoint)."""
-    out = []
-    for a, b in U:
-        cur = a
-        for c, d in V:
-            if d <= cur or c >= b:
-                continue
-            if c > cur:
-                out.append((cur, c))
-            cur = max(cur, d)
-        if cur < b:
-            out.append((cur, b))
-    return out
 
 
 def _mj_distances(m, plan, ga, gb, ts):
