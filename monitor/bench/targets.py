@@ -418,6 +418,7 @@ def gym_gate(
             reps,
         )
         gate = envs["gated"].gate
+        tail = tail_physics(envs["gated"].unwrapped.model, envs["gated"].unwrapped.data, gate)
         npairs = gate.npairs
         candidates = len(gate.scene.candidate_pairs)
         names = [f"{a}:{b}" for a, b in gate.scene.candidate_pairs] if npairs <= 8 else None
@@ -439,7 +440,43 @@ def gym_gate(
         "steps_gated": steps_gated,
         "steps_ungated": steps_ungated,
         "reps": reps,
+        **_floor(tail, u),
     }
+
+
+def _floor(tail: dict[str, Any] | None, ungated_s: float | None) -> dict[str, Any]:
+    """``tail_physics`` figures plus ``physics_floor_ratio`` = 1 + tail loop / ungated step."""
+    if not tail or not ungated_s:
+        return {}
+    return dict(tail, physics_floor_ratio=1.0 + tail["tail_loop_s"] / ungated_s)
+
+
+def tail_physics(model: Any, data: Any, gate: Any, *, reps: int = 5) -> dict[str, Any] | None:
+    """The physics a braking tail costs on its own: ``gate.brake_steps`` ``mj_step`` calls.
+
+    The gate simulates its braking tail (``brake_horizon``, 0.25 s of simulation time by default)
+    on every accepted step, in ``mujoco.rollout`` (about 0.8x this loop, docs/notes/issue-12-gate-3.md);
+    this times the same number of substeps as a plain ``mj_step`` loop from a copy of ``data``
+    with its control held (median of ``reps``), so ``1 + tail / ungated step`` is about the lowest
+    gated/ungated ratio any implementation of this gate can reach (the rollout is ~0.8x the loop;
+    the window's own physics counts once, as the gate commits it). None when the gate has no
+    braking tail.
+    """
+    import mujoco
+
+    active = getattr(gate, "_brake_active", None)   # brake on, not "warn", no callable fallback
+    if not (getattr(gate, "brake", False) and (active is None or active(None))):
+        return None
+    n = int(gate.brake_steps)
+    scratch = mujoco.MjData(model)
+    times = []
+    for _ in range(max(1, reps)):
+        mujoco.mj_copyData(scratch, model, data)
+        t = time.perf_counter()
+        for _ in range(n):
+            mujoco.mj_step(model, scratch)
+        times.append(time.perf_counter() - t)
+    return {"tail_substeps": n, "tail_loop_s": _median(times)}
 
 
 def plain_gate(
@@ -503,6 +540,7 @@ def plain_gate(
     ungated(5)
     per = _blocks({"ungated": lambda r: ungated(steps_ungated), "gated": lambda r: gated(steps_gated)}, reps)
     u, g = _median(per["ungated"]), _median(per["gated"])
+    tail = tail_physics(model, dg, gate)
     out = {
         "monitored_pairs": gate.npairs,
         "candidate_pairs": len(gate.scene.candidate_pairs),
@@ -516,6 +554,7 @@ def plain_gate(
         "steps_gated": steps_gated,
         "steps_ungated": steps_ungated,
         "reps": reps,
+        **_floor(tail, u),
     }
     gate.close()
     return out
@@ -715,6 +754,8 @@ def _gate_note(r: dict[str, Any], what: str) -> str:
         f"{r['monitored_pairs']} monitored pairs"
         + (f" ({', '.join(r['pair_names'])})" if r.get("pair_names") else "")
         + f"; verdicts {r['verdicts']}"
+        + (f"; braking tail {r['tail_substeps']} substeps = {_f(1e6 * r['tail_loop_s'])} µs of mj_step "
+           f"alone: physics floor {_f(r['physics_floor_ratio'])}x" if r.get("physics_floor_ratio") else "")
     )
 
 
