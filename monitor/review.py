@@ -378,37 +378,219 @@ def _logged_allowed(run: dict[str, Any], find: Callable[..., None], notes: list[
     return [tuple(r) for r in raw]
 
 
-def _logged_request(run: dict[str, Any], tol: Any, find: Callable[..., None],
-                    notes: list[str]) -> Any:
-    """The run's logged :class:`~monitor.certify.request.CertifyRequest`, ready to re-derive with.
+def _parse_request(raw: Any, where: str, tol: Any, find: Callable[..., None], notes: list[str]) -> Any:
+    """A logged request record, ready to re-derive with, or None (malformed: a CRITICAL finding).
 
-    None when the log has none (an old log: re-derived as before, with the plain rule) or
-    when it is malformed or forged (a CRITICAL finding; then also as before). The request's
-    window, budget and pairs are replaced (window: each plan's span; budget: the library
-    default per window; pairs: all of the scene's, the pair policy decides them) and its
-    tolerances by the ones this verification uses (a note says when they differ).
+    The request's window, budget and pairs are replaced (window: each plan's span; budget: the
+    library default per window; pairs: all of the scene's, the pair policy decides them) and
+    its tolerances by the ones this verification uses (a note says when they differ).
     """
-    if "request" not in run:
-        return None
     from monitor.certify.request import BudgetLimits, CertifyRequest
     from monitor.errors import MonitorError
 
-    raw = run["request"]
     try:
         req = CertifyRequest.from_json(raw)
     except (MonitorError, TypeError, ValueError) as exc:
-        find(CRITICAL, f"run metadata request is malformed: {_short(str(exc), 200)}; re-derived "
+        find(CRITICAL, f"{where} is malformed: {_short(str(exc), 200)}; its windows were re-derived "
                        f"without it (plain rule)")
         return None
     if req.pairs is not None:
-        find(CRITICAL, f"run metadata request restricts the pairs to {len(req.pairs)}: ignored, the "
+        find(CRITICAL, f"{where} restricts the pairs to {len(req.pairs)}: ignored, the "
                        f"pair policy decides them")
     if req.tolerances != tol:
-        notes.append("the logged request's tolerances differ from the ones used here; the logged ones "
-                     "were not used")
+        notes.append(f"{where}: its tolerances differ from the ones used here; the logged ones "
+                     f"were not used")
     if req.window is not None:
-        notes.append(f"the logged request's window {list(req.window)} was not used (each plan's span is)")
+        notes.append(f"{where}: its window {list(req.window)} was not used (each plan's span is)")
     return req.replace(window=None, pairs=None, budget=BudgetLimits.of(None), tolerances=tol)
+
+
+def _logged_requests(contents: LogContents, tol: Any, find: Callable[..., None],
+                     notes: list[str]) -> dict[int, Any]:
+    """Every logged request by id: ``{id: ready CertifyRequest or None (malformed/ambiguous)}``.
+
+    Id 0 may be the run metadata's ``"request"`` (a gate's request at log open; the only
+    one in logs written before per-window request ids); every ``monitor.request`` record adds
+    one id. A record without an integer id, or an id defined twice with different contents,
+    is a CRITICAL finding (the id is then unusable: its windows are re-derived without it).
+    """
+    raw: dict[int, Any] = {}
+    where: dict[int, str] = {}
+    broken: set[int] = set()
+    if "request" in contents.run:
+        raw[0], where[0] = contents.run["request"], "run metadata request"
+    for rec in getattr(contents, "requests", ()):
+        rid, r = rec.get("id"), rec.get("request")
+        if not _is_int(rid) or rid < 0:
+            find(CRITICAL, f"monitor.request record with id {_short(rid, 40)} (not an integer >= 0)")
+            continue
+        if isinstance(r, dict):
+            r = {**r, "window": None}  # the writer records requests without their window
+        if rid in raw:
+            old = raw[rid] if not isinstance(raw[rid], dict) else {**raw[rid], "window": None}
+            if old != r:
+                find(CRITICAL, f"request id {rid} is defined twice with different contents ({where[rid]} "
+                               f"and a monitor.request record): its windows were re-derived without it")
+                broken.add(rid)
+            continue
+        raw[rid], where[rid] = r, f"monitor.request record {rid}"
+    out: dict[int, Any] = {}
+    for rid in sorted(raw):
+        out[rid] = None if rid in broken else _parse_request(raw[rid], where[rid], tol, find, notes)
+    return out
+
+
+_RULE_FIELDS = ("margin", "epsilon", "ongoing", "penetration_tol")
+
+
+def _loosened(base: Any, req: Any) -> list[str]:
+    """The settings of ``req`` that make "certified" weaker than under ``base`` (empty: none).
+
+    A lower margin; the ongoing-contact rule (``"deepen"``) where ``base`` had the plain rule;
+    a larger ``penetration_tol`` under ``"deepen"``. Epsilon, method and budget only move
+    answers between certified and uncertain, never what a certificate claims.
+    """
+    out = []
+    if req.margin < base.margin:
+        out.append(f"margin {base.margin} -> {req.margin}")
+    if req.ongoing == "deepen" and base.ongoing != "deepen":
+        out.append(f"ongoing {base.ongoing} -> deepen (penetration_tol {req.penetration_tol})")
+    elif req.ongoing == "deepen" and req.penetration_tol > base.penetration_tol:
+        out.append(f"penetration_tol {base.penetration_tol} -> {req.penetration_tol}")
+    return out
+
+
+def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find: Callable[..., None],
+                      notes: list[str]) -> None:
+    """Notes on the requests the windows were re-derived with; an UNVERIFIABLE finding per loosening.
+
+    The baseline is request 0 when the run metadata has it (a gate's settings at log open),
+    else the request of the earliest window. A later request that loosens what "certified"
+    means (:func:`_loosened`) is what a gate setting changed during the run looks like, and
+    also what a forger adding a looser request record would write: the log cannot tell the
+    two apart (its seal is not signed), so such windows are reported as unverifiable (exit 2),
+    never as agreed. Tightening or neutral changes are notes.
+    """
+    if not used:
+        return
+    ids = sorted(used, key=lambda r: min(used[r]))
+    base_id = 0 if requests.get(0) is not None else ids[0]
+    base = requests[base_id]
+    for rid in ids:
+        req, ks = requests[rid], used[rid]
+        fields = ", ".join(f"{f}={getattr(req, f)}" for f in _RULE_FIELDS)
+        line = (f"request {rid} ({fields}) answers {len(ks)} window(s)"
+                + (f", first {min(ks)}, last {max(ks)}" if len(used) > 1 else ""))
+        if rid != base_id:
+            diff = [f"{f} {getattr(base, f)} -> {getattr(req, f)}" for f in _RULE_FIELDS
+                    if getattr(base, f) != getattr(req, f)]
+            line += f"; differs from request {base_id}: {', '.join(diff) or 'budget/method/tolerances only'}"
+            looser = _loosened(base, req)
+            if looser:
+                find(UNVERIFIABLE, f"request {rid} loosens what 'certified' means relative to request "
+                                   f"{base_id} ({'; '.join(looser)}) for {len(ks)} window(s), first "
+                                   f"{min(ks)}: a setting changed during the run or an edited log, which "
+                                   f"the log cannot tell apart", min(ks))
+        notes.append(line)
+
+
+def _allowed_set(rows: Any) -> set[tuple[frozenset, str]]:
+    return {(frozenset(map(str, r[:2])), str(r[2])) for r in rows}
+
+
+def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol: Any,
+                       run: dict[str, Any], allowed: list | None, hazards: Any,
+                       find: Callable[..., None], notes: list[str], expect_pairs: str | None = None) -> Any:
+    """Check the logged pair policy's claims against the model; the scene to re-derive with.
+
+    * ``hazards``: a note lists the candidate pairs it left out (never certified).
+    * An allowed pair with reason Adjacent whose bodies are not adjacent (:func:`monitor.acm`
+      rule): CRITICAL.
+    * ``allowed_mode`` ``"auto"`` / ``"none"`` (a gate's ``allowed="auto"`` / ``None``): the
+      allowed pairs are re-derived from the model (the ACM at the logged ``reference_qpos``,
+      ``allow`` patterns, ``hazards``); a logged allowed pair the re-derivation does not give
+      is CRITICAL and the windows are then re-derived on the re-derived pair set (so the pair
+      comes back into every window). ``"given"`` (a user's matrix) or absent (older logs):
+      reasons other than Adjacent cannot be re-derived; a note says so, and with
+      ``expect_pairs`` (the auditor requires the model's pair set) they are CRITICAL and the
+      windows are re-derived without them.
+    """
+    from monitor.acm import _adjacent
+    from monitor.errors import MonitorError
+
+    if hazards is not None:
+        try:
+            every = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                         **({"allowed": allowed} if allowed else {}))
+            kept = set(map(_pair_key, scene.candidate_pairs))
+            left = sorted(set(map(_pair_key, every.candidate_pairs)) - kept, key=sorted)
+            shown = ", ".join("/".join(sorted(p)) for p in left[:8]) + (" ..." if len(left) > 8 else "")
+            notes.append(f"the run checked only the pairs hazards={_short(hazards, 80)} selects: {len(left)} "
+                         f"candidate pair(s) were not certified, in the log nor here: {shown or '-'}")
+        except (MonitorError, ValueError, TypeError) as exc:  # pragma: no cover - the scene above built
+            notes.append(f"cannot list the pairs hazards= left out: {exc}")
+    for a, b, why in allowed or ():
+        if why != "Adjacent":
+            continue
+        try:
+            ok = _adjacent(model, scene.geom(a).id, scene.geom(b).id)
+        except (MonitorError, KeyError, ValueError):
+            ok = False
+        if not ok:
+            find(CRITICAL, f"allowed pair {a}/{b} claims reason Adjacent, but its bodies are not adjacent in "
+                           f"the attached model")
+    mode = run.get("allowed_mode")
+    claimed = [r for r in allowed or () if r[2] != "Adjacent"]
+    if expect_pairs is not None and mode in (None, "given") and claimed:
+        find(CRITICAL, f"{len(claimed)} allowed pair(s) whose reasons cannot be re-derived from the model "
+                       f"({_short([list(r) for r in claimed], 120)}): the required {expect_pairs!r} pair set "
+                       f"checks them")
+        keep = [r for r in allowed or () if r[2] == "Adjacent"]
+        try:
+            return scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                        **({"allowed": keep} if keep else {}))
+        except (MonitorError, ValueError, TypeError):  # pragma: no cover - the same policy built above
+            return scene
+    if mode is None:
+        if allowed:
+            notes.append("the log does not say how its allowed pairs were chosen (no allowed_mode: a log "
+                         "from before it was logged): reasons other than Adjacent were not re-derived")
+        return scene
+    if mode not in ("auto", "none", "given"):
+        find(CRITICAL, f"run metadata allowed_mode={_short(mode, 40)} is not 'auto', 'none' or 'given'")
+        return scene
+    if mode == "given":
+        if allowed:
+            notes.append(f"the run's allowed-contact matrix was given by its user: its {len(allowed)} "
+                         f"allowed pair(s) are the user's claim (reasons other than Adjacent not re-derived)")
+        return scene
+    ref = run.get("reference_qpos")
+    if ref is not None and not (isinstance(ref, list) and len(ref) == model.nq
+                                and all(_is_num(x) for x in ref)):
+        find(CRITICAL, f"run metadata reference_qpos is not {model.nq} finite numbers: {_short(ref, 80)}")
+        return scene
+    try:
+        again = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                     allowed="auto" if mode == "auto" else None, hazards=hazards,
+                                     allow=run.get("allow"),
+                                     reference=None if ref is None else np.asarray(ref, np.float64))
+    except (MonitorError, ValueError, TypeError) as exc:
+        find(CRITICAL, f"cannot re-derive the allowed pairs (allowed={mode!r}, "
+                       f"allow={_short(run.get('allow'), 60)}) for the attached model: "
+                       f"{_short(str(exc), 200)}")
+        return scene
+    logged, derived = _allowed_set(allowed or ()), _allowed_set(again.allowed_pairs)
+    extra = sorted(logged - derived, key=lambda x: (sorted(x[0]), x[1]))
+    for pair, why in extra:
+        find(CRITICAL, f"allowed pair {'/'.join(sorted(pair))} (reason {why}) is not what allowed={mode!r} "
+                       f"gives for the attached model at the logged reference pose: re-derived with the pair")
+    if derived - logged:
+        notes.append(f"{len(derived - logged)} pair(s) the re-derived policy allows were checked by the run "
+                     f"(stricter than needed)")
+    if extra:
+        return again
+    notes.append(f"the {len(logged)} allowed pair(s) were re-derived from the model (allowed={mode!r})")
+    return scene
 
 
 def _engine() -> tuple[Any, Any]:
@@ -596,7 +778,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             else:
                 run_claims[key] = float(v)
 
-    logged_req = _logged_request(run, tol, find, notes)
+    requests = _logged_requests(contents, tol, find, notes)
+    logged_req = requests.get(0) if "request" in run else None  # windows without a request id
+    used_requests: dict[int, list[int]] = {}
+    no_request_id = 0
 
     policy: Any = None
     raw_policy = run.get("pairs", run.get("pair_policy"))
@@ -616,13 +801,22 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         policy = expect_pairs
     scene = None
     allowed = _logged_allowed(run, find, notes)
+    hazards = run.get("hazards")  # None: every candidate pair (also logs from before it was logged)
+    if hazards is not None and expect_pairs is not None:
+        find(CRITICAL, f"logged hazards={_short(hazards, 80)} selects a subset of the pairs, not the "
+                       f"required {expect_pairs!r}: ignored")
+        hazards = None
     if policy is not None:
         try:
             scene = scene_cls.from_model(model, pairs=policy, tolerances=tol,
-                                         **({"allowed": allowed} if allowed else {}))
+                                         **({"allowed": allowed} if allowed else {}),
+                                         **({"hazards": hazards} if hazards is not None else {}))
         except (MonitorError, ValueError, TypeError) as exc:
-            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not valid for the attached "
-                           f"model: {exc}")
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} (hazards={_short(hazards, 60)}) is "
+                           f"not valid for the attached model: {exc}")
+        if scene is not None:
+            scene = _check_pair_policy(model, scene_cls, scene, policy, tol, run, allowed, hazards,
+                                       find, notes, expect_pairs)
         if isinstance(policy, list):
             notes.append(f"pair policy is an explicit list of {len(policy)} pair(s): only those pairs are "
                          f"certified")
@@ -672,6 +866,16 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             find(CRITICAL, f"unknown verdict {verdict[:40]!r}", k)
         method = c["method"]
         claims_ok = True
+        # the request this window answers: its request_id (per window, so a setting changed
+        # during the run is seen), else the run's (logs before request ids), else none
+        req, rid = logged_req, c.get("request_id")
+        if rid is None:
+            no_request_id += 1
+        elif not _is_int(rid) or rid not in requests:
+            find(CRITICAL, f"request_id {_short(rid, 40)} names no logged request", k)
+        elif requests[rid] is not None:
+            req = requests[rid]
+            used_requests.setdefault(rid, []).append(k)
         if method not in METHODS:
             find(CRITICAL, f"unknown method {method[:40]!r}", k)
             claims_ok = False
@@ -680,7 +884,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if not _is_num(v) or not ok(v):
                 find(CRITICAL, f"{key}={_short(v, 40)} is invalid", k)
                 claims_ok = False
-            elif key in run_claims and float(v) != run_claims[key]:
+            elif key in run_claims and float(v) != run_claims[key] and rid is None:
+                # with a request id the window's own request is the claim (checked below): the
+                # run metadata holds the settings at log open, which the gate may change later
                 find(CRITICAL, f"{key}={v} differs from the run's {run_claims[key]}", k)
         logged_pairs = Counter(_pair_key(p["geoms"]) for p in c["pairs"])
         if scene_pairs is not None and logged_pairs != scene_pairs:
@@ -703,17 +909,17 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if not (math.isclose(w0, t0, rel_tol=1e-12, abs_tol=1e-12)
                     and math.isclose(w1, t1, rel_tol=1e-12, abs_tol=1e-12)):
                 find(CRITICAL, f"window [{w0!r}, {w1!r}] is not the plan's span [{t0!r}, {t1!r}]", k)
-            if logged_req is None:  # an old log (or a forged request, already critical): as before
+            if req is None:  # an old log (or a forged request, already critical): as before
                 new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
                               method=method, window=(t0, t1), tolerances=tol)
             else:
                 for key in ("margin", "epsilon", "method"):
-                    if c[key] != getattr(logged_req, key):
+                    if c[key] != getattr(req, key):
                         find(CRITICAL, f"{key}={_short(c[key], 40)} differs from the logged request's "
-                                       f"{getattr(logged_req, key)}", k)
+                                       f"{getattr(req, key)}", k)
                 # the logged settings (ongoing rule, penetration_tol, ...) with this window's span,
                 # the certificate's margin/epsilon/method and the default budget per window
-                new = certify(scene, plan, request=logged_req.replace(
+                new = certify(scene, plan, request=req.replace(
                     margin=float(c["margin"]), epsilon=float(c["epsilon"]), method=method, window=(t0, t1)))
         except (MonitorError, ValueError, KeyError, TypeError, IndexError, OverflowError) as exc:
             out["errors"].append({"index": k, "sim_time": c.get("sim_time"),
@@ -733,6 +939,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
+    _request_findings(used_requests, requests, find, notes)
+    if no_request_id and (used_requests or len(requests) > 1):
+        notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
+                     f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))
+    elif no_request_id and logged_req is None and certs:
+        notes.append("no logged request (a log written before requests were logged, or certificates "
+                     "without one): re-derived with the plain rule (ongoing='violation'); a run under the "
+                     "ongoing-contact rule shows its resting contacts as flips")
     out["critical"] += sum(f["severity"] == CRITICAL for f in findings)
     out["unverifiable"] = sum(f["severity"] == UNVERIFIABLE for f in findings)
     return out
