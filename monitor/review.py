@@ -500,7 +500,8 @@ def _allowed_set(rows: Any) -> set[tuple[frozenset, str]]:
 
 def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol: Any,
                        run: dict[str, Any], allowed: list | None, hazards: Any,
-                       find: Callable[..., None], notes: list[str], expect_pairs: str | None = None) -> Any:
+                       find: Callable[..., None], notes: list[str], expect_pairs: str | None = None,
+                       first_start: np.ndarray | None = None) -> Any:
     """Check the logged pair policy's claims against the model; the scene to re-derive with.
 
     * ``hazards``: a note lists the candidate pairs it left out (never certified).
@@ -510,10 +511,14 @@ def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol:
       allowed pairs are re-derived from the model (the ACM at the logged ``reference_qpos``,
       ``allow`` patterns, ``hazards``); a logged allowed pair the re-derivation does not give
       is CRITICAL and the windows are then re-derived on the re-derived pair set (so the pair
-      comes back into every window). ``"given"`` (a user's matrix) or absent (older logs):
-      reasons other than Adjacent cannot be re-derived; a note says so, and with
-      ``expect_pairs`` (the auditor requires the model's pair set) they are CRITICAL and the
-      windows are re-derived without them.
+      comes back into every window).
+    * What rests on a claim of the run, not on the model: every non-Adjacent reason under
+      ``"given"`` (a user's matrix) or without ``allowed_mode`` (older logs), User pairs (the
+      ``allow=`` items), and Default/Always at a ``reference_qpos`` that is not
+      ``first_start`` (the first window's start qpos, (nq,), None when unknown: a gate resolves
+      ``"auto"`` at the first state it sees). A note lists them; with ``expect_pairs`` (the
+      auditor requires the model's pair set) they are CRITICAL and the windows are re-derived
+      without them.
     """
     from monitor.acm import _adjacent
     from monitor.errors import MonitorError
@@ -540,57 +545,81 @@ def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol:
             find(CRITICAL, f"allowed pair {a}/{b} claims reason Adjacent, but its bodies are not adjacent in "
                            f"the attached model")
     mode = run.get("allowed_mode")
-    claimed = [r for r in allowed or () if r[2] != "Adjacent"]
-    if expect_pairs is not None and mode in (None, "given") and claimed:
-        find(CRITICAL, f"{len(claimed)} allowed pair(s) whose reasons cannot be re-derived from the model "
-                       f"({_short([list(r) for r in claimed], 120)}): the required {expect_pairs!r} pair set "
-                       f"checks them")
-        keep = [r for r in allowed or () if r[2] == "Adjacent"]
-        try:
-            return scene_cls.from_model(model, pairs=policy, tolerances=tol,
-                                        **({"allowed": keep} if keep else {}))
-        except (MonitorError, ValueError, TypeError):  # pragma: no cover - the same policy built above
-            return scene
-    if mode is None:
-        if allowed:
-            notes.append("the log does not say how its allowed pairs were chosen (no allowed_mode: a log "
-                         "from before it was logged): reasons other than Adjacent were not re-derived")
-        return scene
-    if mode not in ("auto", "none", "given"):
+    if mode is not None and mode not in ("auto", "none", "given"):
         find(CRITICAL, f"run metadata allowed_mode={_short(mode, 40)} is not 'auto', 'none' or 'given'")
-        return scene
-    if mode == "given":
-        if allowed:
-            notes.append(f"the run's allowed-contact matrix was given by its user: its {len(allowed)} "
-                         f"allowed pair(s) are the user's claim (reasons other than Adjacent not re-derived)")
-        return scene
+        mode = None
     ref = run.get("reference_qpos")
     if ref is not None and not (isinstance(ref, list) and len(ref) == model.nq
                                 and all(_is_num(x) for x in ref)):
         find(CRITICAL, f"run metadata reference_qpos is not {model.nq} finite numbers: {_short(ref, 80)}")
-        return scene
+        mode = None if mode == "auto" else mode
+        ref = None
+    rows = [tuple(r) for r in allowed or ()]
+    out = scene
+    if mode in ("auto", "none"):
+        try:
+            again = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                         allowed="auto" if mode == "auto" else None, hazards=hazards,
+                                         allow=run.get("allow"),
+                                         reference=None if ref is None else np.asarray(ref, np.float64))
+        except (MonitorError, ValueError, TypeError) as exc:
+            find(CRITICAL, f"cannot re-derive the allowed pairs (allowed={mode!r}, "
+                           f"allow={_short(run.get('allow'), 60)}) for the attached model: "
+                           f"{_short(str(exc), 200)}")
+            return scene
+        logged, derived = _allowed_set(rows), _allowed_set(again.allowed_pairs)
+        extra = sorted(logged - derived, key=lambda x: (sorted(x[0]), x[1]))
+        for pair, why in extra:
+            find(CRITICAL, f"allowed pair {'/'.join(sorted(pair))} (reason {why}) is not what "
+                           f"allowed={mode!r} gives for the attached model at the logged reference pose: "
+                           f"re-derived with the pair")
+        if derived - logged:
+            notes.append(f"{len(derived - logged)} pair(s) the re-derived policy allows were checked by the "
+                         f"run (stricter than needed)")
+        if extra:
+            out, rows = again, [tuple(r) for r in again.allowed_pairs]
+        else:
+            notes.append(f"the {len(logged)} allowed pair(s) were re-derived from the model and the logged "
+                         f"policy (allowed={mode!r})")
+    # what rests on a claim of the run rather than on the model: a user's matrix (or an old log's
+    # unexplained reasons), allow= items, and Default/Always at a reference pose that is not the
+    # first window's start state (a gate resolves "auto" at the first state it sees)
+    ref_claimed = (mode == "auto" and ref is not None
+                   and (first_start is None or not np.array_equal(np.asarray(ref, np.float64), first_start)))
+    claimed = [r for r in rows if r[2] != "Adjacent" and (
+        mode in (None, "given") or r[2] == "User" or (ref_claimed and r[2] in ("Default", "Always")))]
+    if not claimed:
+        return out
+    why = {None: "the log does not say how they were chosen (no allowed_mode: a log from before it was "
+                 "logged)", "given": "the run's allowed-contact matrix was given by its user",
+           "none": "they come from the run's allow= items",
+           "auto": "they come from the run's allow= items or rest on a reference pose that is not the "
+                   "first window's start state"}[mode]
+    shown = _short([list(r) for r in claimed], 160)
+    if expect_pairs is None:
+        notes.append(f"{len(claimed)} allowed pair(s) are the run's claim, not re-derived from the model "
+                     f"({why}): {shown}")
+        return out
+    find(CRITICAL, f"{len(claimed)} allowed pair(s) whose reasons cannot be re-derived from the model "
+                   f"({why}): {shown}; the required {expect_pairs!r} pair set checks them")
+    keep = [r for r in rows if r not in claimed]
     try:
-        again = scene_cls.from_model(model, pairs=policy, tolerances=tol,
-                                     allowed="auto" if mode == "auto" else None, hazards=hazards,
-                                     allow=run.get("allow"),
-                                     reference=None if ref is None else np.asarray(ref, np.float64))
-    except (MonitorError, ValueError, TypeError) as exc:
-        find(CRITICAL, f"cannot re-derive the allowed pairs (allowed={mode!r}, "
-                       f"allow={_short(run.get('allow'), 60)}) for the attached model: "
-                       f"{_short(str(exc), 200)}")
-        return scene
-    logged, derived = _allowed_set(allowed or ()), _allowed_set(again.allowed_pairs)
-    extra = sorted(logged - derived, key=lambda x: (sorted(x[0]), x[1]))
-    for pair, why in extra:
-        find(CRITICAL, f"allowed pair {'/'.join(sorted(pair))} (reason {why}) is not what allowed={mode!r} "
-                       f"gives for the attached model at the logged reference pose: re-derived with the pair")
-    if derived - logged:
-        notes.append(f"{len(derived - logged)} pair(s) the re-derived policy allows were checked by the run "
-                     f"(stricter than needed)")
-    if extra:
-        return again
-    notes.append(f"the {len(logged)} allowed pair(s) were re-derived from the model (allowed={mode!r})")
-    return scene
+        return scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                    **({"allowed": keep} if keep else {}))
+    except (MonitorError, ValueError, TypeError):  # pragma: no cover - the same policy built above
+        return out
+
+
+def _first_start(contents: LogContents, model: Any) -> np.ndarray | None:
+    """(nq,) qpos at the start of window 0's joint-space plan, or None (no such plan)."""
+    for p in contents.topic(topics.PLAN):
+        if p.get("index") == 0 and p.get("kind", "plan") == "plan":
+            try:
+                q = np.asarray(p["qpos"][0], np.float64)
+            except (KeyError, IndexError, TypeError, ValueError):
+                return None
+            return q if q.shape == (model.nq,) else None
+    return None
 
 
 def _engine() -> tuple[Any, Any]:
@@ -816,7 +845,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            f"not valid for the attached model: {exc}")
         if scene is not None:
             scene = _check_pair_policy(model, scene_cls, scene, policy, tol, run, allowed, hazards,
-                                       find, notes, expect_pairs)
+                                       find, notes, expect_pairs, _first_start(contents, model))
         if isinstance(policy, list):
             notes.append(f"pair policy is an explicit list of {len(policy)} pair(s): only those pairs are "
                          f"certified")

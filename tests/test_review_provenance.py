@@ -50,9 +50,11 @@ def _spec():
     return mujoco.MjSpec.from_string(XML)
 
 
-def _run(model, path, steps, log_options=None, between=None, **gate_kw):
+def _run(model, path, steps, log_options=None, between=None, qpos=None, **gate_kw):
     """A gated run of the ball dropping 1 cm onto the floor (a resting contact from ~window 5)."""
     data = mujoco.MjData(model)
+    if qpos is not None:
+        data.qpos[:] = qpos
     reports = []
     kw = {"pairs": "all", "frame_skip": 5, "log": path,
           "log_options": {"model_source": _spec(), **(log_options or {})}}
@@ -96,7 +98,12 @@ def test_an_allow_gate_log_rederives_its_user_pairs(model, tmp_path):
     assert contents.run["allow"] == [["ball", "wall"]] and contents.run["allowed_mode"] == "none"
     ver = review.verify(contents)
     assert ver["critical"] == 0 and ver["pairs_differ"] == 0, _critical(ver)
-    assert any("re-derived from the model (allowed='none')" in n for n in ver["notes"]), ver["notes"]
+    assert any("re-derived from the model and the logged policy (allowed='none')" in n
+               for n in ver["notes"]), ver["notes"]
+    assert any("1 allowed pair(s) are the run's claim" in n and "allow= items" in n
+               for n in ver["notes"]), ver["notes"]
+    strict = review.verify(contents, expect_pairs="all")  # an auditor who requires every pair
+    assert any("cannot be re-derived from the model" in r for r in _critical(strict)), _critical(strict)
     # the allow record edited away: the logged User pair is no longer what the policy gives
     contents.run["allow"] = None
     ver = review.verify(contents)
@@ -109,18 +116,19 @@ def test_a_default_gate_logs_its_auto_reference_and_review_rederives_it(model, t
     ref = model.qpos0.copy()
     ref[2] = 0.05  # the ball resting on the floor: Default at the reference pose
 
-    def set_reference(k, gate):
-        if k == 0:
+    def set_reference(k, gate):  # the documented reference: the first state (Gate.step resolves
+        if k == 0:               # "auto" before reading it on bc78fcb: set it as SafetyGate does)
             gate.reference_qpos = ref
 
-    _run(model, path, 8, between=set_reference)  # allowed="auto"
+    _run(model, path, 8, between=set_reference, qpos=ref)  # allowed="auto"
     contents = read_log(path)
     assert contents.run["allowed_mode"] == "auto" and contents.run["reference_qpos"] == ref.tolist()
     assert [r[2] for r in contents.run["allowed_pairs"]] == ["Default"]
     ver = review.verify(contents)
     assert ver["critical"] == 0, _critical(ver)
-    assert any("1 allowed pair(s) were re-derived from the model (allowed='auto')" in n
+    assert any("1 allowed pair(s) were re-derived from the model and the logged policy (allowed='auto')" in n
                for n in ver["notes"]), ver["notes"]
+    assert not any("claim" in n for n in ver["notes"]), ver["notes"]
 
 
 # ----------------------------------------------------------------------------- gap 2: settings change
@@ -304,7 +312,8 @@ def test_a_user_matrix_claim_is_noted_and_critical_when_the_auditor_requires_the
         "allowed_pairs": [["wall", "ball", "User"]], "allowed_mode": "given"})
     ver = review.verify(contents)
     assert ver["critical"] == 0
-    assert any("given by its user: its 1 allowed pair(s) are the user's claim" in n for n in ver["notes"])
+    assert any("1 allowed pair(s) are the run's claim" in n and "given by its user" in n
+               for n in ver["notes"]), ver["notes"]
     strict = review.verify(contents, expect_pairs="all")
     assert any("cannot be re-derived from the model" in r for r in _critical(strict)), _critical(strict)
     assert [m["recomputed"] for m in strict["mismatches"]] == ["violation"]
@@ -320,3 +329,22 @@ def test_forged_policy_records_are_findings_never_tracebacks(model, tmp_path):
         contents.run[key] = value
         ver = review.verify(contents)
         assert any(want in r for r in _critical(ver)), (key, _critical(ver))
+
+
+def test_a_reference_pose_that_is_not_the_first_state_is_a_claim(model, tmp_path):
+    """The forger moves the logged reference so that the ball touches the wall there: "auto"
+    then re-derives ball/wall as Default. The reference is not the first window's start state,
+    so the pair is listed as the run's claim, and is CRITICAL when the auditor requires the pair set."""
+    touching = model.qpos0.copy()
+    touching[0], touching[2] = WALL_X - WALL_HALF - BALL_R, 0.5  # the ball's surface on the wall's face
+    again = Scene.from_model(model, pairs="all", allowed="auto", reference=touching)
+    rows = [list(r) for r in again.allowed_pairs if "wall" in r]
+    assert [r[2] for r in rows] == ["Default"]  # the forger's premise
+    contents = _forged_allowed_log(model, tmp_path / "ref.mcap", {
+        "allowed_pairs": rows, "allowed_mode": "auto", "reference_qpos": touching.tolist()})
+    ver = review.verify(contents)
+    assert any("1 allowed pair(s) are the run's claim" in n and "reference pose" in n
+               for n in ver["notes"]), ver["notes"]
+    strict = review.verify(contents, expect_pairs="all")
+    assert any("cannot be re-derived from the model" in r for r in _critical(strict)), _critical(strict)
+    assert [m["recomputed"] for m in strict["mismatches"]] == ["violation"]
