@@ -6,7 +6,8 @@
   the log and the logged plan. Everything else in the log is a claim that is
   checked, never obeyed: the certificate's pair set must equal the one the model
   and the logged pair policy give, its window must equal the plan's span, its
-  margin/epsilon/method must be valid and equal the run's, window indices must be
+  margin/epsilon/method must be valid and equal its request's (each certificate names the
+  request it answers; older logs: the run's), window indices must be
   unique, verdicts must be one of the three, logged tolerances must be valid (the
   recomputation uses the library defaults unless the caller passes others), and
   ``model.xml`` must describe the same model as ``model.mjb``. A failed claim is a
@@ -718,11 +719,15 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
-    the pair set ``Scene.from_model(model, pairs=<logged policy>)`` (the policy is the one
-    claim that defines *what* is certified; a missing policy is assumed ``"mujoco"`` and
-    reported), the library's default :class:`~monitor.tolerances.Tolerances` (or
-    ``tolerances`` from the caller), and the certificate's margin, epsilon and method once
-    they are checked; the window is always the plan's span.
+    the pair set ``Scene.from_model(model, pairs=<logged policy>, allowed=<logged allowed
+    pairs>, hazards=<logged items>)`` (the policy is the one claim that defines *what* is
+    certified; a missing policy is assumed ``"mujoco"`` and reported; the allowed pairs are
+    re-derived from the model where the log says how they were chosen, see
+    :func:`_check_pair_policy`), the library's default :class:`~monitor.tolerances.Tolerances`
+    (or ``tolerances`` from the caller), the window's own request (its ``request_id``:
+    ongoing rule, penetration_tol; logs without ids: the run's request, else the plain rule),
+    and the certificate's margin, epsilon and method once they are checked against that
+    request; the window is always the plan's span.
 
     Claims checked (a failure is a *critical* finding, exit 1 in the CLI): verdict is
     one of the three; index unique among certificates and among plans; method known;
@@ -734,9 +739,15 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     not-certified flips are critical, except logged "uncertain" windows whose
     ``stats["budget_exhausted"]`` is true).
 
+    Also critical: a ``request_id`` naming no logged request, a request id defined twice
+    with different contents, a malformed request, an allowed pair whose Adjacent reason the
+    model contradicts or that the logged policy does not re-derive to.
+
     Unverifiable findings (exit 2 in the CLI): a malformed certificate, a window without
     plan, an error while rebuilding or certifying, windows left out by ``limit``, a model
-    whose XML and MJB cannot be cross-checked, no logged pair policy.
+    whose XML and MJB cannot be cross-checked, no logged pair policy, and a later request
+    that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
+    setting changed during the run and an added record look the same).
 
     Args:
         contents: a read log.

@@ -299,6 +299,18 @@ def test_an_allowed_pair_the_auto_matrix_does_not_give_is_critical(model, tmp_pa
     assert review.verify_exit_code(ver) == 1
 
 
+def test_the_cli_names_the_forged_allowed_pair(model, tmp_path, capsys):
+    from monitor.cli import main
+
+    path = tmp_path / "cli.mcap"
+    _forged_allowed_log(model, path, {"allowed_pairs": [["wall", "ball", "Default"]], "allowed_mode": "auto",
+                                      "reference_qpos": None})
+    assert main(["review", "--verify", "--no-progress", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "[CRITICAL] log: allowed pair ball/wall (reason Default) is not what allowed='auto' gives" in out
+    assert "logged certified -> recomputed violation  [CRITICAL]" in out
+
+
 def test_an_adjacent_claim_for_unrelated_bodies_is_critical(model, tmp_path):
     contents = _forged_allowed_log(model, tmp_path / "adj.mcap",
                                    {"allowed_pairs": [["wall", "ball", "Adjacent"]]})

@@ -49,7 +49,10 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                    help="--verify only the first N windows of each log (the rest are unverified: exit 2)")
     p.add_argument("--expect-pairs", choices=("mujoco", "all"), default=None,
                    help="--verify requires this pair policy (a log claiming another one, e.g. a short "
-                        "explicit list, is critical); default: the logged policy, reported")
+                        "explicit list or hazards= items, is critical, and so are allowed pairs that "
+                        "rest on the run's claim rather than on the model: allow= items, a user's "
+                        "matrix, a reference pose that is not the first window's start); default: the "
+                        "logged policy, reported")
     p.add_argument("--tolerances", metavar="JSON", default=None,
                    help="tolerance fields for --verify, e.g. '{\"abs_pad\": 1e-10}' (default: the library's; "
                         "logged tolerances are only compared, never used)")
