@@ -462,7 +462,7 @@ def _loosened(base: Any, req: Any) -> list[str]:
 
 
 def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find: Callable[..., None],
-                      notes: list[str]) -> None:
+                      notes: list[str], run_claims: dict[str, float] | None = None) -> None:
     """Notes on the requests the windows were re-derived with; an UNVERIFIABLE finding per loosening.
 
     The baseline is request 0 when the run metadata has it (a gate's settings at log open),
@@ -470,13 +470,19 @@ def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find
     means (:func:`_loosened`) is what a gate setting changed during the run looks like, and
     also what a forger adding a looser request record would write: the log cannot tell the
     two apart (its seal is not signed), so such windows are reported as unverifiable (exit 2),
-    never as agreed. Tightening or neutral changes are notes.
+    never as agreed. Tightening or neutral changes are notes. The run metadata's margin and
+    epsilon (``run_claims``) are the settings the run started with: the baseline must have
+    them (CRITICAL otherwise: a forger cannot lower request 0 and leave the run's claim).
     """
     if not used:
         return
     ids = sorted(used, key=lambda r: min(used[r]))
     base_id = 0 if requests.get(0) is not None else ids[0]
     base = requests[base_id]
+    for key, v in (run_claims or {}).items():
+        if getattr(base, key) != v:
+            find(CRITICAL, f"request {base_id} (the run's first) has {key}={getattr(base, key)}, the run "
+                           f"metadata {key}={v}")
     for rid in ids:
         req, ks = requests[rid], used[rid]
         fields = ", ".join(f"{f}={getattr(req, f)}" for f in _RULE_FIELDS)
@@ -979,7 +985,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
-    _request_findings(used_requests, requests, find, notes)
+    _request_findings(used_requests, requests, find, notes, run_claims)
     if no_request_id and (used_requests or len(requests) > 1):
         notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
                      f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))

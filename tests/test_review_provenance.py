@@ -360,3 +360,17 @@ def test_a_reference_pose_that_is_not_the_first_state_is_a_claim(model, tmp_path
     strict = review.verify(contents, expect_pairs="all")
     assert any("cannot be re-derived from the model" in r for r in _critical(strict)), _critical(strict)
     assert [m["recomputed"] for m in strict["mismatches"]] == ["violation"]
+
+
+def test_request_0_must_carry_the_run_metadata_margin(model, tmp_path):
+    """The forger lowers the margin in request 0 and in every certificate but leaves the run
+    metadata's margin (both are written at open by the gate): CRITICAL."""
+    path = tmp_path / "m0.mcap"
+    _run(model, path, 6, allowed=None, margin=0.004)
+    contents = read_log(path)
+    contents.run["request"] = {**contents.run["request"], "margin": 0.0}
+    for c in contents.topic(topics.CERTIFICATE):
+        c["margin"] = 0.0
+    crit = _critical(review.verify(contents))
+    assert any("request 0 (the run's first) has margin=0.0, the run metadata margin=0.004" in r
+               for r in crit), crit
