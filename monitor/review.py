@@ -462,7 +462,8 @@ def _loosened(base: Any, req: Any) -> list[str]:
 
 
 def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find: Callable[..., None],
-                      notes: list[str], run_claims: dict[str, float] | None = None) -> None:
+                      notes: list[str], run_claims: dict[str, float] | None = None,
+                      max_penetration: float | None = None) -> None:
     """Notes on the requests the windows were re-derived with; an UNVERIFIABLE finding per loosening.
 
     The baseline is request 0 when the run metadata has it (a gate's settings at log open),
@@ -473,9 +474,19 @@ def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find
     never as agreed. Tightening or neutral changes are notes. The run metadata's margin and
     epsilon (``run_claims``) are the settings the run started with: the baseline must have
     them (CRITICAL otherwise: a forger cannot lower request 0 and leave the run's claim).
+    With ``max_penetration`` (m, the auditor's bound), a request that lets ongoing contacts
+    deepen beyond it (``ongoing="deepen"`` with a larger ``penetration_tol``) is CRITICAL.
     """
     if not used:
         return
+    if max_penetration is not None:
+        for rid in sorted(used):
+            req = requests[rid]
+            if req.ongoing == "deepen" and req.penetration_tol > max_penetration:
+                ks = used[rid]
+                find(CRITICAL, f"request {rid} lets ongoing contacts deepen to penetration_tol="
+                               f"{req.penetration_tol} m, more than the required {max_penetration} m "
+                               f"({len(ks)} window(s), first {min(ks)})", min(ks))
     ids = sorted(used, key=lambda r: min(used[r]))
     base_id = 0 if requests.get(0) is not None else ids[0]
     base = requests[base_id]
@@ -721,7 +732,7 @@ def _pair_key(geoms: Any) -> frozenset:
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
            limit: int | None = None, tolerances: dict[str, Any] | None = None,
-           expect_pairs: str | None = None) -> dict[str, Any]:
+           expect_pairs: str | None = None, max_penetration: float | None = None) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
@@ -764,6 +775,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         expect_pairs: ``"mujoco"`` or ``"all"``: the pair policy the auditor requires. A log
             whose policy differs is critical and is recomputed with this policy instead (a
             log that consistently claims fewer pairs is otherwise only reported in a note).
+        max_penetration: metres, the deepest ongoing contact the auditor accepts: a window
+            answered under ``ongoing="deepen"`` with a larger ``penetration_tol`` is critical
+            (a log that consistently claims a loose rule is otherwise only reported in a note).
+            0 requires the plain rule.
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -785,6 +800,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     from monitor.log.reader import load_model, model_consistency
 
     tol = make_tolerances(tolerances)
+    if max_penetration is not None and not (_is_num(max_penetration) and max_penetration >= 0):
+        raise InvalidInputError(f"max_penetration must be a finite number >= 0 (m), got {max_penetration!r}")
     scene_cls, certify = _engine()
     model, how = load_model(contents, model_source)
     run = contents.run
@@ -917,6 +934,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         req, rid = logged_req, c.get("request_id")
         if rid is None:
             no_request_id += 1
+            if logged_req is not None:
+                used_requests.setdefault(0, []).append(k)
         elif not _is_int(rid) or rid not in requests:
             find(CRITICAL, f"request_id {_short(rid, 40)} names no logged request", k)
         elif requests[rid] is not None:
@@ -985,7 +1004,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
-    _request_findings(used_requests, requests, find, notes, run_claims)
+    _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
     if no_request_id and (used_requests or len(requests) > 1):
         notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
                      f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))

@@ -374,3 +374,25 @@ def test_request_0_must_carry_the_run_metadata_margin(model, tmp_path):
     crit = _critical(review.verify(contents))
     assert any("request 0 (the run's first) has margin=0.0, the run metadata margin=0.004" in r
                for r in crit), crit
+
+
+def test_max_penetration_makes_a_loose_rule_critical_in_library_and_cli(model, tmp_path, capsys):
+    """A log claiming a loose rule from its first window (the residual of the looser-request attack:
+    consistent from the start) passes with a note; an auditor's bound makes it CRITICAL."""
+    from monitor.cli import main
+    from monitor.errors import InvalidInputError
+
+    path = tmp_path / "deep.mcap"
+    _run(model, path, 12, allowed=None, penetration_tol=0.02)
+    contents = read_log(path)
+    assert review.verify(contents)["critical"] == 0
+    assert review.verify(contents, max_penetration=0.02)["critical"] == 0
+    crit = _critical(review.verify(contents, max_penetration=0.005))
+    assert any("lets ongoing contacts deepen to penetration_tol=0.02 m, more than the required 0.005 m" in r
+               for r in crit), crit
+    assert main(["review", "--verify", "--no-progress", "--max-penetration", "0", str(path)]) == 1
+    assert "more than the required 0.0 m" in capsys.readouterr().out
+    assert main(["review", "--verify", "--max-penetration", "nan", str(path)]) == 2
+    assert "--max-penetration must be a finite number" in capsys.readouterr().err
+    with pytest.raises(InvalidInputError, match="max_penetration"):
+        review.verify(contents, max_penetration=-1.0)
