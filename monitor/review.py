@@ -640,6 +640,19 @@ def _first_start(contents: LogContents, model: Any) -> np.ndarray | None:
     return None
 
 
+def _unlogged_applied(contents: LogContents) -> int:
+    """Replaced actions whose applied window has no certificate of its own in the log.
+
+    A gate writes a blocked step as its proposal's window (action ``replaced``) and, only when
+    the applied motion is not certified, a second window at the same episode and sim time.
+    """
+    def at(m: dict[str, Any]) -> tuple[str, str]:  # text: crafted values may be unhashable
+        return str(m.get("episode", 0)), str(m.get("sim_time"))
+
+    per_time = Counter(at(c) for c in contents.certificates())
+    return sum(1 for a in contents.topic(topics.ACTION) if a.get("replaced") is True and per_time[at(a)] < 2)
+
+
 def _engine() -> tuple[Any, Any]:
     """(Scene class, certify function); ImportError while the engine is not installed."""
     from monitor.certify.engine import certify
@@ -1005,6 +1018,11 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
+    unlogged = _unlogged_applied(contents)
+    if unlogged:
+        notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "
+                     f"(a gate logs the applied window only when it is not certified: the committed brake's "
+                     f"tail or a certified fallback): re-derived are the proposals, not what was applied")
     if no_request_id and (used_requests or len(requests) > 1):
         notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
                      f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))

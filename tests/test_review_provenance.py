@@ -396,3 +396,28 @@ def test_max_penetration_makes_a_loose_rule_critical_in_library_and_cli(model, t
     assert "--max-penetration must be a finite number" in capsys.readouterr().err
     with pytest.raises(InvalidInputError, match="max_penetration"):
         review.verify(contents, max_penetration=-1.0)
+
+
+def test_review_says_how_many_applied_motions_are_not_in_the_log(tmp_path):
+    """A blocked step whose applied motion is certified (the committed brake's tail, a certified
+    fallback) logs only its proposal: review says how many such motions it did not re-derive.
+    Oracle: the gate's own counters (replaced - fallback_uncertified)."""
+    import gymnasium as gym
+
+    import monitor.envs  # noqa: F401  (registers the ids)
+    from monitor.gym_gate import SafetyGate
+
+    path = tmp_path / "arm.mcap"
+    env = SafetyGate(gym.make("monitor/Arm-v0"), log=path)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    for _ in range(40):
+        env.step(env.action_space.sample())
+    stats = dict(env.gate.stats)
+    env.close()
+    unlogged = stats["replaced"] - stats["fallback_uncertified"]
+    assert unlogged > 0  # random actions on the Arm get blocked
+    ver = review.verify(read_log(path))
+    assert ver["critical"] == 0, _critical(ver)
+    assert any(n.startswith(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in "
+                            f"the log") for n in ver["notes"]), ver["notes"]
