@@ -574,7 +574,7 @@ def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol:
         ref = None
     rows = [tuple(r) for r in allowed or ()]
     out = scene
-    if mode in ("auto", "none"):
+    if mode in ("auto", "none") and rows:  # nothing allowed: nothing to re-derive (and no ACM to compute)
         try:
             again = scene_cls.from_model(model, pairs=policy, tolerances=tol,
                                          allowed="auto" if mode == "auto" else None, hazards=hazards,
