@@ -85,6 +85,10 @@ def test_a_hazards_gate_log_rebuilds_its_pair_set(model, tmp_path):
     assert any("hazards=" in n and "1 candidate pair(s) were not certified" in n and "ball/floor" in n
                for n in ver["notes"]), ver["notes"]
     assert review.verify_exit_code(ver) == 0
+    # an auditor who requires every pair: the hazards= subset is CRITICAL and ignored
+    strict = review.verify(read_log(path), expect_pairs="all")
+    assert any("logged hazards=[['ball', 'wall']] selects a subset" in r for r in _critical(strict))
+    assert strict["pairs_differ"] >= 6
     # the same log without the record (a log from before): the pair sets differ on every window
     old = read_log(path)
     old.run.pop("hazards")
