@@ -742,6 +742,13 @@ def _part(cert: Certificate, window: tuple[float, float], span: list[float]) -> 
     return out
 
 
+def _json_items(items: Any) -> Any:
+    """``hazards=`` / ``allow=`` pattern items as JSON (one string stays one item; pairs -> lists)."""
+    if items is None or isinstance(items, str):
+        return items
+    return [x if isinstance(x, str) else [str(v) for v in x] for x in items]
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -1540,21 +1547,38 @@ class Gate:
                 warnings.warn(f"monitor.Gate: log {str(spec)!r} is being written by another gate; this gate "
                               f"writes {str(path)!r}", UserWarning, stacklevel=4)
             self.log_path = path
-            meta = {"margin": self.margin, "epsilon": self.epsilon, "pairs": str(self.pairs),
+            meta = {"margin": self.margin, "epsilon": self.epsilon,
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,
-                    # every certify setting (ongoing rule, tolerances, budget, ...): review --verify
-                    # re-derives each window with it (CertifyRequest.from_json)
-                    "request": self.request.to_json(),
-                    # candidate pairs the allowed-contact matrix took out (never certified):
-                    # review --verify rebuilds the scene with them
-                    "allowed_pairs": [list(a) for a in self.scene.allowed_pairs]}
+                    # the certify settings at open (ongoing rule, tolerances, budget, ...): request id 0;
+                    # each certificate names its own (a setting changed later gets a new record)
+                    "request": self.request.to_json(), **self._policy_metadata()}
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
         else:
             self._log = spec
+            add = getattr(spec, "add_metadata", None)
+            if callable(add):  # a user's MonitorLog: the pair policy of the windows this gate writes
+                add(self._policy_metadata())  # (requests: per certificate, by the log itself)
         return self._log
+
+    def _policy_metadata(self) -> dict[str, Any]:
+        """Run metadata that lets ``review --verify`` rebuild (and re-derive) this gate's pair set.
+
+        ``pairs`` (mode or list), ``allowed_pairs`` (the candidate pairs the allowed-contact
+        matrix and ``allow=`` took out, with reasons: never certified), ``hazards`` / ``allow``
+        (the pattern items, JSON), ``allowed_mode`` (``"auto"``, ``"none"`` or ``"given"``: a
+        user's matrix, whose reasons review cannot re-derive) and ``reference_qpos`` (the
+        pose ``"auto"`` was resolved at; None = keyframe 0 / qpos0).
+        """
+        mode = "none" if self.allowed is None else (
+            "auto" if isinstance(self.allowed, str) and self.allowed == "auto" else "given")
+        ref = self.reference_qpos
+        return {"pairs": str(self.pairs), "allowed_pairs": [list(a) for a in self.scene.allowed_pairs],
+                "hazards": _json_items(self.hazards), "allow": _json_items(self.allow),
+                "allowed_mode": mode,
+                "reference_qpos": None if ref is None else np.asarray(ref, float).tolist()}
 
     def _write_log(self, r: StepReport, applied_plan: Any) -> None:
         log = self._open_log()

@@ -6,7 +6,8 @@
   the log and the logged plan. Everything else in the log is a claim that is
   checked, never obeyed: the certificate's pair set must equal the one the model
   and the logged pair policy give, its window must equal the plan's span, its
-  margin/epsilon/method must be valid and equal the run's, window indices must be
+  margin/epsilon/method must be valid and equal its request's (each certificate names the
+  request it answers; older logs: the run's), window indices must be
   unique, verdicts must be one of the three, logged tolerances must be valid (the
   recomputation uses the library defaults unless the caller passes others), and
   ``model.xml`` must describe the same model as ``model.mjb``. A failed claim is a
@@ -378,37 +379,278 @@ def _logged_allowed(run: dict[str, Any], find: Callable[..., None], notes: list[
     return [tuple(r) for r in raw]
 
 
-def _logged_request(run: dict[str, Any], tol: Any, find: Callable[..., None],
-                    notes: list[str]) -> Any:
-    """The run's logged :class:`~monitor.certify.request.CertifyRequest`, ready to re-derive with.
+def _parse_request(raw: Any, where: str, tol: Any, find: Callable[..., None], notes: list[str]) -> Any:
+    """A logged request record, ready to re-derive with, or None (malformed: a CRITICAL finding).
 
-    None when the log has none (an old log: re-derived as before, with the plain rule) or
-    when it is malformed or forged (a CRITICAL finding; then also as before). The request's
-    window, budget and pairs are replaced (window: each plan's span; budget: the library
-    default per window; pairs: all of the scene's, the pair policy decides them) and its
-    tolerances by the ones this verification uses (a note says when they differ).
+    The request's window, budget and pairs are replaced (window: each plan's span; budget: the
+    library default per window; pairs: all of the scene's, the pair policy decides them) and
+    its tolerances by the ones this verification uses (a note says when they differ).
     """
-    if "request" not in run:
-        return None
     from monitor.certify.request import BudgetLimits, CertifyRequest
     from monitor.errors import MonitorError
 
-    raw = run["request"]
     try:
         req = CertifyRequest.from_json(raw)
     except (MonitorError, TypeError, ValueError) as exc:
-        find(CRITICAL, f"run metadata request is malformed: {_short(str(exc), 200)}; re-derived "
+        find(CRITICAL, f"{where} is malformed: {_short(str(exc), 200)}; its windows were re-derived "
                        f"without it (plain rule)")
         return None
     if req.pairs is not None:
-        find(CRITICAL, f"run metadata request restricts the pairs to {len(req.pairs)}: ignored, the "
+        find(CRITICAL, f"{where} restricts the pairs to {len(req.pairs)}: ignored, the "
                        f"pair policy decides them")
     if req.tolerances != tol:
-        notes.append("the logged request's tolerances differ from the ones used here; the logged ones "
-                     "were not used")
+        notes.append(f"{where}: its tolerances differ from the ones used here; the logged ones "
+                     f"were not used")
     if req.window is not None:
-        notes.append(f"the logged request's window {list(req.window)} was not used (each plan's span is)")
+        notes.append(f"{where}: its window {list(req.window)} was not used (each plan's span is)")
     return req.replace(window=None, pairs=None, budget=BudgetLimits.of(None), tolerances=tol)
+
+
+def _logged_requests(contents: LogContents, tol: Any, find: Callable[..., None],
+                     notes: list[str]) -> dict[int, Any]:
+    """Every logged request by id: ``{id: ready CertifyRequest or None (malformed/ambiguous)}``.
+
+    Id 0 may be the run metadata's ``"request"`` (a gate's request at log open; the only
+    one in logs written before per-window request ids); every ``monitor.request`` record adds
+    one id. A record without an integer id, or an id defined twice with different contents,
+    is a CRITICAL finding (the id is then unusable: its windows are re-derived without it).
+    """
+    raw: dict[int, Any] = {}
+    where: dict[int, str] = {}
+    broken: set[int] = set()
+    if "request" in contents.run:
+        raw[0], where[0] = contents.run["request"], "run metadata request"
+    for rec in getattr(contents, "requests", ()):
+        rid, r = rec.get("id"), rec.get("request")
+        if not _is_int(rid) or rid < 0:
+            find(CRITICAL, f"monitor.request record with id {_short(rid, 40)} (not an integer >= 0)")
+            continue
+        if isinstance(r, dict):
+            r = {**r, "window": None}  # the writer records requests without their window
+        if rid in raw:
+            old = raw[rid] if not isinstance(raw[rid], dict) else {**raw[rid], "window": None}
+            if old != r:
+                find(CRITICAL, f"request id {rid} is defined twice with different contents ({where[rid]} "
+                               f"and a monitor.request record): its windows were re-derived without it")
+                broken.add(rid)
+            continue
+        raw[rid], where[rid] = r, f"monitor.request record {rid}"
+    out: dict[int, Any] = {}
+    for rid in sorted(raw):
+        out[rid] = None if rid in broken else _parse_request(raw[rid], where[rid], tol, find, notes)
+    return out
+
+
+_RULE_FIELDS = ("margin", "epsilon", "ongoing", "penetration_tol")
+
+
+def _loosened(base: Any, req: Any) -> list[str]:
+    """The settings of ``req`` that make "certified" weaker than under ``base`` (empty: none).
+
+    A lower margin; the ongoing-contact rule (``"deepen"``) where ``base`` had the plain rule;
+    a larger ``penetration_tol`` under ``"deepen"``. Epsilon, method and budget only move
+    answers between certified and uncertain, never what a certificate claims.
+    """
+    out = []
+    if req.margin < base.margin:
+        out.append(f"margin {base.margin} -> {req.margin}")
+    if req.ongoing == "deepen" and base.ongoing != "deepen":
+        out.append(f"ongoing {base.ongoing} -> deepen (penetration_tol {req.penetration_tol})")
+    elif req.ongoing == "deepen" and req.penetration_tol > base.penetration_tol:
+        out.append(f"penetration_tol {base.penetration_tol} -> {req.penetration_tol}")
+    return out
+
+
+def _request_findings(used: dict[int, list[int]], requests: dict[int, Any], find: Callable[..., None],
+                      notes: list[str], run_claims: dict[str, float] | None = None,
+                      max_penetration: float | None = None) -> None:
+    """Notes on the requests the windows were re-derived with; an UNVERIFIABLE finding per loosening.
+
+    The baseline is request 0 when the run metadata has it (a gate's settings at log open),
+    else the request of the earliest window. A later request that loosens what "certified"
+    means (:func:`_loosened`) is what a gate setting changed during the run looks like, and
+    also what a forger adding a looser request record would write: the log cannot tell the
+    two apart (its seal is not signed), so such windows are reported as unverifiable (exit 2),
+    never as agreed. Tightening or neutral changes are notes. The run metadata's margin and
+    epsilon (``run_claims``) are the settings the run started with: the baseline must have
+    them (CRITICAL otherwise: a forger cannot lower request 0 and leave the run's claim).
+    With ``max_penetration`` (m, the auditor's bound), a request that lets ongoing contacts
+    deepen beyond it (``ongoing="deepen"`` with a larger ``penetration_tol``) is CRITICAL.
+    """
+    if not used:
+        return
+    if max_penetration is not None:
+        for rid in sorted(used):
+            req = requests[rid]
+            if req.ongoing == "deepen" and req.penetration_tol > max_penetration:
+                ks = used[rid]
+                find(CRITICAL, f"request {rid} lets ongoing contacts deepen to penetration_tol="
+                               f"{req.penetration_tol} m, more than the required {max_penetration} m "
+                               f"({len(ks)} window(s), first {min(ks)})", min(ks))
+    ids = sorted(used, key=lambda r: min(used[r]))
+    base_id = 0 if requests.get(0) is not None else ids[0]
+    base = requests[base_id]
+    for key, v in (run_claims or {}).items():
+        if getattr(base, key) != v:
+            find(CRITICAL, f"request {base_id} (the run's first) has {key}={getattr(base, key)}, the run "
+                           f"metadata {key}={v}")
+    for rid in ids:
+        req, ks = requests[rid], used[rid]
+        fields = ", ".join(f"{f}={getattr(req, f)}" for f in _RULE_FIELDS)
+        line = (f"request {rid} ({fields}) answers {len(ks)} window(s)"
+                + (f", first {min(ks)}, last {max(ks)}" if len(used) > 1 else ""))
+        if rid != base_id:
+            diff = [f"{f} {getattr(base, f)} -> {getattr(req, f)}" for f in _RULE_FIELDS
+                    if getattr(base, f) != getattr(req, f)]
+            line += f"; differs from request {base_id}: {', '.join(diff) or 'budget/method/tolerances only'}"
+            looser = _loosened(base, req)
+            if looser:
+                find(UNVERIFIABLE, f"request {rid} loosens what 'certified' means relative to request "
+                                   f"{base_id} ({'; '.join(looser)}) for {len(ks)} window(s), first "
+                                   f"{min(ks)}: a setting changed during the run or an edited log, which "
+                                   f"the log cannot tell apart", min(ks))
+        notes.append(line)
+
+
+def _allowed_set(rows: Any) -> set[tuple[frozenset, str]]:
+    return {(frozenset(map(str, r[:2])), str(r[2])) for r in rows}
+
+
+def _check_pair_policy(model: Any, scene_cls: Any, scene: Any, policy: Any, tol: Any,
+                       run: dict[str, Any], allowed: list | None, hazards: Any,
+                       find: Callable[..., None], notes: list[str], expect_pairs: str | None = None,
+                       first_start: np.ndarray | None = None) -> Any:
+    """Check the logged pair policy's claims against the model; the scene to re-derive with.
+
+    * ``hazards``: a note lists the candidate pairs it left out (never certified).
+    * An allowed pair with reason Adjacent whose bodies are not adjacent (:func:`monitor.acm`
+      rule): CRITICAL.
+    * ``allowed_mode`` ``"auto"`` / ``"none"`` (a gate's ``allowed="auto"`` / ``None``): the
+      allowed pairs are re-derived from the model (the ACM at the logged ``reference_qpos``,
+      ``allow`` patterns, ``hazards``); a logged allowed pair the re-derivation does not give
+      is CRITICAL and the windows are then re-derived on the re-derived pair set (so the pair
+      comes back into every window).
+    * What rests on a claim of the run, not on the model: every non-Adjacent reason under
+      ``"given"`` (a user's matrix) or without ``allowed_mode`` (older logs), User pairs (the
+      ``allow=`` items), and Default/Always at a ``reference_qpos`` that is not
+      ``first_start`` (the first window's start qpos, (nq,), None when unknown: a gate resolves
+      ``"auto"`` at the first state it sees). A note lists them; with ``expect_pairs`` (the
+      auditor requires the model's pair set) they are CRITICAL and the windows are re-derived
+      without them.
+    """
+    from monitor.acm import _adjacent
+    from monitor.errors import MonitorError
+
+    if hazards is not None:
+        try:
+            every = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                         **({"allowed": allowed} if allowed else {}))
+            kept = set(map(_pair_key, scene.candidate_pairs))
+            left = sorted(set(map(_pair_key, every.candidate_pairs)) - kept, key=sorted)
+            shown = ", ".join("/".join(sorted(p)) for p in left[:8]) + (" ..." if len(left) > 8 else "")
+            notes.append(f"the run checked only the pairs hazards={_short(hazards, 80)} selects: {len(left)} "
+                         f"candidate pair(s) were not certified, in the log nor here: {shown or '-'}")
+        except (MonitorError, ValueError, TypeError) as exc:  # pragma: no cover - the scene above built
+            notes.append(f"cannot list the pairs hazards= left out: {exc}")
+    for a, b, why in allowed or ():
+        if why != "Adjacent":
+            continue
+        try:
+            ok = _adjacent(model, scene.geom(a).id, scene.geom(b).id)
+        except (MonitorError, KeyError, ValueError):
+            ok = False
+        if not ok:
+            find(CRITICAL, f"allowed pair {a}/{b} claims reason Adjacent, but its bodies are not adjacent in "
+                           f"the attached model")
+    mode = run.get("allowed_mode")
+    if mode is not None and mode not in ("auto", "none", "given"):
+        find(CRITICAL, f"run metadata allowed_mode={_short(mode, 40)} is not 'auto', 'none' or 'given'")
+        mode = None
+    ref = run.get("reference_qpos")
+    if ref is not None and not (isinstance(ref, list) and len(ref) == model.nq
+                                and all(_is_num(x) for x in ref)):
+        find(CRITICAL, f"run metadata reference_qpos is not {model.nq} finite numbers: {_short(ref, 80)}")
+        mode = None if mode == "auto" else mode
+        ref = None
+    rows = [tuple(r) for r in allowed or ()]
+    out = scene
+    if mode in ("auto", "none") and rows:  # nothing allowed: nothing to re-derive (and no ACM to compute)
+        try:
+            again = scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                         allowed="auto" if mode == "auto" else None, hazards=hazards,
+                                         allow=run.get("allow"),
+                                         reference=None if ref is None else np.asarray(ref, np.float64))
+        except (MonitorError, ValueError, TypeError) as exc:
+            find(CRITICAL, f"cannot re-derive the allowed pairs (allowed={mode!r}, "
+                           f"allow={_short(run.get('allow'), 60)}) for the attached model: "
+                           f"{_short(str(exc), 200)}")
+            return scene
+        logged, derived = _allowed_set(rows), _allowed_set(again.allowed_pairs)
+        extra = sorted(logged - derived, key=lambda x: (sorted(x[0]), x[1]))
+        for pair, why in extra:
+            find(CRITICAL, f"allowed pair {'/'.join(sorted(pair))} (reason {why}) is not what "
+                           f"allowed={mode!r} gives for the attached model at the logged reference pose: "
+                           f"re-derived with the pair")
+        if derived - logged:
+            notes.append(f"{len(derived - logged)} pair(s) the re-derived policy allows were checked by the "
+                         f"run (stricter than needed)")
+        if extra:
+            out, rows = again, [tuple(r) for r in again.allowed_pairs]
+        else:
+            notes.append(f"the {len(logged)} allowed pair(s) were re-derived from the model and the logged "
+                         f"policy (allowed={mode!r})")
+    # what rests on a claim of the run rather than on the model: a user's matrix (or an old log's
+    # unexplained reasons), allow= items, and Default/Always at a reference pose that is not the
+    # first window's start state (a gate resolves "auto" at the first state it sees)
+    ref_claimed = (mode == "auto" and ref is not None
+                   and (first_start is None or not np.array_equal(np.asarray(ref, np.float64), first_start)))
+    claimed = [r for r in rows if r[2] != "Adjacent" and (
+        mode in (None, "given") or r[2] == "User" or (ref_claimed and r[2] in ("Default", "Always")))]
+    if not claimed:
+        return out
+    why = {None: "the log does not say how they were chosen (no allowed_mode: a log from before it was "
+                 "logged)", "given": "the run's allowed-contact matrix was given by its user",
+           "none": "they come from the run's allow= items",
+           "auto": "they come from the run's allow= items or rest on a reference pose that is not the "
+                   "first window's start state"}[mode]
+    shown = _short([list(r) for r in claimed], 160)
+    if expect_pairs is None:
+        notes.append(f"{len(claimed)} allowed pair(s) are the run's claim, not re-derived from the model "
+                     f"({why}): {shown}")
+        return out
+    find(CRITICAL, f"{len(claimed)} allowed pair(s) whose reasons cannot be re-derived from the model "
+                   f"({why}): {shown}; the required {expect_pairs!r} pair set checks them")
+    keep = [r for r in rows if r not in claimed]
+    try:
+        return scene_cls.from_model(model, pairs=policy, tolerances=tol,
+                                    **({"allowed": keep} if keep else {}))
+    except (MonitorError, ValueError, TypeError):  # pragma: no cover - the same policy built above
+        return out
+
+
+def _first_start(contents: LogContents, model: Any) -> np.ndarray | None:
+    """(nq,) qpos at the start of window 0's joint-space plan, or None (no such plan)."""
+    for p in contents.topic(topics.PLAN):
+        if p.get("index") == 0 and p.get("kind", "plan") == "plan":
+            try:
+                q = np.asarray(p["qpos"][0], np.float64)
+            except (KeyError, IndexError, TypeError, ValueError):
+                return None
+            return q if q.shape == (model.nq,) else None
+    return None
+
+
+def _unlogged_applied(contents: LogContents) -> int:
+    """Replaced actions whose applied window has no certificate of its own in the log.
+
+    A gate writes a blocked step as its proposal's window (action ``replaced``) and, only when
+    the applied motion is not certified, a second window at the same episode and sim time.
+    """
+    def at(m: dict[str, Any]) -> tuple[str, str]:  # text: crafted values may be unhashable
+        return str(m.get("episode", 0)), str(m.get("sim_time"))
+
+    per_time = Counter(at(c) for c in contents.certificates())
+    return sum(1 for a in contents.topic(topics.ACTION) if a.get("replaced") is True and per_time[at(a)] < 2)
 
 
 def _engine() -> tuple[Any, Any]:
@@ -503,15 +745,19 @@ def _pair_key(geoms: Any) -> frozenset:
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
            limit: int | None = None, tolerances: dict[str, Any] | None = None,
-           expect_pairs: str | None = None) -> dict[str, Any]:
+           expect_pairs: str | None = None, max_penetration: float | None = None) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
-    the pair set ``Scene.from_model(model, pairs=<logged policy>)`` (the policy is the one
-    claim that defines *what* is certified; a missing policy is assumed ``"mujoco"`` and
-    reported), the library's default :class:`~monitor.tolerances.Tolerances` (or
-    ``tolerances`` from the caller), and the certificate's margin, epsilon and method once
-    they are checked; the window is always the plan's span.
+    the pair set ``Scene.from_model(model, pairs=<logged policy>, allowed=<logged allowed
+    pairs>, hazards=<logged items>)`` (the policy is the one claim that defines *what* is
+    certified; a missing policy is assumed ``"mujoco"`` and reported; the allowed pairs are
+    re-derived from the model where the log says how they were chosen, see
+    :func:`_check_pair_policy`), the library's default :class:`~monitor.tolerances.Tolerances`
+    (or ``tolerances`` from the caller), the window's own request (its ``request_id``:
+    ongoing rule, penetration_tol; logs without ids: the run's request, else the plain rule),
+    and the certificate's margin, epsilon and method once they are checked against that
+    request; the window is always the plan's span.
 
     Claims checked (a failure is a *critical* finding, exit 1 in the CLI): verdict is
     one of the three; index unique among certificates and among plans; method known;
@@ -523,9 +769,15 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     not-certified flips are critical, except logged "uncertain" windows whose
     ``stats["budget_exhausted"]`` is true).
 
+    Also critical: a ``request_id`` naming no logged request, a request id defined twice
+    with different contents, a malformed request, an allowed pair whose Adjacent reason the
+    model contradicts or that the logged policy does not re-derive to.
+
     Unverifiable findings (exit 2 in the CLI): a malformed certificate, a window without
     plan, an error while rebuilding or certifying, windows left out by ``limit``, a model
-    whose XML and MJB cannot be cross-checked, no logged pair policy.
+    whose XML and MJB cannot be cross-checked, no logged pair policy, and a later request
+    that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
+    setting changed during the run and an added record look the same).
 
     Args:
         contents: a read log.
@@ -536,6 +788,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         expect_pairs: ``"mujoco"`` or ``"all"``: the pair policy the auditor requires. A log
             whose policy differs is critical and is recomputed with this policy instead (a
             log that consistently claims fewer pairs is otherwise only reported in a note).
+        max_penetration: metres, the deepest ongoing contact the auditor accepts: a window
+            answered under ``ongoing="deepen"`` with a larger ``penetration_tol`` is critical
+            (a log that consistently claims a loose rule is otherwise only reported in a note).
+            0 requires the plain rule.
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -557,6 +813,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     from monitor.log.reader import load_model, model_consistency
 
     tol = make_tolerances(tolerances)
+    if max_penetration is not None and not (_is_num(max_penetration) and max_penetration >= 0):
+        raise InvalidInputError(f"max_penetration must be a finite number >= 0 (m), got {max_penetration!r}")
     scene_cls, certify = _engine()
     model, how = load_model(contents, model_source)
     run = contents.run
@@ -596,7 +854,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             else:
                 run_claims[key] = float(v)
 
-    logged_req = _logged_request(run, tol, find, notes)
+    requests = _logged_requests(contents, tol, find, notes)
+    logged_req = requests.get(0) if "request" in run else None  # windows without a request id
+    used_requests: dict[int, list[int]] = {}
+    no_request_id = 0
 
     policy: Any = None
     raw_policy = run.get("pairs", run.get("pair_policy"))
@@ -616,13 +877,22 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         policy = expect_pairs
     scene = None
     allowed = _logged_allowed(run, find, notes)
+    hazards = run.get("hazards")  # None: every candidate pair (also logs from before it was logged)
+    if hazards is not None and expect_pairs is not None:
+        find(CRITICAL, f"logged hazards={_short(hazards, 80)} selects a subset of the pairs, not the "
+                       f"required {expect_pairs!r}: ignored")
+        hazards = None
     if policy is not None:
         try:
             scene = scene_cls.from_model(model, pairs=policy, tolerances=tol,
-                                         **({"allowed": allowed} if allowed else {}))
+                                         **({"allowed": allowed} if allowed else {}),
+                                         **({"hazards": hazards} if hazards is not None else {}))
         except (MonitorError, ValueError, TypeError) as exc:
-            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} is not valid for the attached "
-                           f"model: {exc}")
+            find(CRITICAL, f"logged pair policy {_short(raw_policy, 80)} (hazards={_short(hazards, 60)}) is "
+                           f"not valid for the attached model: {exc}")
+        if scene is not None:
+            scene = _check_pair_policy(model, scene_cls, scene, policy, tol, run, allowed, hazards,
+                                       find, notes, expect_pairs, _first_start(contents, model))
         if isinstance(policy, list):
             notes.append(f"pair policy is an explicit list of {len(policy)} pair(s): only those pairs are "
                          f"certified")
@@ -672,6 +942,18 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             find(CRITICAL, f"unknown verdict {verdict[:40]!r}", k)
         method = c["method"]
         claims_ok = True
+        # the request this window answers: its request_id (per window, so a setting changed
+        # during the run is seen), else the run's (logs before request ids), else none
+        req, rid = logged_req, c.get("request_id")
+        if rid is None:
+            no_request_id += 1
+            if logged_req is not None:
+                used_requests.setdefault(0, []).append(k)
+        elif not _is_int(rid) or rid not in requests:
+            find(CRITICAL, f"request_id {_short(rid, 40)} names no logged request", k)
+        elif requests[rid] is not None:
+            req = requests[rid]
+            used_requests.setdefault(rid, []).append(k)
         if method not in METHODS:
             find(CRITICAL, f"unknown method {method[:40]!r}", k)
             claims_ok = False
@@ -680,7 +962,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if not _is_num(v) or not ok(v):
                 find(CRITICAL, f"{key}={_short(v, 40)} is invalid", k)
                 claims_ok = False
-            elif key in run_claims and float(v) != run_claims[key]:
+            elif key in run_claims and float(v) != run_claims[key] and rid is None:
+                # with a request id the window's own request is the claim (checked below): the
+                # run metadata holds the settings at log open, which the gate may change later
                 find(CRITICAL, f"{key}={v} differs from the run's {run_claims[key]}", k)
         logged_pairs = Counter(_pair_key(p["geoms"]) for p in c["pairs"])
         if scene_pairs is not None and logged_pairs != scene_pairs:
@@ -703,17 +987,17 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             if not (math.isclose(w0, t0, rel_tol=1e-12, abs_tol=1e-12)
                     and math.isclose(w1, t1, rel_tol=1e-12, abs_tol=1e-12)):
                 find(CRITICAL, f"window [{w0!r}, {w1!r}] is not the plan's span [{t0!r}, {t1!r}]", k)
-            if logged_req is None:  # an old log (or a forged request, already critical): as before
+            if req is None:  # an old log (or a forged request, already critical): as before
                 new = certify(scene, plan, margin=float(c["margin"]), epsilon=float(c["epsilon"]),
                               method=method, window=(t0, t1), tolerances=tol)
             else:
                 for key in ("margin", "epsilon", "method"):
-                    if c[key] != getattr(logged_req, key):
+                    if c[key] != getattr(req, key):
                         find(CRITICAL, f"{key}={_short(c[key], 40)} differs from the logged request's "
-                                       f"{getattr(logged_req, key)}", k)
+                                       f"{getattr(req, key)}", k)
                 # the logged settings (ongoing rule, penetration_tol, ...) with this window's span,
                 # the certificate's margin/epsilon/method and the default budget per window
-                new = certify(scene, plan, request=logged_req.replace(
+                new = certify(scene, plan, request=req.replace(
                     margin=float(c["margin"]), epsilon=float(c["epsilon"]), method=method, window=(t0, t1)))
         except (MonitorError, ValueError, KeyError, TypeError, IndexError, OverflowError) as exc:
             out["errors"].append({"index": k, "sim_time": c.get("sim_time"),
@@ -733,6 +1017,19 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
+    _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
+    unlogged = _unlogged_applied(contents)
+    if unlogged:
+        notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "
+                     f"(a gate logs the applied window only when it is not certified: the committed brake's "
+                     f"tail or a certified fallback): re-derived are the proposals, not what was applied")
+    if no_request_id and (used_requests or len(requests) > 1):
+        notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
+                     f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))
+    elif no_request_id and logged_req is None and certs:
+        notes.append("no logged request (a log written before requests were logged, or certificates "
+                     "without one): re-derived with the plain rule (ongoing='violation'); a run under the "
+                     "ongoing-contact rule shows its resting contacts as flips")
     out["critical"] += sum(f["severity"] == CRITICAL for f in findings)
     out["unverifiable"] = sum(f["severity"] == UNVERIFIABLE for f in findings)
     return out

@@ -172,7 +172,8 @@ FORGERIES = {
     "verdict-capitalised": (lambda bad: {"msg": flip(bad[1:], _capitalised_verdict(bad))}, 1,
                             r"\[CRITICAL\] window \d+: unknown verdict 'Violation'"),
     "margin-lowered": (lambda bad: {"msg": flip(bad, _set("margin", 0.0))}, 1,
-                       r"\[CRITICAL\] window \d+: margin=0.0 differs from the run's 0.005"),
+                       r"\[CRITICAL\] window \d+: margin=0.0 differs from the "
+                       r"(run's|logged request's) 0.005"),
 }
 
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from typing import Any
 
@@ -49,7 +50,14 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                    help="--verify only the first N windows of each log (the rest are unverified: exit 2)")
     p.add_argument("--expect-pairs", choices=("mujoco", "all"), default=None,
                    help="--verify requires this pair policy (a log claiming another one, e.g. a short "
-                        "explicit list, is critical); default: the logged policy, reported")
+                        "explicit list or hazards= items, is critical, and so are allowed pairs that "
+                        "rest on the run's claim rather than on the model: allow= items, a user's "
+                        "matrix, a reference pose that is not the first window's start); default: the "
+                        "logged policy, reported")
+    p.add_argument("--max-penetration", metavar="M", type=float, default=None,
+                   help="--verify requires every window's ongoing-contact rule to allow at most M metres "
+                        "of penetration (a window certified under ongoing='deepen' with a larger "
+                        "penetration_tol is critical; 0 requires the plain rule); default: reported")
     p.add_argument("--tolerances", metavar="JSON", default=None,
                    help="tolerance fields for --verify, e.g. '{\"abs_pad\": 1e-10}' (default: the library's; "
                         "logged tolerances are only compared, never used)")
@@ -112,7 +120,8 @@ def _review_one(path: str, args: argparse.Namespace,
         try:
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
                                      limit=args.limit, tolerances=getattr(args, "tolerance_values", None),
-                                     expect_pairs=getattr(args, "expect_pairs", None))
+                                     expect_pairs=getattr(args, "expect_pairs", None),
+                                     max_penetration=getattr(args, "max_penetration", None))
         except ImportError as exc:
             entry["verify"] = {"error": f"verification needs the certification engine: {exc}"}
         except (MonitorError, ValueError) as exc:
@@ -163,8 +172,14 @@ def run(args: argparse.Namespace) -> int:
         except (ValueError, InvalidInputError) as exc:
             print(f"error: --tolerances: {exc}", file=sys.stderr)
             return 2
-    if (args.tolerance_values or getattr(args, "expect_pairs", None)) and getattr(args, "ray", False):
-        print("error: --tolerances and --expect-pairs are not supported with --ray yet", file=sys.stderr)
+    mp = getattr(args, "max_penetration", None)
+    if mp is not None and not (math.isfinite(mp) and mp >= 0):
+        print(f"error: --max-penetration must be a finite number >= 0 (m), got {mp}", file=sys.stderr)
+        return 2
+    if (args.tolerance_values or getattr(args, "expect_pairs", None) or mp is not None) \
+            and getattr(args, "ray", False):
+        print("error: --tolerances, --expect-pairs and --max-penetration are not supported with --ray yet",
+              file=sys.stderr)
         return 2
     paths = expand_logs(args.logs)
     if not paths:

@@ -132,6 +132,9 @@ class LogContents:
         problems: the first :data:`MAX_PROBLEMS` reasons for bad payloads/records.
         metadata: metadata records merged by name (later records update earlier ones);
             values are JSON-decoded when they are JSON, else kept as strings.
+        requests: the decoded ``monitor.request`` records (:data:`topics.METADATA_REQUEST`)
+            in file order, one dict per record (NOT merged: two records naming one request
+            id stay two entries, so review can see a redefinition).
         attachments: attachment name -> bytes (attachments with a wrong CRC are dropped
             and counted as bad records).
         schemas: schema name -> (encoding, data bytes) of every schema seen.
@@ -158,6 +161,7 @@ class LogContents:
     bad_records: int = 0
     problems: list[str] = field(default_factory=list)
     metadata: dict[str, dict[str, Any]] = field(default_factory=dict)
+    requests: list[dict[str, Any]] = field(default_factory=list)
     attachments: dict[str, bytes] = field(default_factory=dict)
     schemas: dict[str, tuple[str, bytes]] = field(default_factory=dict)
     records_walked: int = 0
@@ -535,8 +539,11 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                         out.seal = dict(rec.metadata)
                         continue
                     digest.metadata(rec.name, rec.metadata)
+                    decoded = _decode_metadata(rec.metadata)
+                    if rec.name == topics.METADATA_REQUEST:
+                        out.requests.append(decoded)
                     merged = out.metadata.setdefault(rec.name, {})
-                    merged.update(_decode_metadata(rec.metadata))
+                    merged.update(decoded)
                 elif isinstance(rec, Attachment):
                     digest.attachment(rec.name, rec.media_type, rec.data)
                     out.attachments[rec.name] = bytes(rec.data)

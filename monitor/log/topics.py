@@ -71,6 +71,12 @@ METADATA_MODEL = "monitor.model"
 """Metadata record: attachment names and fingerprints of the logged model."""
 METADATA_FINALISE = "monitor.finalise"
 """Metadata record added when a journal is rewritten into an indexed file (source, bytes dropped)."""
+METADATA_REQUEST = "monitor.request"
+"""Metadata record, one per distinct :class:`~monitor.certify.request.CertifyRequest` a log's
+certificates answer (``{"id": int, "request": CertifyRequest.to_json() with window None}``),
+written before the first certificate that names it; each certificate payload carries
+``"request_id"``. Id 0 may instead be the ``monitor.run`` record's ``"request"`` (a gate logs its
+request at open): then no ``monitor.request`` record repeats it."""
 METADATA_JSON_KEYS = "_json_keys"
 """Metadata key (version 2) listing, comma-separated, the keys whose values are JSON text;
 every other value is a plain string stored as is (no JSON inside JSON)."""
@@ -98,7 +104,7 @@ def schema(topic: str) -> dict[str, Any]:
 
 __all__ = [
     "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
-    "FORMAT_VERSION", "METADATA_FINALISE", "METADATA_JSON_KEYS",
+    "FORMAT_VERSION", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",
 ]

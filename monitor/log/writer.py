@@ -5,10 +5,14 @@ File layout (one MCAP file per run; timestamps and payload fields: :mod:`monitor
 * header, then the ``monitor.run`` metadata (package and MuJoCo versions, margin,
   epsilon, pair policy, predictor, ...; strings stored as is, other values as JSON
   text listed under ``_json_keys``; a gate's log also holds ``"request"``, its
-  :meth:`monitor.certify.request.CertifyRequest.to_json`, which ``review --verify``
-  re-derives every window with) and the model attachments (``model.xml`` +
+  :meth:`monitor.certify.request.CertifyRequest.to_json`: request id 0) and the model
+  attachments (``model.xml`` +
   ``assets/*.stl`` + ``model.mjb``, ``log_time``/``create_time`` = wall clock at open)
   **first**, so that even a killed writer leaves a log that review can re-verify;
+* per distinct request (a gate setting changed mid-run, a log given to a gate, a user's own
+  ``certify`` calls): one ``monitor.request`` metadata record before the first certificate that
+  answers it; every certificate names its request by ``request_id`` and ``review --verify``
+  re-derives the window with that request (:data:`topics.METADATA_REQUEST`);
 * per window: ``/monitor/plan``, ``/monitor/certificate``, ``/monitor/violation``
   (violation or uncertain only), ``/monitor/action``, ``/monitor/log`` (``foxglove.Log``
   for violations, uncertain windows and replaced actions) and with foxglove-sdk
@@ -379,6 +383,13 @@ class MonitorLog:
         run.update({f"version.{k}": v for k, v in versions.items()})
         run["mujoco_version"] = versions.get("mujoco")
         run.update(metadata or {})
+        # requests the certificates answer: key text -> id (monitor.request records, see topics);
+        # a "request" in the run metadata (a gate's, at open) is id 0 and gets no record of its own
+        self._requests: dict[str, int] = {}
+        self._last_request: Any = None
+        self._last_request_id: int | None = None
+        if isinstance(run.get("request"), dict):
+            self._requests[_request_key(run["request"])] = 0
         self.add_metadata(run)
         if model is not None:
             self._attach_model(model)
@@ -429,6 +440,32 @@ class MonitorLog:
         self._w.add_metadata(name, enc)
         self._digest.metadata(name, enc)
         self._flush()
+
+    def _request_id(self, request: Any) -> int:
+        """Id of ``request`` in this log, writing its ``monitor.request`` record the first time.
+
+        ``request`` is a :class:`~monitor.certify.request.CertifyRequest` (frozen: the previous
+        window's object is recognised by identity, so a gate's unchanged request costs one ``is``
+        per window) or its :meth:`~monitor.certify.request.CertifyRequest.to_json` dict. Its
+        ``window`` is not recorded (review re-derives each window on its plan's span), so
+        requests differing only in their window share one id.
+        """
+        if request is self._last_request and self._last_request_id is not None:
+            return self._last_request_id
+        d = request.to_json() if callable(getattr(request, "to_json", None)) else request
+        if not isinstance(d, dict):
+            raise InvalidInputError(f"request must be a CertifyRequest or its to_json() dict, got "
+                                    f"{type(request).__name__}")
+        d = {**d, "window": None}
+        key = _request_key(d)
+        rid = self._requests.get(key)
+        if rid is None:
+            rid = len(self._requests)
+            self.add_metadata({"id": rid, "request": d}, name=topics.METADATA_REQUEST)
+            self._requests[key] = rid
+        if not isinstance(request, dict):  # a dict may be edited in place: never cached by identity
+            self._last_request, self._last_request_id = request, rid
+        return rid
 
     def _attach_model(self, model: Any) -> None:
         exp = export_model(model, self._model_source)
@@ -483,7 +520,7 @@ class MonitorLog:
     def write_window(self, sim_time: float, plan: Any, certificate: Any, proposed_action: Any = None,
                      applied_action: Any = None, replaced: bool = False,
                      wall_time: float | None = None, episode: int | None = None,
-                     reason: str | None = None) -> int:
+                     reason: str | None = None, request: Any = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -500,6 +537,12 @@ class MonitorLog:
                 or the next one when ``sim_time`` is earlier than the previous window's.
             reason: why the action was replaced (e.g. ``"braking tail uncertain"``); default:
                 the window's verdict when it is not certified, else a generic text.
+            request: the :class:`~monitor.certify.request.CertifyRequest` (or its ``to_json()``
+                dict) the certificate answers; default ``certificate.request`` (every
+                certificate ``certify`` returns has one). Logged once per distinct request
+                (a ``monitor.request`` metadata record); the certificate payload names it by
+                ``request_id``. Review re-derives the window with it. None and no
+                ``certificate.request``: no ``request_id`` (review then uses the run's).
 
         Returns:
             The window index in this log.
@@ -530,7 +573,12 @@ class MonitorLog:
                                     f"got {cert.get('verdict')!r}")
         if plan is not None:
             plan_msg = _plan_payload(plan)  # validates before anything is written
+        if request is None:
+            request = getattr(certificate, "request", None)
+        rid = None if request is None else self._request_id(request)
         cert = _null_unknown(cert)
+        if rid is not None:
+            cert["request_id"] = rid
         log_ns = max(_ns(wall), self._last_log_ns + 1)
         sim_ns = _ns(t)
         k = self._index
@@ -592,6 +640,11 @@ class MonitorLog:
 
 
 # --------------------------------------------------------------------------- helpers
+
+
+def _request_key(d: dict[str, Any]) -> str:
+    """Canonical text of a request record (the dedup key of :meth:`MonitorLog._request_id`)."""
+    return json.dumps(_jsonable({**d, "window": None}), sort_keys=True, allow_nan=False)
 
 
 def encode_metadata(values: dict[str, Any]) -> dict[str, str]:
