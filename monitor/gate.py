@@ -118,6 +118,7 @@ class Rollout:
         self._key_state = np.empty(size)  # integration state the scratch window started from
         self._end_state = np.empty(size)
         self._key_ctrl = np.empty(model.nu)
+        self._key_state_bytes = self._key_ctrl_bytes = b""  # bytes of _key_state / _key_ctrl (the key)
         self._key_nstep = 0  # 0: the scratch holds no complete window
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
@@ -149,15 +150,19 @@ class Rollout:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
 
         Compares ``data``'s integration state and the control with the last :meth:`states`
-        call bit for bit (``ctrl=None``: ``data.ctrl``).
+        call bit for bit (``ctrl=None``: ``data.ctrl``): their bytes, so ``-0.0`` and ``0.0``
+        differ and a NaN equals only the same NaN (a stricter test than ``np.array_equal``;
+        a state that fails it is simulated again, never committed).
         """
         if nstep < 1 or self._key_nstep != nstep:
             return False
-        c = data.ctrl if ctrl is None else np.asarray(ctrl, dtype=np.float64)
-        if c.shape != self._key_ctrl.shape or not np.array_equal(c, self._key_ctrl):
+        c = data.ctrl if ctrl is None else ctrl
+        if type(c) is not np.ndarray or c.dtype != np.float64:
+            c = np.asarray(c, dtype=np.float64)
+        if c.shape != self._key_ctrl.shape or c.tobytes() != self._key_ctrl_bytes:
             return False
         mujoco.mj_getState(self.model, data, self._state, _INTEGRATION)
-        return bool(np.array_equal(self._state, self._key_state))
+        return self._state.tobytes() == self._key_state_bytes
 
     def states(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -175,7 +180,8 @@ class Rollout:
         """
         m, s = self.model, self.scratch
         self._key_nstep = 0  # no complete window until the loop below is done
-        mujoco.mj_getState(m, data, self._key_state, _INTEGRATION)
+        key = self._key_state
+        mujoco.mj_getState(m, data, key, _INTEGRATION)
         # A full copy, not only the integration state: then the scratch also carries
         # data's diagnostics (warning counters, solver statistics, fields a substep
         # does not rewrite), so :meth:`commit` gives exactly what stepping data gives.
@@ -183,8 +189,13 @@ class Rollout:
         if ctrl is not None:
             self._s_ctrl[:] = ctrl
         self._key_ctrl[:] = self._s_ctrl
-        rows = np.empty((nstep + 1, 1 + m.nq))  # (time, qpos) per state, by mj_getState
-        mujoco.mj_getState(m, data, rows[0], _WINDOW_ROW)
+        self._key_ctrl_bytes = self._key_ctrl.tobytes()
+        self._key_state_bytes = key.tobytes()
+        ncol = 1 + m.nq
+        rows = np.empty((nstep + 1, ncol))  # (time, qpos) per state, by mj_getState
+        # The integration state begins with time, qpos (mj_getState writes its parts in
+        # mjtState bit order: TIME, QPOS, QVEL, ...): row 0 is its first 1 + nq entries.
+        rows[0] = key[:ncol]
         for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
@@ -193,7 +204,7 @@ class Rollout:
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, qpos[0])
-        rows[:, 1:] = qpos
+        rows[0, 1:] = qpos[0]  # rows 1.. equal qpos 1.. already
         self.window_rows = rows  # (time, qpos) rows exactly as returned (the Plan normalises its copy)
         return times, qpos
 
@@ -346,6 +357,9 @@ class Rollout:
         overhead here, more than a substep; a tail that stops midway simulates substeps
         past its end, which only touch the private scratch).
 
+        Precondition (as :meth:`brake_rows` calls it): the tail scratch's integration state
+        is ``_end_state`` and its ``ctrl`` the brake control.
+
         Returns:
             rows (K, 1 + nq + nv) as :meth:`_tail_by_loop`, or None after a warning.
         """
@@ -359,7 +373,9 @@ class Rollout:
         nq, nv = m.nq, m.nv
         ncol = 1 + nq + nv
         rows = np.empty((n + 1, self._n_full))  # full physics state per waypoint
-        mujoco.mj_getState(m, s, rows[0], _FULL)
+        # Row 0: the scratch's state as set from _end_state (both layouts begin with time,
+        # qpos, qvel); only its first ncol entries are returned.
+        rows[0, :ncol] = self._end_state[:ncol]
         # Substep 1 exactly as the loop runs it (a tail at rest stops here).
         mujoco.mj_step(m, s)
         mujoco.mj_getState(m, s, rows[1], _FULL)
@@ -397,8 +413,12 @@ def _rollout_is_exact(model: mujoco.MjModel) -> bool:
     plugin and no global callback (either could write the user inputs inside ``mj_step``,
     which the rollout re-sets every substep).
     """
-    return (model.nv > 0 and model.nplugin == 0
-            and all(get() is None for get in _CALLBACK_GETTERS))
+    if model.nv == 0 or model.nplugin != 0:
+        return False
+    for get in _CALLBACK_GETTERS:  # read on every call: a callback can be installed at any time
+        if get() is not None:
+            return False
+    return True
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
@@ -1184,9 +1204,11 @@ class Gate:
         """
         from monitor.motion.plan import Plan
 
+        # Bit-for-bit checks (bytes: stricter than ==, e.g. -0.0 != 0.0); both hold by
+        # construction on the gate's own path, a failure only means two calls.
         if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
-                or not np.array_equal(window_rows[:, 0], plan.times)
-                or not np.array_equal(window_rows[-1], tail_rows[0])):
+                or window_rows[:, 0].tobytes() != np.asarray(plan.times).tobytes()
+                or window_rows[-1].tobytes() != tail_rows[0].tobytes()):
             return None
         rows = np.concatenate((window_rows, tail_rows[1:]))
         joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
