@@ -46,7 +46,6 @@ This module imports mujoco and monitor only (no gymnasium, no mcap).
 
 from __future__ import annotations
 
-import copy
 import logging
 import math
 import os
@@ -440,7 +439,7 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
     Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
     by structure alone (joint transmission, affine bias, fixed gain; the value conditions
     ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
-    joint, the ctrl-limited actuators, and views of the value arrays (gainprm, biasprm,
+    joint, the ctrl-limited actuators (None: all of them), and views of the value arrays (gainprm, biasprm,
     gear, ctrlrange: the model's own buffers, so in-place edits are seen). Cached per model
     object and keyed on the bytes of every structure array read (an in-place edit of one of
     them recomputes it); MjModel array views never move, so the cached views stay valid.
@@ -460,7 +459,9 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
         a = np.flatnonzero((trntype == _TRN_JOINT) & (biastype == _AFFINE) & (gaintype == _FIXED))
         jt = jnt_type[j[a]]
         a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
-        hit[4] = (a, jnt_qposadr[j[a]].copy(), np.flatnonzero(ctrllimited.astype(bool)))
+        limited = np.flatnonzero(ctrllimited.astype(bool))
+        # every actuator limited: the clip runs on whole columns (same values, no gather/scatter)
+        hit[4] = (a, jnt_qposadr[j[a]].copy(), None if limited.size == len(ctrllimited) else limited)
         hit[3] = key
     a, adr, limited = hit[4]
     return a, adr, limited, hit[2]
@@ -498,6 +499,8 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         if a.size:
             length = gear[a, 0] * data.qpos[adr]
             ctrl[a] = -(biasprm[a, 0] + b1 * length) / gain
+    if limited is None:  # every actuator limited
+        return np.clip(ctrl, ctrlrange[:, 0], ctrlrange[:, 1])
     if limited.size:
         ctrl[limited] = np.clip(ctrl[limited], ctrlrange[limited, 0], ctrlrange[limited, 1])
     return ctrl
@@ -603,6 +606,33 @@ class StepReport:
     stepped: bool = False
     brake_verdict: str = ""
 
+    @classmethod
+    def _trusted(cls, verdict: str, certificate: Certificate, proposed_ctrl: np.ndarray,
+                 applied_ctrl: np.ndarray, replaced: bool, terminated: bool, unsafe: bool,
+                 applied_verdict: str, fallback_certificate: Certificate | None, fallback_certified: bool,
+                 certify_us: float, time: float, plan: Any, brake_verdict: str) -> StepReport:
+        """The report ``StepReport(...)`` makes (``stepped=False``), without the frozen ``__init__``.
+
+        The frozen dataclass's ``__init__`` sets each of its 15 fields by ``object.__setattr__``;
+        this writes the same instance ``__dict__`` at once (``plan`` under the slot of
+        :class:`_LazyPlanField`). ``tests/test_gate_plumbing.py`` compares the two.
+        """
+        r = object.__new__(cls)
+        r.__dict__.update(verdict=verdict, certificate=certificate, proposed_ctrl=proposed_ctrl,
+                          applied_ctrl=applied_ctrl, replaced=replaced, terminated=terminated, unsafe=unsafe,
+                          applied_verdict=applied_verdict, fallback_certificate=fallback_certificate,
+                          fallback_certified=fallback_certified, certify_us=certify_us, time=time,
+                          _plan_store=plan, stepped=False, brake_verdict=brake_verdict)
+        return r
+
+    def _stepped(self) -> StepReport:
+        """A copy with ``stepped=True`` (= ``dataclasses.replace``, without building the plan)."""
+        r = object.__new__(type(self))
+        state = r.__dict__
+        state.update(self.__dict__)
+        state["stepped"] = True
+        return r
+
     @property
     def cost(self) -> float:
         """1.0 when the APPLIED window has a confirmed violation, else 0.0.
@@ -638,10 +668,12 @@ class StepReport:
             version (int), proposal_cost (float), intervened (bool), block_reason (str)
             (:mod:`monitor.gate_policy`) and, if ``timing``, certify_us (float µs).
         """
-        return {**safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
-                              replaced=self.replaced, fallback_certified=self.fallback_certified,
-                              terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
-                              certify_us=self.certify_us if timing else None), **safety_keys(self)}
+        out = safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
+                          replaced=self.replaced, fallback_certified=self.fallback_certified,
+                          terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
+                          certify_us=self.certify_us if timing else None)
+        out.update(safety_keys(self))
+        return out
 
 
 def _all_culled(cert: Certificate) -> int | None:
@@ -672,6 +704,21 @@ def _npairs(cert: Certificate) -> int:
     return n if type(n) is int else len(cert.pairs)
 
 
+_NO_GEOMS = np.array(["", ""], dtype=object)  # templates, copied into each info dict (never handed out)
+_NO_POINT = np.full(3, math.inf)
+_CULLED: dict[int, np.ndarray] = {}
+
+
+def _culled_methods(n: int) -> np.ndarray:
+    """A fresh (n,) object array of ``"culled"`` (a copy of a cached template)."""
+    t = _CULLED.get(n)
+    if t is None:
+        if len(_CULLED) >= 64:
+            _CULLED.clear()
+        t = _CULLED[n] = np.full(n, "culled", dtype=object)
+    return t.copy()
+
+
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
                 fallback_certified: bool, terminated: bool, time: float, brake_verdict: str = "",
                 certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
@@ -686,7 +733,7 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
     else:
         n = _all_culled(cert)
         if n is not None:  # every pair culled (the common gated step): no PairResult is built
-            checker = np.full(n, "culled", dtype=object)
+            checker = _culled_methods(n)
             mix = f"culled:{n}" if n else ""
         else:
             checker = cert.pair_methods()   # no PairResult built on the compiled path
@@ -702,8 +749,8 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         "checker": checker,
         "checker_mix": mix,
         "witness_time": inf if wit is None else float(wit.time),
-        "witness_geoms": np.array(["", ""] if wit is None else list(wit.geoms), dtype=object),
-        "witness_point": np.full(3, inf) if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
+        "witness_geoms": _NO_GEOMS.copy() if wit is None else np.array(list(wit.geoms), dtype=object),
+        "witness_point": _NO_POINT.copy() if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
         "earliest_time": earliest,
         "clearance": clearance,
         "replaced": bool(replaced),
@@ -1232,9 +1279,11 @@ class Gate:
             self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
         body_a, body_b = self._pair_bodies(scene)
-        fixed = np.flatnonzero(~(moving[body_a] | moving[body_b]))
-        if not fixed.size:
+        either = moving[body_a]  # (P,) a body of the pair moves
+        either |= moving[body_b]
+        if either.all():  # every pair has a moving body (the common gated step): nothing to reuse
             return None, {}, {}
+        fixed = np.flatnonzero(~either)
         pos, rot = plan.body_poses(np.array([plan.t0]))
         ba, bb = body_a[fixed], body_b[fixed]
         # key of pair i: the bytes of (p_a (3,), R_a (9,), p_b (3,), R_b (9,)) at t0
@@ -1487,8 +1536,8 @@ class Gate:
             self._committed = brake_next
             self._tail = None if brake_next is None else (tail, tail_cert, tail_qvel)
             self._tail_context = self._reuse_context()
-        report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
-                            applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
+        report = StepReport._trusted(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
+                                     applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict)
         self._account(report)
         self._write_log(report, applied_plan)
         self.last_report = report
@@ -1530,8 +1579,7 @@ class Gate:
         else:
             data.ctrl[:] = report.applied_ctrl
             mujoco.mj_step(self.model, data, nstep=n)
-        report = copy.copy(report)  # as dataclasses.replace(report, stepped=True), without building the plan
-        object.__setattr__(report, "stepped", True)
+        report = report._stepped()  # as dataclasses.replace(report, stepped=True), without building the plan
         self.last_report = report
         return report
 

@@ -226,3 +226,39 @@ def test_log_null_unknown_fast_path_matches_the_rule():
     assert [type(v) for v in got.values()] == [type(v) for v in want.values()]
     assert got["a"] is None and got["o"] is None and got["p"] == 9.999999999999999e307
     assert got["f"]["g"] is None and got["j"]["k"] is None and got["e"][1] == [2.0, None]
+
+
+def test_hold_ctrl_clip_follows_ctrllimited_edits_on_an_all_limited_model():
+    """Every actuator limited: the clip runs on whole columns; unlimiting one in place is seen."""
+    m = mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+    d = mujoco.MjData(m)
+    assert m.actuator_ctrllimited.all()
+    d.qpos[:] = 10.0  # far outside every ctrlrange: each position servo's hold is clipped
+    before = hold_ctrl(m, d)
+    assert np.array_equal(before, _hold_scalar(m, d))
+    assert np.array_equal(before, m.actuator_ctrlrange[:, 1])
+    m.actuator_ctrllimited[0] = 0
+    after = hold_ctrl(m, d)
+    assert np.array_equal(after, _hold_scalar(m, d))
+    assert after[0] != before[0] and np.array_equal(after[1:], before[1:])
+
+
+def test_step_report_fast_constructors_match_the_dataclass():
+    """StepReport._trusted / _stepped write the same instance state as the dataclass's
+    __init__ / dataclasses.replace (compared field by field and as whole __dict__s)."""
+    import dataclasses
+
+    from monitor.certify.certificate import Certificate
+    from monitor.gate import StepReport
+
+    cert = Certificate("certified", (0.0, 0.1), 0.0, 1e-3, "auto", None, None, 0.5, (), {"pairs": 0}, ())
+    args = ("certified", cert, np.zeros(2), np.ones(2), True, False, True, "violation", cert, False, 12.5,
+            0.25, "plan-object", "certified")
+    slow = StepReport(*args[:13], brake_verdict=args[13])
+    fast = StepReport._trusted(*args)
+    assert fast.__dict__ == slow.__dict__ and fast == slow
+    assert all(getattr(fast, f.name) is getattr(slow, f.name) for f in dataclasses.fields(StepReport))
+    stepped = fast._stepped()
+    assert stepped.__dict__ == dataclasses.replace(slow, stepped=True).__dict__ and not fast.stepped
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.verdict = "violation"
