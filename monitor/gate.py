@@ -433,14 +433,16 @@ _HOLD_CACHE: dict[int, list[Any]] = {}
 _HOLD_CACHE_MAX = 16
 
 
-def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None,
+                                               tuple[np.ndarray, ...]]:
     """Which actuators :func:`hold_ctrl` computes, from the model's CURRENT structure arrays.
 
     Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
     by structure alone (joint transmission, affine bias, fixed gain; the value conditions
     ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
-    joint, the ctrl-limited actuators (None: all of them), and views of the value arrays (gainprm, biasprm,
-    gear, ctrlrange: the model's own buffers, so in-place edits are seen). Cached per model
+    joint, the ctrl-limited actuators (a or limited None: every actuator, in order), and views of
+    the value columns used (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1], gear[:, 0], ctrlrange[:, 0],
+    ctrlrange[:, 1]: the model's own buffers, so in-place edits are seen). Cached per model
     object and keyed on the bytes of every structure array read (an in-place edit of one of
     them recomputes it); MjModel array views never move, so the cached views stay valid.
     """
@@ -448,8 +450,11 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
     if hit is None or hit[0] is not model:
         if len(_HOLD_CACHE) >= _HOLD_CACHE_MAX:
             _HOLD_CACHE.pop(next(iter(_HOLD_CACHE)))
+        gainprm, biasprm, gear, ctrlrange = (getattr(model, f) for f in _HOLD_VALUES)
+        # column views (gain, bias 0, bias 1, gear, lower, upper): the model's memory, read live
         hit = [model, [getattr(model, f) for f in _HOLD_STRUCT],
-               tuple(getattr(model, f) for f in _HOLD_VALUES), None, None]
+               (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1], gear[:, 0], ctrlrange[:, 0], ctrlrange[:, 1]),
+               None, None]
         _HOLD_CACHE[id(model)] = hit  # the model reference keeps id(model) unique
     struct = hit[1]
     key = b"|".join([v.tobytes() for v in struct])
@@ -460,8 +465,9 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
         jt = jnt_type[j[a]]
         a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
         limited = np.flatnonzero(ctrllimited.astype(bool))
-        # every actuator limited: the clip runs on whole columns (same values, no gather/scatter)
-        hit[4] = (a, jnt_qposadr[j[a]].copy(), None if limited.size == len(ctrllimited) else limited)
+        # None: every actuator (a: in order; limited: the clip runs on whole columns)
+        hit[4] = (None if np.array_equal(a, np.arange(len(trntype))) else a, jnt_qposadr[j[a]].copy(),
+                  None if limited.size == len(ctrllimited) else limited)
         hit[3] = key
     a, adr, limited = hit[4]
     return a, adr, limited, hit[2]
@@ -486,23 +492,30 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         (nu,) float64 control.
     """
     nu = model.nu
-    ctrl = np.zeros(nu)
     if nu == 0:
-        return ctrl
-    a, adr, limited, (gainprm, biasprm, gear, ctrlrange) = _hold_plan(model)
-    if a.size:
-        gain = gainprm[a, 0]
-        b1 = biasprm[a, 1]
-        ok = (gain != 0.0) & (b1 != 0.0)
-        if not ok.all():
-            a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
+        return np.zeros(0)
+    a, adr, limited, (gain0, bias0, bias1, gear0, lo, hi) = _hold_plan(model)
+    if a is None and gain0.all() and bias1.all():
+        # every actuator position-like, in order, gain and biasprm[1] nonzero (ndarray.all():
+        # no element == 0, as the test below): the same operations on whole columns
+        ctrl = -(bias0 + bias1 * (gear0 * data.qpos[adr])) / gain0
+    else:
+        ctrl = np.zeros(nu)
+        if a is None:
+            a = np.arange(nu)
         if a.size:
-            length = gear[a, 0] * data.qpos[adr]
-            ctrl[a] = -(biasprm[a, 0] + b1 * length) / gain
+            gain = gain0[a]
+            b1 = bias1[a]
+            ok = (gain != 0.0) & (b1 != 0.0)
+            if not ok.all():
+                a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
+            if a.size:
+                length = gear0[a] * data.qpos[adr]
+                ctrl[a] = -(bias0[a] + b1 * length) / gain
     if limited is None:  # every actuator limited
-        return np.clip(ctrl, ctrlrange[:, 0], ctrlrange[:, 1])
+        return np.clip(ctrl, lo, hi)
     if limited.size:
-        ctrl[limited] = np.clip(ctrl[limited], ctrlrange[limited, 0], ctrlrange[limited, 1])
+        ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
     return ctrl
 
 
@@ -1401,10 +1414,11 @@ class Gate:
         if len(hits) != 1:
             return None
         k = int(hits[0])
-        if (k + n >= len(plan.times) or not np.array_equal(plan.qpos[k], data.qpos)
-                or not np.array_equal(qvel[k], data.qvel)
-                or not np.array_equal(plan.mocap_pos, data.mocap_pos)
-                or not np.array_equal(plan.mocap_quat, data.mocap_quat)):
+        # bit for bit: bytes (stricter than ==: -0.0 != 0.0); shapes are the model's, fixed
+        if (k + n >= len(plan.times) or plan.qpos[k].tobytes() != data.qpos.tobytes()
+                or qvel[k].tobytes() != data.qvel.tobytes()
+                or plan.mocap_pos.tobytes() != data.mocap_pos.tobytes()
+                or plan.mocap_quat.tobytes() != data.mocap_quat.tobytes()):
             return None
         return cert
 
@@ -1568,7 +1582,7 @@ class Gate:
                 f"ctrl must be a numeric array of shape ({self.model.nu},), got {ctrl!r}") from e
         if ctrl.shape != (self.model.nu,):
             raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
-        if not np.all(np.isfinite(ctrl)):
+        if not np.isfinite(ctrl).all():
             raise InvalidInputError("ctrl contains NaN or inf")
         report = self.decide(data, ctrl, nstep=n)
         # The scratch usually holds the applied window already (the proposal's, or the

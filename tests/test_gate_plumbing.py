@@ -241,6 +241,19 @@ def test_hold_ctrl_clip_follows_ctrllimited_edits_on_an_all_limited_model():
     after = hold_ctrl(m, d)
     assert np.array_equal(after, _hold_scalar(m, d))
     assert after[0] != before[0] and np.array_equal(after[1:], before[1:])
+    # every actuator position-like (whole-column formula) until a value edit makes one of
+    # them hold 0: then the per-actuator selection decides
+    rng = np.random.default_rng(5)
+    for field, col in (("actuator_gainprm", 0), ("actuator_biasprm", 1)):
+        d.qpos[:] = rng.normal(0.0, 0.3, m.nq)
+        whole = hold_ctrl(m, d)
+        assert np.array_equal(whole, _hold_scalar(m, d)) and np.count_nonzero(whole) == m.nu
+        saved = getattr(m, field)[1, col]
+        getattr(m, field)[1, col] = 0.0
+        edited = hold_ctrl(m, d)
+        assert np.array_equal(edited, _hold_scalar(m, d)), field
+        assert edited[1] == 0.0 and np.array_equal(edited[[0, 2]], whole[[0, 2]]), field
+        getattr(m, field)[1, col] = saved
 
 
 def test_step_report_fast_constructors_match_the_dataclass():
