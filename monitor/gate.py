@@ -1286,16 +1286,16 @@ class Gate:
         """Indices of pairs to certify (None = all), reusable results, cache keys of fixed pairs."""
         if not self.reuse:
             return None, {}, {}
-        context = self._reuse_context()
-        if context != self._cache_context:
-            self._cache.clear()
-            self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
         body_a, body_b = self._pair_bodies(scene)
         either = moving[body_a]  # (P,) a body of the pair moves
         either |= moving[body_b]
         if either.all():  # every pair has a moving body (the common gated step): nothing to reuse
-            return None, {}, {}
+            return None, {}, {}  # (the cache is neither read nor written: its context is checked below)
+        context = self._reuse_context()
+        if context != self._cache_context:  # before any read or write of the cache
+            self._cache.clear()
+            self._cache_context = context
         fixed = np.flatnonzero(~either)
         pos, rot = plan.body_poses(np.array([plan.t0]))
         ba, bb = body_a[fixed], body_b[fixed]
