@@ -176,6 +176,15 @@ class Rollout:
             (quaternions normalised, as MuJoCo uses them) followed by the state
             after each substep. Fresh arrays: the caller may keep them.
         """
+        rows = self._window(data, ctrl, nstep)
+        return rows[:, 0].copy(), rows[:, 1:].copy()
+
+    def _window(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> np.ndarray:
+        """:meth:`states` as one read-only array ``rows`` (nstep + 1, 1 + nq) of (time, qpos).
+
+        ``rows[:, 0]`` and ``rows[:, 1:]`` are exactly :meth:`states`' times and qpos (row 0's
+        quaternions normalised); also kept as :attr:`window_rows`.
+        """
         m, s = self.model, self.scratch
         self._key_nstep = 0  # no complete window until the loop below is done
         key = self._key_state
@@ -198,13 +207,12 @@ class Rollout:
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
         self._key_nstep = int(nstep)
-        times, qpos = rows[:, 0].copy(), rows[:, 1:].copy()
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
-        mujoco.mj_normalizeQuat(m, qpos[0])
-        rows[0, 1:] = qpos[0]  # rows 1.. equal qpos 1.. already
+        mujoco.mj_normalizeQuat(m, rows[0, 1:])  # in place (a contiguous row)
+        rows.setflags(write=False)  # shared by the window's rows object, the joint call and the tail
         self.window_rows = rows  # (time, qpos) rows exactly as returned (the Plan normalises its copy)
-        return times, qpos
+        return rows
 
     def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """Advance ``data`` by the predicted window if the scratch holds it (else do nothing).
@@ -281,7 +289,7 @@ class Rollout:
         """
         m = self.model
         if not (window_fresh and self._key_nstep == nstep) and not self.window_matches(data, ctrl, nstep):
-            self.states(data, ctrl, nstep)
+            self._window(data, ctrl, nstep)
         s = self._tail_data
         if s is None:
             s = self._tail_data = mujoco.MjData(m)
@@ -520,19 +528,18 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 # --------------------------------------------------------------------------- reports
 class _WindowRows:
-    """The rollout's window (times, qpos from :meth:`Rollout.states`); its Plan built on first use.
+    """The rollout's window (the read-only rows of :meth:`Rollout._window`); its Plan built on first use.
 
-    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (same arrays, the live data's mocap
-    copied when the window was predicted). The joint call certifies the window without it;
-    the two-call path, a log and :attr:`StepReport.plan` build it.
+    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (the same times and qpos, copied from
+    the rows when it is built; the live data's mocap copied when the window was predicted).
+    The joint call certifies the window without it; the two-call path, a log and
+    :attr:`StepReport.plan` build it.
     """
 
-    __slots__ = ("times", "_qpos", "_model", "_mocap_pos", "_mocap_quat", "_plan")
+    __slots__ = ("rows", "_model", "_mocap_pos", "_mocap_quat", "_plan")
 
-    def __init__(self, times: np.ndarray, qpos: np.ndarray, model: mujoco.MjModel,
-                 data: mujoco.MjData) -> None:
-        self.times = times  # (K,) s
-        self._qpos = qpos  # (K, nq), owned (the Plan normalises it in place)
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        self.rows = rows  # (K, 1 + nq) time (s), qpos; read-only
         self._model = model
         self._mocap_pos = np.array(data.mocap_pos)
         self._mocap_quat = np.array(data.mocap_quat)
@@ -544,9 +551,15 @@ class _WindowRows:
         if self._plan is None:
             from monitor.motion.plan import Plan
 
-            self._plan = Plan._trusted(self.times, self._qpos, model=self._model, mocap_pos=self._mocap_pos,
-                                       mocap_quat=self._mocap_quat)
+            rows = self.rows  # fresh owned copies: the Plan normalises its qpos in place
+            self._plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self._model,
+                                       mocap_pos=self._mocap_pos, mocap_quat=self._mocap_quat)
         return self._plan
+
+    @property
+    def times(self) -> np.ndarray:
+        """(K,) waypoint times (s): a read-only view of the rows."""
+        return self.rows[:, 0]
 
 
 def _plan_of(p: Any) -> Any:
@@ -1267,7 +1280,8 @@ class Gate:
         # Bit-for-bit checks (bytes: stricter than ==, e.g. -0.0 != 0.0); both hold by
         # construction on the gate's own path, a failure only means two calls.
         if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
-                or window_rows[:, 0].tobytes() != np.asarray(plan.times).tobytes()
+                or not ((isinstance(plan, _WindowRows) and plan.rows is window_rows)  # the same rows
+                        or window_rows[:, 0].tobytes() == np.asarray(plan.times).tobytes())
                 or window_rows[-1].tobytes() != tail_rows[0].tobytes()):
             return None
         rows = np.concatenate((window_rows, tail_rows[1:]))
@@ -1470,7 +1484,7 @@ class Gate:
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             self.reference_qpos = np.array(data.qpos)
         if own_predictor:  # the rollout's window; its Plan is built only when something reads it
-            plan: Any = _WindowRows(*self._rollout.states(data, ctrl, n), self.model, data)
+            plan: Any = _WindowRows(self._rollout._window(data, ctrl, n), self.model, data)
         else:
             plan = predict(ctrl)
         brake_on = self._brake_active(fallback)

@@ -275,3 +275,40 @@ def test_step_report_fast_constructors_match_the_dataclass():
     assert stepped.__dict__ == dataclasses.replace(slow, stepped=True).__dict__ and not fast.stepped
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.verdict = "violation"
+
+
+def test_window_rows_are_the_states_with_row_zero_normalised():
+    """Rollout.states / window_rows: the state at the window start with its quaternions
+    normalised (a hand-set, non-unit one too), then each substep's state as an independent
+    MjData stepped from a copy gives it; the caller's data untouched; window_rows read-only."""
+    from monitor.gate import Rollout
+
+    m = mujoco.MjModel.from_xml_string(_MIXED)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(11)
+    d.qpos[:] = rng.normal(0.0, 0.5, m.nq)
+    free = m.jnt_qposadr[next(j for j in range(m.njnt) if m.jnt_type[j] == _FREE)]
+    d.qpos[free + 3:free + 7] = [0.6, 0.8, 0.0, 0.0]
+    d.qpos[free + 3:free + 7] *= 1.0 + 1e-7  # a state set by hand: not unit
+    d.ctrl[:] = rng.normal(0.0, 1.0, m.nu)
+    before = np.array(d.qpos)
+    ro = Rollout(m)
+    times, qpos = ro.states(d, None, 3)
+    oracle = mujoco.MjData(m)
+    mujoco.mj_copyData(oracle, m, d)
+    q0 = np.array(d.qpos)
+    mujoco.mj_normalizeQuat(m, q0)
+    want_t, want_q = [d.time], [q0]
+    for _ in range(3):
+        mujoco.mj_step(m, oracle)
+        want_t.append(oracle.time)
+        want_q.append(np.array(oracle.qpos))
+    assert np.array(want_t).tobytes() == times.tobytes()
+    assert np.array(want_q).tobytes() == qpos.tobytes()
+    assert not np.array_equal(q0, before)  # row 0 really was normalised
+    assert d.qpos.tobytes() == before.tobytes()  # the caller's data untouched
+    rows = ro.window_rows
+    assert rows[:, 0].tobytes() == times.tobytes() and rows[:, 1:].tobytes() == qpos.tobytes()
+    assert not rows.flags.writeable
+    qpos[0, 0] += 1.0  # states' arrays are the caller's own
+    assert rows[0, 1] != qpos[0, 0]
