@@ -440,16 +440,17 @@ _HOLD_CACHE: dict[int, list[Any]] = {}
 _HOLD_CACHE_MAX = 16
 
 
-def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None,
+def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, bool,
                                                tuple[np.ndarray, ...]]:
     """Which actuators :func:`hold_ctrl` computes, from the model's CURRENT structure arrays.
 
-    Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
+    Returns (a, adr, limited, whole, values): the position-like actuators on a hinge / slide joint
     by structure alone (joint transmission, affine bias, fixed gain; the value conditions
     ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
-    joint, the ctrl-limited actuators (a or limited None: every actuator, in order), and views of
-    the value columns used (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1], gear[:, 0], ctrlrange[:, 0],
-    ctrlrange[:, 1]: the model's own buffers, so in-place edits are seen). Cached per model
+    joint, the ctrl-limited actuators (None: every actuator), whether ``a`` is every actuator in
+    order, and views of the value columns used (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1],
+    gear[:, 0], ctrlrange[:, 0], ctrlrange[:, 1]: the model's own buffers, so in-place edits are
+    seen). Cached per model
     object and keyed on the bytes of every structure array read (an in-place edit of one of
     them recomputes it); MjModel array views never move, so the cached views stay valid.
     """
@@ -472,12 +473,13 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray | None, np.ndarray, np
         jt = jnt_type[j[a]]
         a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
         limited = np.flatnonzero(ctrllimited.astype(bool))
-        # None: every actuator (a: in order; limited: the clip runs on whole columns)
-        hit[4] = (None if np.array_equal(a, np.arange(len(trntype))) else a, jnt_qposadr[j[a]].copy(),
-                  None if limited.size == len(ctrllimited) else limited)
+        # whole: a is every actuator in order; limited None: every actuator (the clip runs on
+        # whole columns)
+        hit[4] = (a, jnt_qposadr[j[a]].copy(), None if limited.size == len(ctrllimited) else limited,
+                  bool(np.array_equal(a, np.arange(len(trntype)))))
         hit[3] = key
-    a, adr, limited = hit[4]
-    return a, adr, limited, hit[2]
+    a, adr, limited, whole = hit[4]
+    return a, adr, limited, whole, hit[2]
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -501,15 +503,13 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     nu = model.nu
     if nu == 0:
         return np.zeros(0)
-    a, adr, limited, (gain0, bias0, bias1, gear0, lo, hi) = _hold_plan(model)
-    if a is None and gain0.all() and bias1.all():
+    a, adr, limited, whole, (gain0, bias0, bias1, gear0, lo, hi) = _hold_plan(model)
+    if whole and gain0.all() and bias1.all():
         # every actuator position-like, in order, gain and biasprm[1] nonzero (ndarray.all():
         # no element == 0, as the test below): the same operations on whole columns
         ctrl = -(bias0 + bias1 * (gear0 * data.qpos[adr])) / gain0
     else:
         ctrl = np.zeros(nu)
-        if a is None:
-            a = np.arange(nu)
         if a.size:
             gain = gain0[a]
             b1 = bias1[a]
