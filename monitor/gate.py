@@ -1226,7 +1226,7 @@ class Gate:
             cert = certify(scene, plan, request=self._request or self.request)
         else:
             cert = self._certify_subset(certify, scene, plan, todo, reused)
-        if self.reuse:
+        if keys:  # fixed pairs (only with reuse on)
             self._remember(cert, keys)
         us = (time.perf_counter() - t_start) * 1e6
         self.stats["reused_pairs"] += len(reused)
