@@ -46,13 +46,11 @@ This module imports mujoco and monitor only (no gymnasium, no mcap).
 
 from __future__ import annotations
 
-import copy
 import logging
 import math
 import os
 import time
 import warnings
-from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -118,6 +116,7 @@ class Rollout:
         self._key_state = np.empty(size)  # integration state the scratch window started from
         self._end_state = np.empty(size)
         self._key_ctrl = np.empty(model.nu)
+        self._key_state_bytes = self._key_ctrl_bytes = b""  # bytes of _key_state / _key_ctrl (the key)
         self._key_nstep = 0  # 0: the scratch holds no complete window
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
@@ -149,15 +148,19 @@ class Rollout:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
 
         Compares ``data``'s integration state and the control with the last :meth:`states`
-        call bit for bit (``ctrl=None``: ``data.ctrl``).
+        call bit for bit (``ctrl=None``: ``data.ctrl``): their bytes, so ``-0.0`` and ``0.0``
+        differ and a NaN equals only the same NaN (a stricter test than ``np.array_equal``;
+        a state that fails it is simulated again, never committed).
         """
         if nstep < 1 or self._key_nstep != nstep:
             return False
-        c = data.ctrl if ctrl is None else np.asarray(ctrl, dtype=np.float64)
-        if c.shape != self._key_ctrl.shape or not np.array_equal(c, self._key_ctrl):
+        c = data.ctrl if ctrl is None else ctrl
+        if type(c) is not np.ndarray or c.dtype != np.float64:
+            c = np.asarray(c, dtype=np.float64)
+        if c.shape != self._key_ctrl.shape or c.tobytes() != self._key_ctrl_bytes:
             return False
         mujoco.mj_getState(self.model, data, self._state, _INTEGRATION)
-        return bool(np.array_equal(self._state, self._key_state))
+        return self._state.tobytes() == self._key_state_bytes
 
     def states(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -173,9 +176,19 @@ class Rollout:
             (quaternions normalised, as MuJoCo uses them) followed by the state
             after each substep. Fresh arrays: the caller may keep them.
         """
+        rows = self._window(data, ctrl, nstep)
+        return rows[:, 0].copy(), rows[:, 1:].copy()
+
+    def _window(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> np.ndarray:
+        """:meth:`states` as one read-only array ``rows`` (nstep + 1, 1 + nq) of (time, qpos).
+
+        ``rows[:, 0]`` and ``rows[:, 1:]`` are exactly :meth:`states`' times and qpos (row 0's
+        quaternions normalised); also kept as :attr:`window_rows`.
+        """
         m, s = self.model, self.scratch
         self._key_nstep = 0  # no complete window until the loop below is done
-        mujoco.mj_getState(m, data, self._key_state, _INTEGRATION)
+        key = self._key_state
+        mujoco.mj_getState(m, data, key, _INTEGRATION)
         # A full copy, not only the integration state: then the scratch also carries
         # data's diagnostics (warning counters, solver statistics, fields a substep
         # does not rewrite), so :meth:`commit` gives exactly what stepping data gives.
@@ -183,19 +196,23 @@ class Rollout:
         if ctrl is not None:
             self._s_ctrl[:] = ctrl
         self._key_ctrl[:] = self._s_ctrl
-        rows = np.empty((nstep + 1, 1 + m.nq))  # (time, qpos) per state, by mj_getState
-        mujoco.mj_getState(m, data, rows[0], _WINDOW_ROW)
+        self._key_ctrl_bytes = self._key_ctrl.tobytes()
+        self._key_state_bytes = key.tobytes()
+        ncol = 1 + m.nq
+        rows = np.empty((nstep + 1, ncol))  # (time, qpos) per state, by mj_getState
+        # The integration state begins with time, qpos (mj_getState writes its parts in
+        # mjtState bit order: TIME, QPOS, QVEL, ...): row 0 is its first 1 + nq entries.
+        rows[0] = key[:ncol]
         for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
         self._key_nstep = int(nstep)
-        times, qpos = rows[:, 0].copy(), rows[:, 1:].copy()
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
-        mujoco.mj_normalizeQuat(m, qpos[0])
-        rows[:, 1:] = qpos
+        mujoco.mj_normalizeQuat(m, rows[0, 1:])  # in place (a contiguous row)
+        rows.setflags(write=False)  # shared by the window's rows object, the joint call and the tail
         self.window_rows = rows  # (time, qpos) rows exactly as returned (the Plan normalises its copy)
-        return times, qpos
+        return rows
 
     def commit(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """Advance ``data`` by the predicted window if the scratch holds it (else do nothing).
@@ -272,7 +289,7 @@ class Rollout:
         """
         m = self.model
         if not (window_fresh and self._key_nstep == nstep) and not self.window_matches(data, ctrl, nstep):
-            self.states(data, ctrl, nstep)
+            self._window(data, ctrl, nstep)
         s = self._tail_data
         if s is None:
             s = self._tail_data = mujoco.MjData(m)
@@ -346,6 +363,9 @@ class Rollout:
         overhead here, more than a substep; a tail that stops midway simulates substeps
         past its end, which only touch the private scratch).
 
+        Precondition (as :meth:`brake_rows` calls it): the tail scratch's integration state
+        is ``_end_state`` and its ``ctrl`` the brake control.
+
         Returns:
             rows (K, 1 + nq + nv) as :meth:`_tail_by_loop`, or None after a warning.
         """
@@ -359,7 +379,9 @@ class Rollout:
         nq, nv = m.nq, m.nv
         ncol = 1 + nq + nv
         rows = np.empty((n + 1, self._n_full))  # full physics state per waypoint
-        mujoco.mj_getState(m, s, rows[0], _FULL)
+        # Row 0: the scratch's state as set from _end_state (both layouts begin with time,
+        # qpos, qvel); only its first ncol entries are returned.
+        rows[0, :ncol] = self._end_state[:ncol]
         # Substep 1 exactly as the loop runs it (a tail at rest stops here).
         mujoco.mj_step(m, s)
         mujoco.mj_getState(m, s, rows[1], _FULL)
@@ -397,8 +419,12 @@ def _rollout_is_exact(model: mujoco.MjModel) -> bool:
     plugin and no global callback (either could write the user inputs inside ``mj_step``,
     which the rollout re-sets every substep).
     """
-    return (model.nv > 0 and model.nplugin == 0
-            and all(get() is None for get in _CALLBACK_GETTERS))
+    if model.nv == 0 or model.nplugin != 0:
+        return False
+    for get in _CALLBACK_GETTERS:  # read on every call: a callback can be installed at any time
+        if get() is not None:
+            return False
+    return True
 
 
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
@@ -414,14 +440,17 @@ _HOLD_CACHE: dict[int, list[Any]] = {}
 _HOLD_CACHE_MAX = 16
 
 
-def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, bool,
+                                               tuple[np.ndarray, ...]]:
     """Which actuators :func:`hold_ctrl` computes, from the model's CURRENT structure arrays.
 
-    Returns (a, adr, limited, values): the position-like actuators on a hinge / slide joint
+    Returns (a, adr, limited, whole, values): the position-like actuators on a hinge / slide joint
     by structure alone (joint transmission, affine bias, fixed gain; the value conditions
     ``gain != 0``, ``biasprm[1] != 0`` are tested per call), the qpos address of each one's
-    joint, the ctrl-limited actuators, and views of the value arrays (gainprm, biasprm,
-    gear, ctrlrange: the model's own buffers, so in-place edits are seen). Cached per model
+    joint, the ctrl-limited actuators (None: every actuator), whether ``a`` is every actuator in
+    order, and views of the value columns used (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1],
+    gear[:, 0], ctrlrange[:, 0], ctrlrange[:, 1]: the model's own buffers, so in-place edits are
+    seen). Cached per model
     object and keyed on the bytes of every structure array read (an in-place edit of one of
     them recomputes it); MjModel array views never move, so the cached views stay valid.
     """
@@ -429,8 +458,11 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
     if hit is None or hit[0] is not model:
         if len(_HOLD_CACHE) >= _HOLD_CACHE_MAX:
             _HOLD_CACHE.pop(next(iter(_HOLD_CACHE)))
+        gainprm, biasprm, gear, ctrlrange = (getattr(model, f) for f in _HOLD_VALUES)
+        # column views (gain, bias 0, bias 1, gear, lower, upper): the model's memory, read live
         hit = [model, [getattr(model, f) for f in _HOLD_STRUCT],
-               tuple(getattr(model, f) for f in _HOLD_VALUES), None, None]
+               (gainprm[:, 0], biasprm[:, 0], biasprm[:, 1], gear[:, 0], ctrlrange[:, 0], ctrlrange[:, 1]),
+               None, None]
         _HOLD_CACHE[id(model)] = hit  # the model reference keeps id(model) unique
     struct = hit[1]
     key = b"|".join([v.tobytes() for v in struct])
@@ -440,10 +472,14 @@ def _hold_plan(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
         a = np.flatnonzero((trntype == _TRN_JOINT) & (biastype == _AFFINE) & (gaintype == _FIXED))
         jt = jnt_type[j[a]]
         a = a[(jt == _HINGE_SLIDE[0]) | (jt == _HINGE_SLIDE[1])]
-        hit[4] = (a, jnt_qposadr[j[a]].copy(), np.flatnonzero(ctrllimited.astype(bool)))
+        limited = np.flatnonzero(ctrllimited.astype(bool))
+        # whole: a is every actuator in order; limited None: every actuator (the clip runs on
+        # whole columns)
+        hit[4] = (a, jnt_qposadr[j[a]].copy(), None if limited.size == len(ctrllimited) else limited,
+                  bool(np.array_equal(a, np.arange(len(trntype)))))
         hit[3] = key
-    a, adr, limited = hit[4]
-    return a, adr, limited, hit[2]
+    a, adr, limited, whole = hit[4]
+    return a, adr, limited, whole, hit[2]
 
 
 def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -465,39 +501,45 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         (nu,) float64 control.
     """
     nu = model.nu
-    ctrl = np.zeros(nu)
     if nu == 0:
-        return ctrl
-    a, adr, limited, (gainprm, biasprm, gear, ctrlrange) = _hold_plan(model)
-    if a.size:
-        gain = gainprm[a, 0]
-        b1 = biasprm[a, 1]
-        ok = (gain != 0.0) & (b1 != 0.0)
-        if not ok.all():
-            a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
+        return np.zeros(0)
+    a, adr, limited, whole, (gain0, bias0, bias1, gear0, lo, hi) = _hold_plan(model)
+    if whole and gain0.all() and bias1.all():
+        # every actuator position-like, in order, gain and biasprm[1] nonzero (ndarray.all():
+        # no element == 0, as the test below): the same operations on whole columns
+        ctrl = -(bias0 + bias1 * (gear0 * data.qpos[adr])) / gain0
+    else:
+        ctrl = np.zeros(nu)
         if a.size:
-            length = gear[a, 0] * data.qpos[adr]
-            ctrl[a] = -(biasprm[a, 0] + b1 * length) / gain
+            gain = gain0[a]
+            b1 = bias1[a]
+            ok = (gain != 0.0) & (b1 != 0.0)
+            if not ok.all():
+                a, adr, gain, b1 = a[ok], adr[ok], gain[ok], b1[ok]
+            if a.size:
+                length = gear0[a] * data.qpos[adr]
+                ctrl[a] = -(bias0[a] + b1 * length) / gain
+    if limited is None:  # every actuator limited
+        return np.clip(ctrl, lo, hi)
     if limited.size:
-        ctrl[limited] = np.clip(ctrl[limited], ctrlrange[limited, 0], ctrlrange[limited, 1])
+        ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
     return ctrl
 
 
 # --------------------------------------------------------------------------- reports
 class _WindowRows:
-    """The rollout's window (times, qpos from :meth:`Rollout.states`); its Plan built on first use.
+    """The rollout's window (the read-only rows of :meth:`Rollout._window`); its Plan built on first use.
 
-    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (same arrays, the live data's mocap
-    copied when the window was predicted). The joint call certifies the window without it;
-    the two-call path, a log and :attr:`StepReport.plan` build it.
+    :attr:`plan` is exactly :meth:`Rollout.plan`'s Plan (the same times and qpos, copied from
+    the rows when it is built; the live data's mocap copied when the window was predicted).
+    The joint call certifies the window without it; the two-call path, a log and
+    :attr:`StepReport.plan` build it.
     """
 
-    __slots__ = ("times", "_qpos", "_model", "_mocap_pos", "_mocap_quat", "_plan")
+    __slots__ = ("rows", "_model", "_mocap_pos", "_mocap_quat", "_plan")
 
-    def __init__(self, times: np.ndarray, qpos: np.ndarray, model: mujoco.MjModel,
-                 data: mujoco.MjData) -> None:
-        self.times = times  # (K,) s
-        self._qpos = qpos  # (K, nq), owned (the Plan normalises it in place)
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        self.rows = rows  # (K, 1 + nq) time (s), qpos; read-only
         self._model = model
         self._mocap_pos = np.array(data.mocap_pos)
         self._mocap_quat = np.array(data.mocap_quat)
@@ -509,9 +551,15 @@ class _WindowRows:
         if self._plan is None:
             from monitor.motion.plan import Plan
 
-            self._plan = Plan._trusted(self.times, self._qpos, model=self._model, mocap_pos=self._mocap_pos,
-                                       mocap_quat=self._mocap_quat)
+            rows = self.rows  # fresh owned copies: the Plan normalises its qpos in place
+            self._plan = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self._model,
+                                       mocap_pos=self._mocap_pos, mocap_quat=self._mocap_quat)
         return self._plan
+
+    @property
+    def times(self) -> np.ndarray:
+        """(K,) waypoint times (s): a read-only view of the rows."""
+        return self.rows[:, 0]
 
 
 def _plan_of(p: Any) -> Any:
@@ -583,6 +631,33 @@ class StepReport:
     stepped: bool = False
     brake_verdict: str = ""
 
+    @classmethod
+    def _trusted(cls, verdict: str, certificate: Certificate, proposed_ctrl: np.ndarray,
+                 applied_ctrl: np.ndarray, replaced: bool, terminated: bool, unsafe: bool,
+                 applied_verdict: str, fallback_certificate: Certificate | None, fallback_certified: bool,
+                 certify_us: float, time: float, plan: Any, brake_verdict: str) -> StepReport:
+        """The report ``StepReport(...)`` makes (``stepped=False``), without the frozen ``__init__``.
+
+        The frozen dataclass's ``__init__`` sets each of its 15 fields by ``object.__setattr__``;
+        this writes the same instance ``__dict__`` at once (``plan`` under the slot of
+        :class:`_LazyPlanField`). ``tests/test_gate_plumbing.py`` compares the two.
+        """
+        r = object.__new__(cls)
+        r.__dict__.update(verdict=verdict, certificate=certificate, proposed_ctrl=proposed_ctrl,
+                          applied_ctrl=applied_ctrl, replaced=replaced, terminated=terminated, unsafe=unsafe,
+                          applied_verdict=applied_verdict, fallback_certificate=fallback_certificate,
+                          fallback_certified=fallback_certified, certify_us=certify_us, time=time,
+                          _plan_store=plan, stepped=False, brake_verdict=brake_verdict)
+        return r
+
+    def _stepped(self) -> StepReport:
+        """A copy with ``stepped=True`` (= ``dataclasses.replace``, without building the plan)."""
+        r = object.__new__(type(self))
+        state = r.__dict__
+        state.update(self.__dict__)
+        state["stepped"] = True
+        return r
+
     @property
     def cost(self) -> float:
         """1.0 when the APPLIED window has a confirmed violation, else 0.0.
@@ -618,10 +693,12 @@ class StepReport:
             version (int), proposal_cost (float), intervened (bool), block_reason (str)
             (:mod:`monitor.gate_policy`) and, if ``timing``, certify_us (float µs).
         """
-        return {**safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
-                              replaced=self.replaced, fallback_certified=self.fallback_certified,
-                              terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
-                              certify_us=self.certify_us if timing else None), **safety_keys(self)}
+        out = safety_info(self.certificate, verdict=self.verdict, applied_verdict=self.applied_verdict,
+                          replaced=self.replaced, fallback_certified=self.fallback_certified,
+                          terminated=self.terminated, time=self.time, brake_verdict=self.brake_verdict,
+                          certify_us=self.certify_us if timing else None)
+        out.update(safety_keys(self))
+        return out
 
 
 def _all_culled(cert: Certificate) -> int | None:
@@ -652,6 +729,21 @@ def _npairs(cert: Certificate) -> int:
     return n if type(n) is int else len(cert.pairs)
 
 
+_NO_GEOMS = np.array(["", ""], dtype=object)  # templates, copied into each info dict (never handed out)
+_NO_POINT = np.full(3, math.inf)
+_CULLED: dict[int, np.ndarray] = {}
+
+
+def _culled_methods(n: int) -> np.ndarray:
+    """A fresh (n,) object array of ``"culled"`` (a copy of a cached template)."""
+    t = _CULLED.get(n)
+    if t is None:
+        if len(_CULLED) >= 64:
+            _CULLED.clear()
+        t = _CULLED[n] = np.full(n, "culled", dtype=object)
+    return t.copy()
+
+
 def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str, replaced: bool,
                 fallback_certified: bool, terminated: bool, time: float, brake_verdict: str = "",
                 certify_us: float | None = None, npairs: int | None = None) -> dict[str, Any]:
@@ -666,12 +758,13 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
     else:
         n = _all_culled(cert)
         if n is not None:  # every pair culled (the common gated step): no PairResult is built
-            checker = np.full(n, "culled", dtype=object)
+            checker = _culled_methods(n)
             mix = f"culled:{n}" if n else ""
         else:
             checker = cert.pair_methods()   # no PairResult built on the compiled path
-            counts = Counter(checker.tolist())
-            mix = " ".join(f"{m}:{counts[m]}" for m in sorted(counts))  # code-point order, as np.unique
+            names = checker.tolist()
+            # counts per method (list.count: a few distinct names), code-point order as np.unique
+            mix = " ".join(f"{m}:{names.count(m)}" for m in sorted(set(names)))
         wit = cert.witness
         earliest = inf if cert.earliest_time is None else float(cert.earliest_time)
         clearance = float(cert.clearance)
@@ -682,8 +775,8 @@ def safety_info(cert: Certificate | None, *, verdict: str, applied_verdict: str,
         "checker": checker,
         "checker_mix": mix,
         "witness_time": inf if wit is None else float(wit.time),
-        "witness_geoms": np.array(["", ""] if wit is None else list(wit.geoms), dtype=object),
-        "witness_point": np.full(3, inf) if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
+        "witness_geoms": _NO_GEOMS.copy() if wit is None else np.array(list(wit.geoms), dtype=object),
+        "witness_point": _NO_POINT.copy() if wit is None else np.asarray(wit.point, float).reshape(3).copy(),
         "earliest_time": earliest,
         "clearance": clearance,
         "replaced": bool(replaced),
@@ -1140,7 +1233,7 @@ class Gate:
             cert = certify(scene, plan, request=self._request or self.request)
         else:
             cert = self._certify_subset(certify, scene, plan, todo, reused)
-        if self.reuse:
+        if keys:  # fixed pairs (only with reuse on)
             self._remember(cert, keys)
         us = (time.perf_counter() - t_start) * 1e6
         self.stats["reused_pairs"] += len(reused)
@@ -1191,9 +1284,12 @@ class Gate:
         """
         from monitor.motion.plan import Plan
 
+        # Bit-for-bit checks (bytes: stricter than ==, e.g. -0.0 != 0.0); both hold by
+        # construction on the gate's own path, a failure only means two calls.
         if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
-                or not np.array_equal(window_rows[:, 0], plan.times)
-                or not np.array_equal(window_rows[-1], tail_rows[0])):
+                or not ((isinstance(plan, _WindowRows) and plan.rows is window_rows)  # the same rows
+                        or window_rows[:, 0].tobytes() == np.asarray(plan.times).tobytes())
+                or window_rows[-1].tobytes() != tail_rows[0].tobytes()):
             return None
         rows = np.concatenate((window_rows, tail_rows[1:]))
         joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
@@ -1211,15 +1307,17 @@ class Gate:
         """Indices of pairs to certify (None = all), reusable results, cache keys of fixed pairs."""
         if not self.reuse:
             return None, {}, {}
-        context = self._reuse_context()
-        if context != self._cache_context:
-            self._cache.clear()
-            self._cache_context = context
         moving = np.asarray(plan.moving_bodies(), bool)
         body_a, body_b = self._pair_bodies(scene)
-        fixed = np.flatnonzero(~(moving[body_a] | moving[body_b]))
-        if not fixed.size:
-            return None, {}, {}
+        either = moving[body_a]  # (P,) a body of the pair moves
+        either |= moving[body_b]
+        if either.all():  # every pair has a moving body (the common gated step): nothing to reuse
+            return None, {}, {}  # (the cache is neither read nor written: its context is checked below)
+        context = self._reuse_context()
+        if context != self._cache_context:  # before any read or write of the cache
+            self._cache.clear()
+            self._cache_context = context
+        fixed = np.flatnonzero(~either)
         pos, rot = plan.body_poses(np.array([plan.t0]))
         ba, bb = body_a[fixed], body_b[fixed]
         # key of pair i: the bytes of (p_a (3,), R_a (9,), p_b (3,), R_b (9,)) at t0
@@ -1337,10 +1435,11 @@ class Gate:
         if len(hits) != 1:
             return None
         k = int(hits[0])
-        if (k + n >= len(plan.times) or not np.array_equal(plan.qpos[k], data.qpos)
-                or not np.array_equal(qvel[k], data.qvel)
-                or not np.array_equal(plan.mocap_pos, data.mocap_pos)
-                or not np.array_equal(plan.mocap_quat, data.mocap_quat)):
+        # bit for bit: bytes (stricter than ==: -0.0 != 0.0); shapes are the model's, fixed
+        if (k + n >= len(plan.times) or plan.qpos[k].tobytes() != data.qpos.tobytes()
+                or qvel[k].tobytes() != data.qvel.tobytes()
+                or plan.mocap_pos.tobytes() != data.mocap_pos.tobytes()
+                or plan.mocap_quat.tobytes() != data.mocap_quat.tobytes()):
             return None
         return cert
 
@@ -1392,7 +1491,7 @@ class Gate:
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             self.reference_qpos = np.array(data.qpos)
         if own_predictor:  # the rollout's window; its Plan is built only when something reads it
-            plan: Any = _WindowRows(*self._rollout.states(data, ctrl, n), self.model, data)
+            plan: Any = _WindowRows(self._rollout._window(data, ctrl, n), self.model, data)
         else:
             plan = predict(ctrl)
         brake_on = self._brake_active(fallback)
@@ -1472,8 +1571,8 @@ class Gate:
             self._committed = brake_next
             self._tail = None if brake_next is None else (tail, tail_cert, tail_qvel)
             self._tail_context = self._reuse_context()
-        report = StepReport(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
-                            applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict=brake_verdict)
+        report = StepReport._trusted(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
+                                     applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict)
         self._account(report)
         self._write_log(report, applied_plan)
         self.last_report = report
@@ -1504,7 +1603,7 @@ class Gate:
                 f"ctrl must be a numeric array of shape ({self.model.nu},), got {ctrl!r}") from e
         if ctrl.shape != (self.model.nu,):
             raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
-        if not np.all(np.isfinite(ctrl)):
+        if not np.isfinite(ctrl).all():
             raise InvalidInputError("ctrl contains NaN or inf")
         report = self.decide(data, ctrl, nstep=n)
         # The scratch usually holds the applied window already (the proposal's, or the
@@ -1515,8 +1614,7 @@ class Gate:
         else:
             data.ctrl[:] = report.applied_ctrl
             mujoco.mj_step(self.model, data, nstep=n)
-        report = copy.copy(report)  # as dataclasses.replace(report, stepped=True), without building the plan
-        object.__setattr__(report, "stepped", True)
+        report = report._stepped()  # as dataclasses.replace(report, stepped=True), without building the plan
         self.last_report = report
         return report
 

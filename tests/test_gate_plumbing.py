@@ -226,3 +226,89 @@ def test_log_null_unknown_fast_path_matches_the_rule():
     assert [type(v) for v in got.values()] == [type(v) for v in want.values()]
     assert got["a"] is None and got["o"] is None and got["p"] == 9.999999999999999e307
     assert got["f"]["g"] is None and got["j"]["k"] is None and got["e"][1] == [2.0, None]
+
+
+def test_hold_ctrl_clip_follows_ctrllimited_edits_on_an_all_limited_model():
+    """Every actuator limited: the clip runs on whole columns; unlimiting one in place is seen."""
+    m = mujoco.MjModel.from_xml_path(str(scene_path("arm")))
+    d = mujoco.MjData(m)
+    assert m.actuator_ctrllimited.all()
+    d.qpos[:] = 10.0  # far outside every ctrlrange: each position servo's hold is clipped
+    before = hold_ctrl(m, d)
+    assert np.array_equal(before, _hold_scalar(m, d))
+    assert np.array_equal(before, m.actuator_ctrlrange[:, 1])
+    m.actuator_ctrllimited[0] = 0
+    after = hold_ctrl(m, d)
+    assert np.array_equal(after, _hold_scalar(m, d))
+    assert after[0] != before[0] and np.array_equal(after[1:], before[1:])
+    # every actuator position-like (whole-column formula) until a value edit makes one of
+    # them hold 0: then the per-actuator selection decides
+    rng = np.random.default_rng(5)
+    for field, col in (("actuator_gainprm", 0), ("actuator_biasprm", 1)):
+        d.qpos[:] = rng.normal(0.0, 0.3, m.nq)
+        whole = hold_ctrl(m, d)
+        assert np.array_equal(whole, _hold_scalar(m, d)) and np.count_nonzero(whole) == m.nu
+        saved = getattr(m, field)[1, col]
+        getattr(m, field)[1, col] = 0.0
+        edited = hold_ctrl(m, d)
+        assert np.array_equal(edited, _hold_scalar(m, d)), field
+        assert edited[1] == 0.0 and np.array_equal(edited[[0, 2]], whole[[0, 2]]), field
+        getattr(m, field)[1, col] = saved
+
+
+def test_step_report_fast_constructors_match_the_dataclass():
+    """StepReport._trusted / _stepped write the same instance state as the dataclass's
+    __init__ / dataclasses.replace (compared field by field and as whole __dict__s)."""
+    import dataclasses
+
+    from monitor.certify.certificate import Certificate
+    from monitor.gate import StepReport
+
+    cert = Certificate("certified", (0.0, 0.1), 0.0, 1e-3, "auto", None, None, 0.5, (), {"pairs": 0}, ())
+    args = ("certified", cert, np.zeros(2), np.ones(2), True, False, True, "violation", cert, False, 12.5,
+            0.25, "plan-object", "certified")
+    slow = StepReport(*args[:13], brake_verdict=args[13])
+    fast = StepReport._trusted(*args)
+    assert fast.__dict__ == slow.__dict__ and fast == slow
+    assert all(getattr(fast, f.name) is getattr(slow, f.name) for f in dataclasses.fields(StepReport))
+    stepped = fast._stepped()
+    assert stepped.__dict__ == dataclasses.replace(slow, stepped=True).__dict__ and not fast.stepped
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.verdict = "violation"
+
+
+def test_window_rows_are_the_states_with_row_zero_normalised():
+    """Rollout.states / window_rows: the state at the window start with its quaternions
+    normalised (a hand-set, non-unit one too), then each substep's state as an independent
+    MjData stepped from a copy gives it; the caller's data untouched; window_rows read-only."""
+    from monitor.gate import Rollout
+
+    m = mujoco.MjModel.from_xml_string(_MIXED)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(11)
+    d.qpos[:] = rng.normal(0.0, 0.5, m.nq)
+    free = m.jnt_qposadr[next(j for j in range(m.njnt) if m.jnt_type[j] == _FREE)]
+    d.qpos[free + 3:free + 7] = [0.6, 0.8, 0.0, 0.0]
+    d.qpos[free + 3:free + 7] *= 1.0 + 1e-7  # a state set by hand: not unit
+    d.ctrl[:] = rng.normal(0.0, 1.0, m.nu)
+    before = np.array(d.qpos)
+    ro = Rollout(m)
+    times, qpos = ro.states(d, None, 3)
+    oracle = mujoco.MjData(m)
+    mujoco.mj_copyData(oracle, m, d)
+    q0 = np.array(d.qpos)
+    mujoco.mj_normalizeQuat(m, q0)
+    want_t, want_q = [d.time], [q0]
+    for _ in range(3):
+        mujoco.mj_step(m, oracle)
+        want_t.append(oracle.time)
+        want_q.append(np.array(oracle.qpos))
+    assert np.array(want_t).tobytes() == times.tobytes()
+    assert np.array(want_q).tobytes() == qpos.tobytes()
+    assert not np.array_equal(q0, before)  # row 0 really was normalised
+    assert d.qpos.tobytes() == before.tobytes()  # the caller's data untouched
+    rows = ro.window_rows
+    assert rows[:, 0].tobytes() == times.tobytes() and rows[:, 1:].tobytes() == qpos.tobytes()
+    assert not rows.flags.writeable
+    qpos[0, 0] += 1.0  # states' arrays are the caller's own
+    assert rows[0, 1] != qpos[0, 0]
