@@ -1477,6 +1477,9 @@ class Gate:
         if n < 1:
             raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
         ctrl = np.asarray(ctrl)
+        if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
+            # (before the scene is built: `allowed="auto"` frees the pairs touching at THIS pose)
+            self.reference_qpos = np.array(data.qpos)
         self._sync_scene()  # certify against the model as it is now (domain randomisation, tuning)
         if cast is None:
             def cast(c: Any) -> np.ndarray:
@@ -1488,8 +1491,6 @@ class Gate:
             def predict(c: Any) -> Any:
                 return self.predict(data, c, n)
         t_win = float(data.time)
-        if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
-            self.reference_qpos = np.array(data.qpos)
         if own_predictor:  # the rollout's window; its Plan is built only when something reads it
             plan: Any = _WindowRows(self._rollout._window(data, ctrl, n), self.model, data)
         else:
