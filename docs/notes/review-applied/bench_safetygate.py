@@ -1,8 +1,10 @@
-"""SafetyGate(monitor/Arm-v0) with a log (default options: foxglove on when installed), seeded random actions: median µs per env.step,
-accepted and replaced steps apart (about half the random Arm actions are blocked).
+"""SafetyGate(monitor/Arm-v0) with a default log, seeded random actions: median µs per env.step.
+
+Accepted and replaced steps apart (about half the random Arm actions are blocked); the log has
+default options (foxglove on when installed).
 
   for r in 1 2 3; do for t in /tmp/h12ac_main /work/wt/h12ac; do \
-    (cd $t && PYTHONPATH=$t /work/main/.venv/bin/python /work/wt/h12ac/docs/notes/review-applied/bench_safetygate.py); \
+    (cd $t && PYTHONPATH=$t python /work/wt/h12ac/docs/notes/review-applied/bench_safetygate.py); \
   done; done
 """
 import statistics
@@ -31,5 +33,6 @@ for k in range(330):
         env.reset()
 windows = env.gate._log.windows
 env.close()
-print(f"{monitor.__file__.split('/monitor/')[0]:20} accepted {statistics.median(acc):8.1f} us (n={len(acc)})  "
+tree = monitor.__file__.split('/monitor/')[0]
+print(f"{tree:20} accepted {statistics.median(acc):8.1f} us (n={len(acc)})  "
       f"replaced {statistics.median(rep):8.1f} us (n={len(rep)})  log windows {windows}")

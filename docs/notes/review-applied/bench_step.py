@@ -2,7 +2,7 @@
 
 Run one tree per process, interleaved (cwd = the tree, see review-provenance.md's caveat):
   for r in 1 2 3; do for t in /tmp/h12ac_main /work/wt/h12ac; do \
-    (cd $t && PYTHONPATH=$t /work/main/.venv/bin/python /work/wt/h12ac/docs/notes/review-applied/bench_step.py); \
+    (cd $t && PYTHONPATH=$t python /work/wt/h12ac/docs/notes/review-applied/bench_step.py); \
   done; done
 """
 import statistics
@@ -34,5 +34,7 @@ with Gate(model, log=tmp / "g.mcap", log_options={"foxglove": False}) as gate:
             mujoco.mj_resetData(model, data)
             gate.reset()
     windows = gate._log.windows
-print(f"{monitor.__file__.split('/monitor/')[0]:20} accepted {statistics.median(acc):8.1f} us (n={len(acc)})  "
-      f"replaced {statistics.median(rep) if rep else float('nan'):8.1f} us (n={len(rep)})  log windows {windows}")
+med_rep = statistics.median(rep) if rep else float("nan")
+tree = monitor.__file__.split('/monitor/')[0]
+print(f"{tree:20} accepted {statistics.median(acc):8.1f} us (n={len(acc)})  "
+      f"replaced {med_rep:8.1f} us (n={len(rep)})  log windows {windows}")
