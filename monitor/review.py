@@ -694,7 +694,8 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
 
     * the record exists and is one (else UNVERIFIABLE: what ran is not in the log);
     * its window contains window k's span, and its plan passes through window k's start state
-      (the proposal's first waypoint; both were simulated from the same state): else CRITICAL
+      (the proposal's first waypoint; both were simulated from the same state) and through the
+      start state of the step window that begins where window k ends (if logged): else CRITICAL
       when the record claims ``certified`` (a certificate claimed for a motion it does not
       cover), UNVERIFIABLE otherwise;
     * ``covered_by``: a fallback record names itself; a braking tail names an earlier step
@@ -710,6 +711,8 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
         passed), ``applied_missing``, ``unlogged_old`` (older logs' count for the note).
     """
     by_index = {c["index"]: c for c in certs}
+    step_at = {(str(c.get("episode", 0)), float(c["window"][0])): c["index"] for c in certs
+               if not is_applied_record(c)}  # the step window starting at each time (to find the next step)
     acts = [a for a in contents.topic(topics.ACTION) if a.get("replaced") is True]
     new_style = (contents.run.get(topics.APPLIED_MOTIONS_KEY) == "logged"
                  or any("applied_window" in a for a in acts))
@@ -775,6 +778,12 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
             continue
         if not _passes_through(plan_msgs.get(k), plan_msgs.get(jw), float(step["window"][0])):
             bad(rec, f"applied record {jw}'s motion does not pass through replaced step {k}'s start state", k)
+            continue
+        t_end = float(step["window"][1])
+        nxt = step_at.get((str(step.get("episode", 0)), t_end))
+        if nxt is not None and not _passes_through(plan_msgs.get(nxt), plan_msgs.get(jw), t_end):
+            bad(rec, f"applied record {jw}'s motion does not end replaced step {k} in the state the next "
+                     f"window {nxt} starts from", k)
             continue
         out["applied_steps"] += int(jw in ok_records)
     return out

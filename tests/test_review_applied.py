@@ -287,3 +287,26 @@ def test_writer_validates_applied_fields(tmp_path):
         with pytest.raises(InvalidInputError, match="covered_by"):
             log.write_window(0.0, None, cert, applied={"kind": "fallback", "covered_by": 5})
         assert log.write_window(0.0, None, cert, applied={"kind": "fallback", "covered_by": 0}) == 0
+
+
+def test_forged_record_motion_that_leaves_the_step_elsewhere_is_critical(arm_log, tmp_path):
+    """A tail record whose motion is edited after the step's start (a different motion that still
+    covers the span and starts right): it no longer ends the step where the next window starts."""
+    path, _, _ = arm_log
+    certs, plans, acts = _records(read_log(path))
+    starts = {c["window"][0] for c in certs.values() if "applied" not in c}
+    k, j = next((k, a["applied_window"]) for k, a in sorted(acts.items())
+                if a["replaced"] and certs[a["applied_window"]]["verdict"] == "certified"
+                and certs[k]["window"][1] in starts)
+    t1 = certs[k]["window"][1]
+    hit = int(np.flatnonzero(np.asarray(plans[j]["times"]) == t1)[0])
+
+    def move(topic, p):
+        if topic == topics.PLAN and p["index"] == j:
+            p["qpos"][hit] = [q + 1e-3 for q in p["qpos"][hit]]  # 1 mrad off at the step's end
+        return p
+
+    ver = _forge(path, tmp_path / "elsewhere.mcap", msg=move)
+    crit = _critical(ver)
+    assert any(f"applied record {j}'s motion does not end replaced step {k} in the state the next window" in r
+               for r in crit), crit
