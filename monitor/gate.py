@@ -1058,6 +1058,8 @@ class Gate:
         self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
         self._joint_hint = True  # try the joint window + tail call (see decide)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
+        self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
+        self._tail_record: tuple[Certificate, int] | None = None  # (tail certificate, its log record index)
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
         self.tolerances = tolerances
@@ -1674,7 +1676,8 @@ class Gate:
         mode = "none" if self.allowed is None else (
             "auto" if isinstance(self.allowed, str) and self.allowed == "auto" else "given")
         ref = self.reference_qpos
-        return {"pairs": str(self.pairs), "allowed_pairs": [list(a) for a in self.scene.allowed_pairs],
+        return {"applied_motions": "logged",  # every replaced action names the motion that ran
+                "pairs": str(self.pairs), "allowed_pairs": [list(a) for a in self.scene.allowed_pairs],
                 "hazards": _json_items(self.hazards), "allow": _json_items(self.allow),
                 "allowed_mode": mode,
                 "reference_qpos": None if ref is None else np.asarray(ref, float).tolist()}
@@ -1684,11 +1687,45 @@ class Gate:
         if log is None:
             return
         why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
-        log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, r.replaced,
-                         reason=why)
-        if r.replaced and not r.fallback_certified and r.fallback_certificate is not None:
-            log.write_window(r.time, applied_plan, r.fallback_certificate, r.applied_ctrl,
-                             r.applied_ctrl, True, reason=why)
+        if not r.replaced:  # the window that ran is this one; it may commit a braking tail
+            self._log_accepted = log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl,
+                                                  r.applied_ctrl, False, reason=why)
+            return
+        fb = r.fallback_certificate
+        if fb is None or not getattr(log, "logs_applied_motions", False):  # a log object of another kind
+            log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why)
+            if not r.fallback_certified and fb is not None:
+                log.write_window(r.time, applied_plan, fb, r.applied_ctrl, r.applied_ctrl, True, reason=why)
+            return
+        self._write_applied(log, r, applied_plan, why)
+
+    def _write_applied(self, log: Any, r: StepReport, applied_plan: Any, why: str | None) -> None:
+        """Log a replaced step: its proposal, naming the record of the motion that ran.
+
+        That record (``applied=``, see :data:`monitor.log.topics.APPLIED_MOTIONS_KEY`) is a fresh
+        fallback's own window, or, for the committed brake (``decide`` reuses the committed tail's
+        certificate object: ``applied_plan`` is None and the certificate *is* ``self._tail[1]``),
+        the braking tail's plan and certificate, written at the first step braking on it and
+        named again by the later ones.
+        """
+        fb = r.fallback_certificate
+        nxt = log.windows  # the proposal's index; a new record gets the next one
+        tail = self._tail
+        if applied_plan is None and tail is not None and fb is tail[1]:
+            rec = self._tail_record
+            if rec is not None and rec[0] is fb:  # this tail is in the log already
+                log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True,
+                                 reason=why, applied_window=rec[1])
+                return
+            by = self._log_accepted
+            applied = {"kind": "brake_tail", "covered_by": nxt + 1 if by is None else by}
+            applied_plan = tail[0].plan if isinstance(tail[0], _Tail) else tail[0]
+            self._tail_record = (fb, nxt + 1)
+        else:
+            applied = {"kind": "fallback", "covered_by": nxt + 1}
+        log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why,
+                         applied_window=nxt + 1)
+        log.write_window(r.time, _plan_of(applied_plan), fb, applied=applied)
 
     def close(self) -> None:
         """Finish the log if the gate opened it."""

@@ -153,7 +153,20 @@ def certificate_problem(c: dict[str, Any]) -> str | None:
     st = c.get("stats")
     if st is not None and not isinstance(st, dict):
         return "stats is not an object"
+    ap = c.get("applied")
+    if ap is not None and not (isinstance(ap, dict) and ap.get("kind") in APPLIED_KINDS
+                               and _is_int(ap.get("covered_by")) and ap["covered_by"] >= 0):
+        return f"applied {_short(ap, 60)} is not {{kind: fallback | brake_tail, covered_by: index}}"
     return None
+
+
+APPLIED_KINDS = ("fallback", "brake_tail")
+"""Kinds of applied-motion records (:data:`monitor.log.topics.APPLIED_MOTIONS_KEY`)."""
+
+
+def is_applied_record(c: dict[str, Any]) -> bool:
+    """True for an applied-motion record (the motion a replaced step ran), not a step's own window."""
+    return isinstance(c.get("applied"), dict)
 
 
 def split_certificates(contents: LogContents) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
@@ -223,7 +236,8 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         stop_kind, messages, bad_payloads, bad_records, problems), ``run`` (metadata),
         ``bad_messages`` (rows: index, problem), ``unknown_verdicts`` (rows: index,
         verdict), ``integrity`` (problems found by :func:`_integrity`), ``windows``, ``verdicts``
-        ({verdict: count}), ``blocked_actions``, ``actions``, ``latency_us``
+        ({verdict: count}; applied-motion records excluded: ``applied_motions`` {records,
+        verdicts}), ``blocked_actions``, ``actions``, ``latency_us``
         ({p50, p95, max, n}), ``checker_mix`` ({method: pairs}), ``violations``
         (rows: index, sim_time, verdict, time, geoms, bodies, point, distance,
         clearance), and ``series`` (per-window sim_time, verdict, clearance,
@@ -237,8 +251,14 @@ def analyze(contents: LogContents) -> dict[str, Any]:
     series = {"sim_time": [], "verdict": [], "clearance": [], "latency_us": [], "margin": [], "episode": [],
               "index": []}
     rows = []
+    applied: Counter = Counter()
     for c in certs:
         v = c.get("verdict")
+        if is_applied_record(c) and v in VERDICTS:  # the motion a replaced step ran: counted apart
+            applied[v] += 1
+            if v != "certified":
+                rows.append(_violation_row(c))
+            continue
         if v not in VERDICTS:
             unknown.append({"index": c["index"], "sim_time": c["sim_time"], "verdict": str(v)[:60]})
             continue
@@ -279,6 +299,7 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         "versions": {k[len("version."):]: v for k, v in contents.run.items() if k.startswith("version.")},
         "windows": sum(verdicts.values()),
         "verdicts": dict(verdicts),
+        "applied_motions": {"records": sum(applied.values()), "verdicts": dict(applied)},
         "actions": len(actions),
         "blocked_actions": sum(1 for a in actions if a.get("replaced")),
         "latency_us": {"n": len(lat), "p50": _percentile(lat, 50), "p95": _percentile(lat, 95),
@@ -653,6 +674,140 @@ def _unlogged_applied(contents: LogContents) -> int:
     return sum(1 for a in contents.topic(topics.ACTION) if a.get("replaced") is True and per_time[at(a)] < 2)
 
 
+_SPAN_TOL = 1e-12  # s: window ends of one run are the same float sums; a little slack, never a gap
+
+
+def _covers(outer: Any, inner: Any) -> bool:
+    """``outer`` [a, b] contains ``inner`` [c, d] (finite numbers; ``_SPAN_TOL`` slack)."""
+    return outer[0] <= inner[0] + _SPAN_TOL and inner[1] <= outer[1] + _SPAN_TOL
+
+
+def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
+                      plan_msgs: dict[int, list[dict[str, Any]]], find: Callable[..., None],
+                      notes: list[str]) -> dict[str, int]:
+    """Check that every replaced step names the record of the motion that ran, and that it covers it.
+
+    A gate that logs applied motions (run metadata ``applied_motions``, or any action naming an
+    ``applied_window``) writes, for each replaced action of window k, ``applied_window`` j: an
+    applied-motion record (``applied``: kind, covered_by; :data:`topics.APPLIED_MOTIONS_KEY`)
+    whose plan and certificate are re-derived like any window. Here:
+
+    * the record exists and is one (else UNVERIFIABLE: what ran is not in the log);
+    * its window contains window k's span, and its plan passes through window k's start state
+      (the proposal's first waypoint; both were simulated from the same state) and through the
+      start state of the step window that begins where window k ends (if logged): else CRITICAL
+      when the record claims ``certified`` (a certificate claimed for a motion it does not
+      cover), UNVERIFIABLE otherwise;
+    * ``covered_by``: a fallback record names itself; a braking tail names an earlier step
+      window (not a record) that ends where the tail starts and, when the record was
+      certified jointly with it (``stats.joint_window``), has the same joint window: else
+      CRITICAL when certified, UNVERIFIABLE otherwise.
+
+    Older logs (neither marker): the replaced actions without a second certificate at the same
+    time are counted in a note, as before.
+
+    Returns:
+        counts: ``applied_records``, ``applied_steps`` (replaced actions whose record checks
+        passed), ``applied_missing``, ``unlogged_old`` (older logs' count for the note).
+    """
+    by_index = {c["index"]: c for c in certs}
+    step_at = {(str(c.get("episode", 0)), float(c["window"][0])): c["index"] for c in certs
+               if not is_applied_record(c)}  # the step window starting at each time (to find the next step)
+    acts = [a for a in contents.topic(topics.ACTION) if a.get("replaced") is True]
+    new_style = (contents.run.get(topics.APPLIED_MOTIONS_KEY) == "logged"
+                 or any("applied_window" in a for a in acts))
+    out = {"applied_records": sum(1 for c in certs if is_applied_record(c)), "applied_steps": 0,
+           "applied_missing": 0, "unlogged_old": 0}
+    if not new_style:
+        out["unlogged_old"] = _unlogged_applied(contents)
+        return out
+
+    def bad(rec: dict[str, Any], reason: str, index: Any) -> None:
+        find(CRITICAL if rec.get("verdict") == "certified" else UNVERIFIABLE, reason, index)
+
+    ok_records = set()
+    for c in certs:
+        if not is_applied_record(c):
+            continue
+        j, ap = c["index"], c["applied"]
+        by = ap["covered_by"]
+        if ap["kind"] == "fallback":
+            if by != j:
+                bad(c, f"applied fallback record names window {_short(by, 20)}'s certificate, not its own", j)
+                continue
+        else:
+            src = by_index.get(by)
+            if src is None or is_applied_record(src) or by >= j:
+                bad(c, f"applied braking-tail record: covered_by={_short(by, 20)} is no earlier step "
+                       f"window", j)
+                continue
+            if not math.isclose(float(src["window"][1]), float(c["window"][0]), rel_tol=0, abs_tol=_SPAN_TOL):
+                bad(c, f"applied braking-tail record starts at t={c['window'][0]!r}, not where window {by} "
+                       f"(its covering step) ends (t={src['window'][1]!r})", j)
+                continue
+            jw = (c.get("stats") or {}).get("joint_window")
+            if jw is not None:
+                sjw = (src.get("stats") or {}).get("joint_window")
+                if sjw != jw or not (isinstance(jw, list) and len(jw) == 2 and all(_is_num(v) for v in jw)
+                                     and _covers(jw, c["window"])):
+                    bad(c, f"applied braking-tail record claims the joint certificate over {_short(jw, 60)}, "
+                           f"window {by} has {_short(sjw, 60)}", j)
+                    continue
+        ok_records.add(j)
+    for a in acts:
+        k = a.get("index")
+        jw = a.get("applied_window")
+        step = by_index.get(k) if _is_int(k) else None
+        if jw is None:
+            out["applied_missing"] += 1
+            find(UNVERIFIABLE, "replaced step names no record of the motion that ran (no applied_window)",
+                 k if _is_int(k) else None)
+            continue
+        rec = by_index.get(jw) if _is_int(jw) else None
+        if rec is None or not is_applied_record(rec):
+            out["applied_missing"] += 1
+            find(UNVERIFIABLE, f"replaced step's applied motion record (window {_short(jw, 20)}) is missing",
+                 k if _is_int(k) else None)
+            continue
+        if step is None or is_applied_record(step):
+            find(UNVERIFIABLE, f"replaced action {_short(k, 20)} has no step window", None)
+            continue
+        if not _covers(rec["window"], step["window"]):
+            bad(rec, f"applied record {jw} (window {rec['window']}) does not cover the span {step['window']} "
+                     f"of replaced step {k}: the motion that ran is not certified by it", k)
+            continue
+        if not _passes_through(plan_msgs.get(k), plan_msgs.get(jw), float(step["window"][0])):
+            bad(rec, f"applied record {jw}'s motion does not pass through replaced step {k}'s start state", k)
+            continue
+        t_end = float(step["window"][1])
+        nxt = step_at.get((str(step.get("episode", 0)), t_end))
+        if nxt is not None and not _passes_through(plan_msgs.get(nxt), plan_msgs.get(jw), t_end):
+            bad(rec, f"applied record {jw}'s motion does not end replaced step {k} in the state the next "
+                     f"window {nxt} starts from", k)
+            continue
+        out["applied_steps"] += int(jw in ok_records)
+    return out
+
+
+def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
+    """The record's plan has a waypoint at ``t`` whose qpos equals the step plan's first (1e-9)."""
+    if not step_plans or not rec_plans or len(step_plans) > 1 or len(rec_plans) > 1:
+        return True  # a missing or duplicate plan is reported by verify's window loop
+    p, r = step_plans[0], rec_plans[0]
+    if p.get("kind", "plan") != "plan" or r.get("kind", "plan") != "plan":
+        return True  # body motions: no joint state to compare (a gate logs joint-space plans)
+    try:
+        times = np.asarray(r["times"], np.float64)
+        hit = np.flatnonzero(np.abs(times - t) <= _SPAN_TOL)
+        if len(hit) == 0:
+            return False
+        q0 = np.asarray(p["qpos"][0], np.float64)
+        q1 = np.asarray(r["qpos"][int(hit[0])], np.float64)
+        return q0.shape == q1.shape and bool(np.allclose(q0, q1, rtol=0.0, atol=1e-9))
+    except (KeyError, IndexError, TypeError, ValueError):
+        return False
+
+
 def _engine() -> tuple[Any, Any]:
     """(Scene class, certify function); ImportError while the engine is not installed."""
     from monitor.certify.engine import certify
@@ -801,7 +956,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         severity ``"critical" | "unverifiable"``, reason), ``notes`` (strings),
         ``critical`` (critical mismatches + critical findings), ``unverifiable`` (number
         of unverifiable findings), ``missing_plans``, ``errors`` (rows: index, error),
-        ``pairs_differ``.
+        ``pairs_differ``, and for applied-motion records (:func:`_applied_findings`)
+        ``applied_checked`` (records re-derived, counted in ``checked`` too), ``applied_records``,
+        ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``.
 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
@@ -926,7 +1083,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            "pair_policy": policy if isinstance(policy, str) else
                            (None if policy is None else [list(p) for p in policy]),
                            "mismatches": [], "findings": findings, "notes": notes, "critical": 0,
-                           "unverifiable": 0, "missing_plans": 0, "errors": [], "pairs_differ": 0}
+                           "unverifiable": 0, "missing_plans": 0, "errors": [], "pairs_differ": 0,
+                           "applied_checked": 0}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     it = certs
     if progress is None:
@@ -1005,6 +1163,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             find(UNVERIFIABLE, f"cannot recompute: {type(exc).__name__}: {str(exc)[:200]}", k)
             continue
         out["checked"] += 1
+        out["applied_checked"] += int(is_applied_record(c))
         if new.verdict != verdict:
             critical = (new.verdict == "certified") != (verdict == "certified")
             budget = bool((c.get("stats") or {}).get("budget_exhausted")) and verdict == "uncertain"
@@ -1018,11 +1177,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
-    unlogged = _unlogged_applied(contents)
+    applied = _applied_findings(contents, good, plan_msgs, find, notes)
+    out.update(applied)
+    unlogged = applied["unlogged_old"]
     if unlogged:
         notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "
                      f"(a gate logs the applied window only when it is not certified: the committed brake's "
-                     f"tail or a certified fallback): re-derived are the proposals, not what was applied")
+                     f"tail or a certified fallback): re-derived are the proposals, not what was applied "
+                     f"(a log from before applied motions were logged)")
     if no_request_id and (used_requests or len(requests) > 1):
         notes.append(f"{no_request_id} window(s) name no request (request_id absent): re-derived with the "
                      f"run's request" + ("" if logged_req is not None else " (none: plain rule)"))
@@ -1160,7 +1322,10 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
         f"predictor {_fmt(run.get('predictor'))}",
         f"   windows {entry['windows']}: certified {v['certified']}, violation {v['violation']}, "
         f"uncertain {v['uncertain']}",
-        f"   actions {entry['actions']}, blocked/replaced {entry['blocked_actions']}",
+        f"   actions {entry['actions']}, blocked/replaced {entry['blocked_actions']}"
+        + (f"; applied motions logged {entry['applied_motions']['records']} "
+           f"({', '.join(f'{k} {n}' for k, n in sorted(entry['applied_motions']['verdicts'].items()))})"
+           if entry.get("applied_motions", {}).get("records") else ""),
         f"   us per certification: p50 {_fmt(lat['p50'], '.1f')}, p95 {_fmt(lat['p95'], '.1f')}, "
         f"max {_fmt(lat['max'], '.1f')} (n={lat['n']})",
         "   checker mix: " + (", ".join(f"{k} {n}" for k, n in sorted(entry["checker_mix"].items()))
@@ -1186,6 +1351,10 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
                      f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s); "
                      f"{ver.get('unverifiable', 0)} unverifiable, {ver.get('pairs_differ', 0)} with a "
                      f"different pair set; {ver.get('windows', '?')} window(s) in the log")
+        if ver.get("applied_records") or ver.get("applied_missing"):
+            lines.append(f"     applied motions re-derived: {ver.get('applied_checked', 0)} record(s) of "
+                         f"{ver.get('applied_records', 0)}, covering {ver.get('applied_steps', 0)} replaced "
+                         f"step(s); {ver.get('applied_missing', 0)} replaced step(s) without a record")
         mc = ver.get("model_consistency")
         if mc:
             lines.append(f"     model: {mc['status']}: {mc['detail']}")
@@ -1329,11 +1498,11 @@ def _table(header: list[str], rows: list[list[Any]], cls: str = "") -> str:
 def _verify_html(ver: dict[str, Any]) -> str:
     if ver.get("error"):
         return f"<p class='bad'>verification could not run: {html.escape(str(ver['error']))}</p>"
-    parts = [_table(["model", "re-derived", "mismatches", "critical flips", "without plan", "errors",
-                     "pair set differs"],
-                    [[ver.get("model_source"), ver.get("checked"), len(ver.get("mismatches", [])),
-                      ver.get("critical"), ver.get("missing_plans"), len(ver.get("errors", [])),
-                      ver.get("pairs_differ", 0)]], "summary")]
+    parts = [_table(["model", "re-derived", "applied motions re-derived", "mismatches", "critical flips",
+                     "without plan", "errors", "pair set differs"],
+                    [[ver.get("model_source"), ver.get("checked"), ver.get("applied_checked", 0),
+                      len(ver.get("mismatches", [])), ver.get("critical"), ver.get("missing_plans"),
+                      len(ver.get("errors", [])), ver.get("pairs_differ", 0)]], "summary")]
     if ver.get("mismatches"):
         parts.append("<h4>Windows whose verdict changed</h4>" + _table(
             ["window", "sim time", "logged", "recomputed", "critical", "logged clearance", "clearance",

@@ -402,10 +402,11 @@ def test_max_penetration_makes_a_loose_rule_critical_in_library_and_cli(model, t
         review.verify(contents, max_penetration=-1.0)
 
 
-def test_review_says_how_many_applied_motions_are_not_in_the_log(tmp_path):
+def test_review_rederives_the_applied_motions_of_blocked_steps(tmp_path):
     """A blocked step whose applied motion is certified (the committed brake's tail, a certified
-    fallback) logs only its proposal: review says how many such motions it did not re-derive.
-    Oracle: the gate's own counters (replaced - fallback_uncertified)."""
+    fallback) names the record of that motion (h12ac; before, only its proposal was logged and
+    review said how many motions it did not re-derive: that note is now for older logs only,
+    tests/test_review_applied.py). Oracle: the gate's own counters."""
     import gymnasium as gym
 
     import monitor.envs  # noqa: F401  (registers the ids)
@@ -419,9 +420,8 @@ def test_review_says_how_many_applied_motions_are_not_in_the_log(tmp_path):
         env.step(env.action_space.sample())
     stats = dict(env.gate.stats)
     env.close()
-    unlogged = stats["replaced"] - stats["fallback_uncertified"]
-    assert unlogged > 0  # random actions on the Arm get blocked
+    assert stats["replaced"] - stats["fallback_uncertified"] > 0  # random actions on the Arm get blocked
     ver = review.verify(read_log(path))
     assert ver["critical"] == 0, _critical(ver)
-    assert any(n.startswith(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in "
-                            f"the log") for n in ver["notes"]), ver["notes"]
+    assert ver["applied_steps"] == stats["replaced"] and ver["applied_missing"] == 0
+    assert not any("ran a motion that is not in the log" in n for n in ver["notes"]), ver["notes"]

@@ -77,6 +77,14 @@ certificates answer (``{"id": int, "request": CertifyRequest.to_json() with wind
 written before the first certificate that names it; each certificate payload carries
 ``"request_id"``. Id 0 may instead be the ``monitor.run`` record's ``"request"`` (a gate logs its
 request at open): then no ``monitor.request`` record repeats it."""
+APPLIED_MOTIONS_KEY = "applied_motions"
+"""``monitor.run`` key a gate writes (value ``"logged"``) when every replaced action of its log names
+the record of the motion actually applied: the action payload's ``applied_window`` is the index of a
+window whose certificate payload has ``"applied": {"kind": "fallback" | "brake_tail", "covered_by": i}``
+(a certified or uncertified fallback: its own window, ``covered_by`` = itself; the committed brake:
+the braking tail's plan and certificate, written once per committed tail, ``covered_by`` = the
+accepted window certified with it). Logs without the key (older gates) log the applied motion only
+when it is not certified."""
 METADATA_JSON_KEYS = "_json_keys"
 """Metadata key (version 2) listing, comma-separated, the keys whose values are JSON text;
 every other value is a plain string stored as is (no JSON inside JSON)."""
@@ -104,7 +112,7 @@ def schema(topic: str) -> dict[str, Any]:
 
 __all__ = [
     "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
-    "FORMAT_VERSION", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
+    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",
 ]

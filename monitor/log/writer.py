@@ -342,6 +342,10 @@ class MonitorLog:
         ...     log.write_window(data.time, plan, cert)
     """
 
+    logs_applied_motions = True
+    """:meth:`write_window` takes ``applied_window=`` / ``applied=`` (a gate logs, for every replaced
+    action, the motion that ran: see :data:`monitor.log.topics.APPLIED_MOTIONS_KEY`)."""
+
     def __init__(self, path: str | os.PathLike[str] | None = None, *, model: Any = None,
                  metadata: dict[str, Any] | None = None, env_id: str | None = None, foxglove: bool = True,
                  model_source: Any = None, fsync: bool = False, index: bool = True) -> None:
@@ -520,7 +524,8 @@ class MonitorLog:
     def write_window(self, sim_time: float, plan: Any, certificate: Any, proposed_action: Any = None,
                      applied_action: Any = None, replaced: bool = False,
                      wall_time: float | None = None, episode: int | None = None,
-                     reason: str | None = None, request: Any = None) -> int:
+                     reason: str | None = None, request: Any = None, applied_window: int | None = None,
+                     applied: dict[str, Any] | None = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -543,6 +548,16 @@ class MonitorLog:
                 (a ``monitor.request`` metadata record); the certificate payload names it by
                 ``request_id``. Review re-derives the window with it. None and no
                 ``certificate.request``: no ``request_id`` (review then uses the run's).
+            applied_window: for a replaced action, the index of the window (this log) that holds
+                the motion actually applied (its plan and certificate: an ``applied`` record,
+                written by this call's successor or earlier for a committed braking tail);
+                stored in the action payload. Review checks that record's certificate covers
+                this window's span.
+            applied: marks this window as an *applied-motion record* (the motion a replaced step
+                ran, not a proposal): ``{"kind": "fallback" | "brake_tail", "covered_by": i}``
+                with ``i`` the index of the window whose certification covers it (a fallback:
+                this window itself; a committed braking tail: the accepted window it was
+                certified with, one step earlier). Stored in the certificate payload.
 
         Returns:
             The window index in this log.
@@ -573,12 +588,19 @@ class MonitorLog:
                                     f"got {cert.get('verdict')!r}")
         if plan is not None:
             plan_msg = _plan_payload(plan)  # validates before anything is written
+        if applied_window is not None and not _is_index(applied_window):
+            raise InvalidInputError(f"applied_window must be a window index (int >= 0), "
+                                    f"got {applied_window!r}")
+        if applied is not None:
+            applied = _applied_record(applied, self._index)
         if request is None:
             request = getattr(certificate, "request", None)
         rid = None if request is None else self._request_id(request)
         cert = _null_unknown(cert)
         if rid is not None:
             cert["request_id"] = rid
+        if applied is not None:
+            cert["applied"] = applied
         log_ns = max(_ns(wall), self._last_log_ns + 1)
         sim_ns = _ns(t)
         k = self._index
@@ -603,7 +625,8 @@ class MonitorLog:
                 "reason": str(reason) if replaced else None,
                 **head, "proposed": None if proposed_action is None else np.ravel(proposed_action),
                 "applied": None if applied_action is None else np.ravel(applied_action),
-                "replaced": bool(replaced)}))
+                "replaced": bool(replaced),
+                **({} if applied_window is None else {"applied_window": int(applied_window)})}))
         if cert["verdict"] != "certified" or replaced:
             level, text = log_line(k, self._episode, t, cert, reason if replaced else None)
             self._put(topics.LOG, log_ns, sim_ns, _dumps({
@@ -640,6 +663,25 @@ class MonitorLog:
 
 
 # --------------------------------------------------------------------------- helpers
+
+
+APPLIED_KINDS = ("fallback", "brake_tail")
+"""Kinds of applied-motion records (:meth:`MonitorLog.write_window` ``applied=``)."""
+
+
+def _is_index(x: Any) -> bool:
+    return isinstance(x, int | np.integer) and not isinstance(x, bool) and x >= 0
+
+
+def _applied_record(applied: Any, index: int) -> dict[str, Any]:
+    """The validated ``applied`` field of window ``index`` (see :meth:`MonitorLog.write_window`)."""
+    if not isinstance(applied, dict) or applied.get("kind") not in APPLIED_KINDS:
+        raise InvalidInputError(f"applied must be a dict with kind in {APPLIED_KINDS}, got {applied!r}")
+    by = applied.get("covered_by")
+    if not _is_index(by) or by > index:
+        raise InvalidInputError(f"applied['covered_by'] must be a window index <= {index} (this window), "
+                                f"got {by!r}")
+    return {**applied, "kind": str(applied["kind"]), "covered_by": int(by)}
 
 
 def _request_key(d: dict[str, Any]) -> str:
