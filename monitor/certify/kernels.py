@@ -1359,11 +1359,16 @@ def _tree_verified(traj, mp, key) -> bool:
     if getattr(probe._st, "key", None) != key[0]:
         return False    # the live model is no longer the one the plan was built on: no verdict to keep
     pm = pack_trajectory(probe)
-    ok = static_key(pm) == key[1] and _poses_match(probe, pm)
+    ok = static_key(pm, _pack_static(probe)) == key[1] and _poses_match(probe, pm)
     if len(_VERIFIED_TREES) >= _VERIFIED_TREES_MAX:
         _VERIFIED_TREES.pop(next(iter(_VERIFIED_TREES)))
     _VERIFIED_TREES[key] = ok
     return ok
+
+
+def _pack_static(traj):
+    """The packer's cached model part of ``traj``'s structure (a hint for ``static_key``), or None."""
+    return getattr(getattr(traj, "_st", None), "_motion_pack_static", None)
 
 
 def _pack_agrees(traj, mp) -> bool:
@@ -1417,7 +1422,7 @@ def _pack_agrees(traj, mp) -> bool:
     skey = getattr(st, "key", None)
     if skey is None or not hasattr(traj, "_quat_tracks"):
         return _poses_match(traj, mp)
-    key = (skey, static_key(mp))
+    key = (skey, static_key(mp, _pack_static(traj)))
     state = _VERIFIED_TREES.get(key)
     if not _tree_verified(traj, mp, key):
         return False
