@@ -1606,12 +1606,23 @@ def trajectory_pack(traj):
     place is replaced by a new object (``Plan.refreshed``, see ``engine._check_model``)
     before it gets here, so it gets its own pack.
     """
+    return trajectory_pack_memo(traj)[0]
+
+
+def trajectory_pack_memo(traj) -> tuple:
+    """(:func:`trajectory_pack` of ``traj``, a dict cached with it) or (None, None).
+
+    The dict lives as long as the cached pack (per trajectory object, weakly keyed) and is
+    empty at first: the engine keeps there what it derives from the (immutable) trajectory
+    alone, e.g. ``moving_bodies()``, so a window certified again costs no re-derivation.
+    Not cached (a fresh empty dict) for objects that cannot be weakly referenced.
+    """
     try:
         hit = _MOTION_PACKS.get(traj)
     except TypeError:          # not weak-referenceable / hashable: no cache
         hit = None
     if hit is not None:
-        return hit[0]
+        return hit if hit[0] is not None else (None, None)
     from monitor.errors import MonitorError
     from monitor.motion.pack import pack_trajectory
 
@@ -1621,11 +1632,12 @@ def trajectory_pack(traj):
             mp = None
     except (MonitorError, TypeError, AttributeError, ValueError):
         mp = None
+    entry = (mp, {})
     try:
-        _MOTION_PACKS[traj] = (mp,)
+        _MOTION_PACKS[traj] = entry
     except TypeError:
         pass
-    return mp
+    return entry if mp is not None else (None, None)
 
 
 WHOLE_SHAPE_MAX_TESTS = 4096
@@ -1688,4 +1700,4 @@ whole_shape_stage._compiled_stage = True  # the engine's window kernel runs this
 __all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MODE_FULL", "MODE_CERTIFY_ONLY",
            "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
            "check_pair_window", "whole_shape_stage", "window_kernel", "sphere_gap", "scene_pack",
-           "trajectory_pack"]
+           "trajectory_pack", "trajectory_pack_memo"]
