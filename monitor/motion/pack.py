@@ -364,11 +364,11 @@ def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
 
     ``st``: the :class:`_Static` the pack was probably built from (optional). When every
     static array of ``mp`` IS that tree's view (identity) and the pack's ``body_pos`` /
-    ``body_quat`` are the tree's or equal it outside the mocap rows, the bytes are read as
-    ONE ``st.tree.tobytes()`` (the same bytes as the field-by-field join: the views lie back
-    to back in that order, mocap rows zero): an in-place edit of the shared arrays changes
-    them like any other. Otherwise (another or a modified pack) field by field. Same key
-    either way.
+    ``body_quat`` are the tree's or equal it outside the mocap rows, the key is the one
+    computed field by field the last time ``st.tree`` held the same bytes (one
+    ``tree.tobytes()`` and one comparison: every static array is a view of ``tree``, so an
+    in-place edit of any of them is seen); otherwise (another or a modified pack, or a tree
+    whose bytes changed) it is computed field by field. Same key either way.
     """
     if st is not None and st.tree is not None:
         arrs = _get_static(mp)
@@ -394,9 +394,14 @@ def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
             memo = st.key_memo
             if memo[0] is not None and memo[0] == tree:
                 return memo[1]
-            key = tree + b"|" + repr(st.shapes).encode()
+            key = _field_key(mp)
             memo[0], memo[1] = tree, key
             return key
+    return _field_key(mp)
+
+
+def _field_key(mp: MotionPack) -> bytes:
+    """:func:`static_key` read field by field."""
     arrs = list(_get_static(mp))
     mocap = mp.body_mocap[1:] != 0
     if mocap.any():
