@@ -279,6 +279,8 @@ class _ModelStructure:
             self.chain_both_cols = np.concatenate([cc, cr])  # (2 nbody, nq): one product for both
         # Chains (virtual joints root -> body over the moving bodies) per moving pattern.
         self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
+        # (moving, rotating, chains) per pattern of changing qpos columns (_flags_and_chains).
+        self.flag_cache: dict[bytes, tuple] = {}
         self.ref = _ref_points(model)
         self.ref.setflags(write=False)
         self.ref_norm = float(np.max(np.linalg.norm(self.ref, axis=-1), initial=0.0))
@@ -385,6 +387,55 @@ def _structure(model: mujoco.MjModel) -> _ModelStructure:
         _LAST_STRUCT.pop(next(iter(_LAST_STRUCT)))
     _LAST_STRUCT[id(model)] = (model, st)  # the model reference keeps id(model) unique
     return st
+
+
+def _flags_and_chains(st: _ModelStructure, changes: np.ndarray) -> tuple:
+    """(moving, rotating, (chain_v, own_count)) of a plan whose changing qpos columns are ``changes``.
+
+    Which qpos columns change anywhere in the window, per body chain: a body moves (rotates)
+    when one of its own joints or of its ancestors' (up to the world or a mocap body, which is
+    a fixed frame) changes. Small trees: one product for both flags; else propagated one tree
+    depth at a time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
+    Chains (virtual joints root -> body over the moving bodies) are cached per moving pattern.
+    A pure function of the structure and ``changes`` (:meth:`Plan._setup` caches it per
+    ``changes`` in ``st.flag_cache``); the flag arrays are read-only (shared by plans).
+    """
+    nbody = st.nbody
+    parent = st.parent
+    if st.chain_cols is not None:  # small trees: one product for both (all False if nothing changes)
+        both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
+        moving, rotating = both[:nbody], both[nbody:]
+    else:
+        moving = np.zeros(nbody, dtype=bool)
+        rotating = np.zeros(nbody, dtype=bool)
+        if changes.any():
+            own_moving = (st.own_cols & changes).any(axis=1)
+            own_rot = (st.own_rot_cols & changes).any(axis=1)
+            for bodies, parents in st.levels:
+                moving[bodies] = own_moving[bodies] | moving[parents]
+                rotating[bodies] = own_rot[bodies] | rotating[parents]
+    moving.setflags(write=False)
+    rotating.setflags(write=False)
+    key = moving.tobytes()
+    chains = st.chains.get(key)
+    if chains is None:
+        own_v = st.own_v
+        chain_v: list[np.ndarray] = []
+        own_count: list[int] = []
+        for b in range(nbody):
+            chain: list[int] = []
+            c = b
+            while c != 0 and moving[c]:
+                chain = own_v[c] + chain
+                c = parent[c]
+            arr = np.array(chain, dtype=np.int64)
+            arr.setflags(write=False)
+            chain_v.append(arr)
+            own_count.append(len(own_v[b]) if moving[b] else 0)
+        chains = (chain_v, own_count)
+        if len(st.chains) < 64:
+            st.chains[key] = chains
+    return moving, rotating, chains
 
 
 class Plan(WindowTimes):
@@ -525,23 +576,13 @@ class Plan(WindowTimes):
         # mocap body, which is a fixed frame) changes. Propagated one tree depth at a
         # time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
         changes = (q != q[0]).any(axis=0)  # (nq,)
-        nbody = st.nbody
-        parent = st.parent
-        if st.chain_cols is not None:  # small trees: one product for both (all False if nothing changes)
-            both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
-            moving, rotating = both[:nbody], both[nbody:]
-        else:
-            moving = np.zeros(nbody, dtype=bool)
-            rotating = np.zeros(nbody, dtype=bool)
-            if changes.any():
-                own_moving = (st.own_cols & changes).any(axis=1)
-                own_rot = (st.own_rot_cols & changes).any(axis=1)
-                for bodies, parents in st.levels:
-                    moving[bodies] = own_moving[bodies] | moving[parents]
-                    rotating[bodies] = own_rot[bodies] | rotating[parents]
-        self._moving = moving
-        self._rotating = rotating
-        self._moving.setflags(write=False)
+        ckey = changes.tobytes()
+        hit = st.flag_cache.get(ckey)   # the flags and chains are a function of (structure, changes)
+        if hit is None:
+            hit = _flags_and_chains(st, changes)
+            if len(st.flag_cache) < 256:
+                st.flag_cache[ckey] = hit
+        self._moving, self._rotating, chains = hit
 
         # Virtual joints: one per hinge/slide/ball, two per free joint (translation
         # then rotation about the body origin). kind: 0 hinge, 1 slide, 2 ball,
@@ -549,25 +590,6 @@ class Plan(WindowTimes):
         # moving bodies only (a mocap or static ancestor is a constant frame).
         self._vkind = st.vkind
         self._first_v = st.first_v
-        key = moving.tobytes()
-        chains = st.chains.get(key)
-        if chains is None:
-            own_v = st.own_v
-            chain_v: list[np.ndarray] = []
-            own_count: list[int] = []
-            for b in range(nbody):
-                chain: list[int] = []
-                c = b
-                while c != 0 and moving[c]:
-                    chain = own_v[c] + chain
-                    c = parent[c]
-                arr = np.array(chain, dtype=np.int64)
-                arr.setflags(write=False)
-                chain_v.append(arr)
-                own_count.append(len(own_v[b]) if moving[b] else 0)
-            chains = (chain_v, own_count)
-            if len(st.chains) < 64:
-                st.chains[key] = chains
         self._chain_v, self._own_count = chains
 
         self._magnitude = {
