@@ -1424,7 +1424,7 @@ def _pack_agrees(traj, mp) -> bool:
         return _poses_match(traj, mp)
     key = (skey, static_key(mp, _pack_static(traj)))
     state = _VERIFIED_TREES.get(key)
-    if not _tree_verified(traj, mp, key):
+    if state is not True and not _tree_verified(traj, mp, key):   # True: verified (a dict hit)
         return False
     if not plan_data_agrees(traj, mp):
         return False

@@ -256,19 +256,20 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
               st.jnt_qposadr, moving, rotating, tol_arr)
     tol_arr[KN.TOL_QMAG] += st.qpos0_mag
     tol_arr[KN.TOL_PATHMAG] = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
-    mp = MotionPack(
-        times=times, qpos=qpos, qpos0=st.qpos0, jnt_type=st.jnt_type, jnt_qposadr=st.jnt_qposadr,
-        jnt_pos=st.jnt_pos, jnt_axis=st.jnt_axis, jnt_axis_norm=st.jnt_axis_norm, jnt_track=st.jnt_track,
-        body_parent=st.body_parent, body_jntadr=st.body_jntadr, body_jntnum=st.body_jntnum,
-        body_pos=body_pos, body_quat=body_quat, body_mocap=st.body_mocap, body_moving=moving,
-        body_rotating=rotating, ref_points=st.ref_points, qt_adr=st.qt_adr, qt_target=target,
-        qt_half=half, qt_phi=phi, qt_cum=cum, qt_same=same, tol=tol_arr)
+    # = MotionPack(times=..., ..., tol=tol_arr), positionally in field order (no keyword parsing)
+    mp = _new_pack(MotionPack, (
+        times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis, st.jnt_axis_norm,
+        st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos, body_quat, st.body_mocap,
+        moving, rotating, st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr))
     if moving.any():
         z = np.zeros(1)
         tol_arr[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
                                          np.empty((1, nbody, 3, 3)), np.empty((1, nbody)),
                                          np.empty((1, nbody)))  # the pack shares tol_arr
     return mp
+
+
+_new_pack = tuple.__new__
 
 
 def _pack_body_motion(bm: BodyMotion) -> MotionPack:
