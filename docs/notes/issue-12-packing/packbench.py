@@ -11,8 +11,8 @@ import time
 import gymnasium as gym
 import numpy as np
 
-import monitor.envs  # noqa: F401
 import monitor.certify.kernels as KS
+import monitor.envs  # noqa: F401
 from monitor.gym_gate import SafetyGate
 from monitor.motion.plan import Plan
 
@@ -25,6 +25,7 @@ orig = Plan._trusted.__func__
 
 
 def spy(cls, times, qpos, model, **k):
+    """Record the rows of every Plan the gate builds."""
     rec.append((times.copy(), qpos.copy(), model, {a: b.copy() for a, b in k.items() if a != "tolerances"}))
     return orig(cls, times, qpos, model, **k)
 
