@@ -156,7 +156,7 @@ class _Static(NamedTuple):
     shapes: tuple = ()
     """Shapes of the :data:`STATIC_FIELDS` arrays, in order (part of :func:`static_key`)."""
     key_memo: list | None = None
-    """[tree bytes, key] of the last :func:`static_key` computed from this tree (a cache)."""
+    """[(tree bytes, key)] of the last :func:`static_key` computed from this tree (a cache)."""
 
 
 def _tree_buffer(fields: list[tuple[np.ndarray, type]]) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -216,7 +216,7 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
     tree, views = _tree_buffer([fields[name] for name in STATIC_FIELDS])
     v = dict(zip(STATIC_FIELDS, views, strict=True))
     return _Static(**v, mocapid=mid, qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=mocap_rows,
-                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None, None])
+                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None])
 
 
 _NO_TRACKS: dict[int, tuple[np.ndarray, ...]] = {}
@@ -392,11 +392,11 @@ def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
                     break
         if same:
             tree = st.tree.tobytes()
-            memo = st.key_memo
-            if memo[0] is not None and memo[0] == tree:
-                return memo[1]
+            last = st.key_memo[0]       # (tree bytes, key), replaced as one object (threads)
+            if last is not None and last[0] == tree:
+                return last[1]
             key = _field_key(mp)
-            memo[0], memo[1] = tree, key
+            st.key_memo[0] = (tree, key)
             return key
     return _field_key(mp)
 
