@@ -760,6 +760,10 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     charged = info[KS.WI_TESTS]
     if charged:
         bud.charge(int(charged))
+    if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
+        return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
+                           margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
+                           allowed=allowed, sc=sc, sr=sr, KS=KS)
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -898,6 +902,29 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
                                 earliest, clearance, lazy, stats, allowed)
+
+
+def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
+                res: np.ndarray, info: np.ndarray, *, geoms: tuple, t0: float, t1: float, margin: float,
+                epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple, sc: np.ndarray,
+                sr: np.ndarray, KS: Any) -> Certificate:
+    """The certificate :func:`_certify_fast` builds when stage 0 culled every selected pair.
+
+    The same values as its general tail with no survivor (no stage runs, no result, nothing
+    unfinished): "certified", no witness or earliest time, clearance the best culled gap
+    (``info[WI_BEST]``, inf if none is finite), ``checker_mix == {"culled": P}``, 0 tests;
+    the pairs stay arrays (:class:`_WindowPairs`).
+    """
+    P = len(sel)
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], np.zeros(P, bool), {}, geoms, (t0, t1),
+                        sc, sr, info.item(KS.WI_PAD))
+    best_cull = info.item(KS.WI_BEST)
+    clearance = float(best_cull) if best_cull < float("inf") else float("inf")
+    stats = {"pairs": P, "pairs_culled": P, "tests": 0, "max_depth": 0,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": {"culled": P} if P else {},
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
+    return Certificate._trusted(Verdict.CERTIFIED, (t0, t1), margin, epsilon, _METHOD_OF[method], None, None,
+                                clearance, lazy, stats, allowed)
 
 
 _VERDICT_OF = {v.value: v for v in Verdict}
