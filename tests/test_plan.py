@@ -354,3 +354,86 @@ def test_sub_intervals_at_and_across_waypoints_one_ulp():
             dev = np.linalg.norm(world[1:] - world[0], axis=-1).max(axis=0)
             r = np.linalg.norm(pts - plan.ref_points[b], axis=-1)
             assert (dev <= mb.trans[i, b] + chord(mb.angle[i, b]) * r).all(), (cases[i], b)
+
+
+# -- Plan._trusted (the gate's constructor) and the vectorised quaternion normalisation -----------
+
+_QXML = """<mujoco><worldbody>
+<body name="a"><freejoint/><geom type="box" size=".1 .1 .1"/></body>
+<body name="b" pos="0 1 0"><joint name="ball" type="ball"/><geom type="sphere" size=".1"/>
+  <body name="c" pos=".3 0 0"><joint type="hinge" axis="0 1 1"/><joint type="slide" axis="1 0 0"/>
+    <geom type="capsule" size=".05 .2"/></body></body>
+<body name="m" mocap="true" pos="1 1 1"><geom type="sphere" size=".1"/></body>
+<body name="m2" mocap="true" pos="2 1 1"><geom type="sphere" size=".1"/></body>
+</worldbody></mujoco>"""
+
+
+def _quat_inputs(rng, K):
+    """Seeded waypoints of _QXML with quaternions off unit norm by up to 1e-9 (within tolerance)."""
+    t = np.cumsum(rng.uniform(0.01, 0.1, K))
+    q = rng.normal(size=(K, 13))
+    for a in (3, 7):
+        q[:, a:a + 4] /= np.linalg.norm(q[:, a:a + 4], axis=1, keepdims=True)
+        q[:, a:a + 4] *= 1.0 + rng.uniform(-1e-9, 1e-9, (K, 1))
+    mq = rng.normal(size=(2, 4))
+    mq /= np.linalg.norm(mq, axis=1, keepdims=True)
+    return t, q, rng.normal(size=(2, 3)), mq * (1.0 + 1e-10)
+
+
+def test_trusted_plans_equal_validating_ones_and_per_joint_normalisation():
+    """Oracle: the per-joint ``normalize_quats`` (the former loop) on the caller's arrays; both
+    constructors give the same bits for every quaternion, flag and magnitude."""
+    from monitor.motion import _kinematics as KM
+    from monitor.tolerances import DEFAULT
+
+    m = mujoco.MjModel.from_xml_string(_QXML)
+    rng = np.random.default_rng(12)
+    for trial in range(40):
+        t, q, mp, mq = _quat_inputs(rng, int(rng.integers(2, 8)))
+        if trial % 3 == 0:
+            q[:, 7:13] = q[0, 7:13]           # ball and hinge/slide held: only the free body moves
+        want = q.copy()
+        for a, label in ((3, "a"), (7, "b")):
+            want[:, a:a + 4] = KM.normalize_quats(label, q[:, a:a + 4], DEFAULT)
+        want_mq = KM.normalize_quats("mocap_quat", mq, DEFAULT)
+        p1 = Plan(t, q, m, mocap_pos=mp, mocap_quat=mq)
+        p2 = Plan._trusted(t.copy(), q.copy(), m, mocap_pos=mp.copy(), mocap_quat=mq.copy())
+        for p in (p1, p2):
+            assert p.qpos.tobytes() == want.tobytes()
+            assert p.mocap_quat.tobytes() == want_mq.tobytes()
+        assert p1._moving.tobytes() == p2._moving.tobytes()
+        assert p1._rotating.tobytes() == p2._rotating.tobytes()
+        assert p1._magnitude == p2._magnitude
+        assert p1._magnitude["q"] == float(np.abs(want).max()) + p1._st.qpos0_mag
+        for j, tr in p1._quat_tracks.items():
+            assert tr.cum.tobytes() == p2._quat_tracks[j].cum.tobytes()
+
+
+@pytest.mark.parametrize("bad", ["nan_q", "inf_q", "inf_t0", "inf_t1", "nan_t", "decreasing", "quat_norm",
+                                 "nan_mocap_pos", "nan_mocap_quat"])
+def test_trusted_refuses_what_the_validating_constructor_refuses(bad):
+    m = mujoco.MjModel.from_xml_string(_QXML)
+    t, q, mp, mq = _quat_inputs(np.random.default_rng(3), 4)
+    if bad == "nan_q":
+        q[2, 12] = np.nan
+    elif bad == "inf_q":
+        q[1, 0] = -np.inf
+    elif bad == "inf_t0":
+        t[0] = -np.inf
+    elif bad == "inf_t1":
+        t[-1] = np.inf
+    elif bad == "nan_t":
+        t[1] = np.nan
+    elif bad == "decreasing":
+        t[2] = t[0]
+    elif bad == "quat_norm":
+        q[2, 8] += 0.5
+    elif bad == "nan_mocap_pos":
+        mp[1, 0] = np.nan
+    else:
+        mq[0, 2] = np.nan
+    with pytest.raises(InvalidInputError) as want:
+        Plan(t, q, m, mocap_pos=mp, mocap_quat=mq)
+    with pytest.raises(InvalidInputError) as got:
+        Plan._trusted(t.copy(), q.copy(), m, mocap_pos=mp.copy(), mocap_quat=mq.copy())
+    assert str(got.value) == str(want.value)

@@ -547,14 +547,15 @@ _FAST_CHUNK = 4
 
 
 def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
-    """(ScenePack, MotionPack) for the compiled window path, or None (then the Python pipeline runs).
+    """(ScenePack, MotionPack, memo) for the compiled window path, or None (then the Python pipeline runs).
 
-    Both are cached (:func:`monitor.certify.kernels.scene_pack` per scene and geoms,
-    :func:`~monitor.certify.kernels.trajectory_pack` per trajectory object, checked once
-    against the trajectory's own poses).
+    Both packs are cached (:func:`monitor.certify.kernels.scene_pack` per scene and geoms,
+    :func:`~monitor.certify.kernels.trajectory_pack_memo` per trajectory object, checked once
+    against the trajectory's own poses); ``memo`` is the dict cached with the motion pack
+    (see :func:`_plan_inputs`).
     """
     KS = _kernels()
-    mp = KS.trajectory_pack(plan)
+    mp, memo = KS.trajectory_pack_memo(plan)
     if mp is None:
         return None
     hot = _hot(scene)
@@ -572,7 +573,7 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
             hot["scene_pack"] = (scene.geoms, scene.pair_ids, KS.scene_pack, sp)
     if int(plan.nbody) != mp.nbody:
         return None
-    return sp, mp
+    return sp, mp, memo
 
 
 _new = object.__new__
@@ -729,8 +730,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     """
     KS = _kernels()
 
-    sp, mp = fast
-    moving = np.asarray(plan.moving_bodies(), bool)
+    sp, mp, memo = fast
     P = len(sel)
     pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
     if pid.flags.writeable:
@@ -738,13 +738,11 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         # ONE specialisation (numba types the readonly flag: a second ~20 s compile otherwise)
         pid = pid.view()
         pid.flags.writeable = False
-    fixed, mov = _body_flags(scene, moving)
+    moving, fixed, mov, prm = _plan_inputs(scene, plan, memo, t0, t1, margin, epsilon, tol, KS)
     # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
     # every surviving pair takes the Python route, which calls the replacement
     narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
     route_all = narrow and method == "toleranced"
-    prm = np.array([t0, t1, margin, epsilon, tol.rel_pad, tol.abs_pad, tol.scale_pad, float(tol.max_depth),
-                    float(KS.WHOLE_SHAPE_MAX_TESTS)])
     code = np.empty(P, np.int64)
     gap = np.empty(P)
     surv = np.empty(P, np.int64)
@@ -762,6 +760,10 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     charged = info[KS.WI_TESTS]
     if charged:
         bud.charge(int(charged))
+    if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
+        return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
+                           margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
+                           allowed=allowed, sc=sc, sr=sr, KS=KS)
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -902,11 +904,68 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                                 earliest, clearance, lazy, stats, allowed)
 
 
+def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
+                res: np.ndarray, info: np.ndarray, *, geoms: tuple, t0: float, t1: float, margin: float,
+                epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple, sc: np.ndarray,
+                sr: np.ndarray, KS: Any) -> Certificate:
+    """The certificate :func:`_certify_fast` builds when stage 0 culled every selected pair.
+
+    The same values as its general tail with no survivor (no stage runs, no result, nothing
+    unfinished): "certified", no witness or earliest time, clearance the best culled gap
+    (``info[WI_BEST]``, inf if none is finite), ``checker_mix == {"culled": P}``, 0 tests;
+    the pairs stay arrays (:class:`_WindowPairs`).
+    """
+    P = len(sel)
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], np.zeros(P, bool), {}, geoms, (t0, t1),
+                        sc, sr, info.item(KS.WI_PAD))
+    best_cull = info.item(KS.WI_BEST)
+    clearance = float(best_cull) if best_cull < float("inf") else float("inf")
+    stats = {"pairs": P, "pairs_culled": P, "tests": 0, "max_depth": 0,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": {"culled": P} if P else {},
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
+    return Certificate._trusted(Verdict.CERTIFIED, (t0, t1), margin, epsilon, _METHOD_OF[method], None, None,
+                                clearance, lazy, stats, allowed)
+
+
 _VERDICT_OF = {v.value: v for v in Verdict}
 _METHOD_OF = {m.value: m for m in Method}
 """Verdict / Method member of a validated string (a member is its own key: StrEnum hashes as its value)."""
 _NONE = np.zeros(0, np.int64)
 """The empty ``route`` of a window_kernel call (nothing is ever written to it)."""
+
+
+def _plan_inputs(scene: Any, plan: Any, memo: dict, t0: float, t1: float, margin: float, epsilon: float,
+                 tol: Tolerances, KS: Any) -> tuple:
+    """(moving (nbody,) bool, fixed, mov, prm): the window kernel's inputs derived from the plan.
+
+    Kept in ``memo``, the dict cached with the plan's motion pack (per trajectory object:
+    a Plan / BodyMotion never changes after construction, so ``moving_bodies()`` is
+    computed once), the kernel flags held with the ``scene.body_static`` array they were
+    made from (``Scene.sync`` replaces it, never edits it; :func:`_body_flags`; only for a
+    :class:`monitor.Scene`), and ``prm`` with the exact
+    values and the :class:`Tolerances` object it was built from. The kernel only reads
+    ``fixed``, ``mov`` and ``prm``; ``moving`` is read-only.
+    """
+    hit = memo.get("moving")
+    if hit is None:
+        hit = memo["moving"] = np.asarray(plan.moving_bodies(), bool).copy()
+        hit.setflags(write=False)
+    moving = hit
+    static = scene.body_static
+    fl = memo.get("flags")
+    if fl is None or fl[0] is not static:
+        fixed, mov = _body_flags(scene, moving)
+        fl = (static, fixed, mov)
+        if _hot(scene) is not None:   # a Scene (sync replaces body_static); duck-typed scenes: per call
+            memo["flags"] = fl
+    pr = memo.get("prm")
+    if (pr is None or pr[0] != t0 or pr[1] != t1 or pr[2] != margin or pr[3] != epsilon or pr[4] is not tol
+            or (t0 == 0.0 and math.copysign(1.0, t0) != math.copysign(1.0, pr[0]))    # -0.0 == 0.0
+            or (margin == 0.0 and math.copysign(1.0, margin) != math.copysign(1.0, pr[2]))):
+        prm = np.array([t0, t1, margin, epsilon, tol.rel_pad, tol.abs_pad, tol.scale_pad,
+                        float(tol.max_depth), float(KS.WHOLE_SHAPE_MAX_TESTS)])
+        memo["prm"] = pr = (t0, t1, margin, epsilon, tol, prm)
+    return moving, fl[1], fl[2], pr[5]
 
 
 def _body_flags(scene: Any, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

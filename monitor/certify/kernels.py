@@ -1359,11 +1359,16 @@ def _tree_verified(traj, mp, key) -> bool:
     if getattr(probe._st, "key", None) != key[0]:
         return False    # the live model is no longer the one the plan was built on: no verdict to keep
     pm = pack_trajectory(probe)
-    ok = static_key(pm) == key[1] and _poses_match(probe, pm)
+    ok = static_key(pm, _pack_static(probe)) == key[1] and _poses_match(probe, pm)
     if len(_VERIFIED_TREES) >= _VERIFIED_TREES_MAX:
         _VERIFIED_TREES.pop(next(iter(_VERIFIED_TREES)))
     _VERIFIED_TREES[key] = ok
     return ok
+
+
+def _pack_static(traj):
+    """The packer's cached model part of ``traj``'s structure (a hint for ``static_key``), or None."""
+    return getattr(getattr(traj, "_st", None), "_motion_pack_static", None)
 
 
 def _pack_agrees(traj, mp) -> bool:
@@ -1417,9 +1422,9 @@ def _pack_agrees(traj, mp) -> bool:
     skey = getattr(st, "key", None)
     if skey is None or not hasattr(traj, "_quat_tracks"):
         return _poses_match(traj, mp)
-    key = (skey, static_key(mp))
+    key = (skey, static_key(mp, _pack_static(traj)))
     state = _VERIFIED_TREES.get(key)
-    if not _tree_verified(traj, mp, key):
+    if state is not True and not _tree_verified(traj, mp, key):   # True: verified (a dict hit)
         return False
     if not plan_data_agrees(traj, mp):
         return False
@@ -1601,12 +1606,23 @@ def trajectory_pack(traj):
     place is replaced by a new object (``Plan.refreshed``, see ``engine._check_model``)
     before it gets here, so it gets its own pack.
     """
+    return trajectory_pack_memo(traj)[0]
+
+
+def trajectory_pack_memo(traj) -> tuple:
+    """(:func:`trajectory_pack` of ``traj``, a dict cached with it) or (None, None).
+
+    The dict lives as long as the cached pack (per trajectory object, weakly keyed) and is
+    empty at first: the engine keeps there what it derives from the (immutable) trajectory
+    alone, e.g. ``moving_bodies()``, so a window certified again costs no re-derivation.
+    Not cached (a fresh empty dict) for objects that cannot be weakly referenced.
+    """
     try:
         hit = _MOTION_PACKS.get(traj)
     except TypeError:          # not weak-referenceable / hashable: no cache
         hit = None
     if hit is not None:
-        return hit[0]
+        return hit if hit[0] is not None else (None, None)
     from monitor.errors import MonitorError
     from monitor.motion.pack import pack_trajectory
 
@@ -1616,11 +1632,12 @@ def trajectory_pack(traj):
             mp = None
     except (MonitorError, TypeError, AttributeError, ValueError):
         mp = None
+    entry = (mp, {})
     try:
-        _MOTION_PACKS[traj] = (mp,)
+        _MOTION_PACKS[traj] = entry
     except TypeError:
         pass
-    return mp
+    return entry if mp is not None else (None, None)
 
 
 WHOLE_SHAPE_MAX_TESTS = 4096
@@ -1683,4 +1700,4 @@ whole_shape_stage._compiled_stage = True  # the engine's window kernel runs this
 __all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MODE_FULL", "MODE_CERTIFY_ONLY",
            "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
            "check_pair_window", "whole_shape_stage", "window_kernel", "sphere_gap", "scene_pack",
-           "trajectory_pack"]
+           "trajectory_pack", "trajectory_pack_memo"]

@@ -113,8 +113,22 @@ def _i64(a: object) -> np.ndarray:
     return out
 
 
+STATIC_FIELDS = ("qpos0", "jnt_type", "jnt_qposadr", "jnt_pos", "jnt_axis", "jnt_axis_norm", "jnt_track",
+                 "body_parent", "body_jntadr", "body_jntnum", "body_pos", "body_quat", "body_mocap",
+                 "ref_points", "qt_adr")
+"""The :class:`MotionPack` fields that depend on the model alone (for a Plan; mocap rows of
+``body_pos`` / ``body_quat`` are the plan's held poses and are excluded by :func:`static_key`)."""
+
+
 class _Static(NamedTuple):
-    """The model-only part of a pack (shared by every pack of one model structure; never written)."""
+    """The model-only part of a pack (shared by every pack of one model structure; never written).
+
+    The :data:`STATIC_FIELDS` arrays are views, in that order and without gaps, of ONE float64
+    buffer ``tree`` (the int64 fields are int64 views of its bytes), so the bytes of the whole
+    kinematic tree are ``tree.tobytes()`` (:func:`static_key`). The rows of ``body_pos`` /
+    ``body_quat`` of mocap bodies (b >= 1) are zero in ``tree``: a pack holds the plan's
+    held mocap poses there (a copy of the two arrays).
+    """
 
     qpos0: np.ndarray
     jnt_type: np.ndarray
@@ -137,11 +151,31 @@ class _Static(NamedTuple):
     """(M,) bodies whose pack pose is the plan's held mocap pose (``mocapid >= 0``)."""
     quat_j: np.ndarray | None = None
     """(nqt,) ball / free joints, in track order."""
+    tree: np.ndarray | None = None
+    """(L,) float64: the buffer every :data:`STATIC_FIELDS` array is a view of (see above)."""
+    shapes: tuple = ()
+    """Shapes of the :data:`STATIC_FIELDS` arrays, in order (part of :func:`static_key`)."""
+    key_memo: list | None = None
+    """[(tree bytes, key)] of the last :func:`static_key` computed from this tree (a cache)."""
+
+
+def _tree_buffer(fields: list[tuple[np.ndarray, type]]) -> tuple[np.ndarray, list[np.ndarray]]:
+    """One float64 buffer holding ``fields`` back to back; each returned as a view of its dtype."""
+    n = sum(a.size for a, _ in fields)
+    tree = np.zeros(n, dtype=np.float64)
+    out, o = [], 0
+    for a, dt in fields:
+        v = tree[o:o + a.size].view(dt).reshape(a.shape)
+        v[...] = a
+        out.append(v)
+        o += a.size
+    return tree, out
 
 
 def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: object, jnt_axis: object,
             body_parent: object, body_jntadr: object, body_jntnum: object, body_pos: object,
-            body_quat: object, mocapid: object, ref_points: object, check_free: bool = True) -> _Static:
+            body_quat: object, mocapid: object, ref_points: object, check_free: bool = True,
+            world_identity: bool = False) -> _Static:
     jt = _i64(jnt_type)
     jadr = _i64(jnt_qposadr)
     jpos = _f64(np.array(jnt_pos, dtype=np.float64), (-1, 3))
@@ -164,14 +198,25 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
     body_mocap = (mid >= 0).astype(np.int64)
     body_mocap[0] = 1
     q0 = _f64(np.array(qpos0, dtype=np.float64))
-    return _Static(
-        qpos0=q0, jnt_type=jt, jnt_qposadr=jadr, jnt_pos=jpos, jnt_axis=jaxis,
-        jnt_axis_norm=_f64(axis_norm), jnt_track=jnt_track, body_parent=parent, body_jntadr=jntadr,
-        body_jntnum=jntnum, body_pos=_f64(np.array(body_pos, dtype=np.float64), (-1, 3)),
-        body_quat=_f64(np.array(body_quat, dtype=np.float64), (-1, 4)), body_mocap=body_mocap, mocapid=mid,
-        ref_points=_f64(np.array(ref_points, dtype=np.float64), (-1, 3)),
-        qt_adr=_i64(jadr[quat_j] + np.where(jt[quat_j] == _FREE, 3, 0)),
-        qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=np.flatnonzero(mid >= 0), quat_j=quat_j)
+    bpos = _f64(np.array(body_pos, dtype=np.float64), (-1, 3))
+    bquat = _f64(np.array(body_quat, dtype=np.float64), (-1, 4))
+    if world_identity:      # MuJoCo's world body sits at the origin with identity orientation
+        bpos[0] = 0.0
+        bquat[0] = (1.0, 0.0, 0.0, 0.0)
+    mocap_rows = np.flatnonzero(mid[1:] >= 0) + 1
+    bpos[mocap_rows] = 0.0        # a pack holds the plan's mocap poses in these rows (static_key zeroes them)
+    bquat[mocap_rows] = 0.0
+    f, i = np.float64, np.int64
+    fields = dict(qpos0=(q0, f), jnt_type=(jt, i), jnt_qposadr=(jadr, i), jnt_pos=(jpos, f),
+                  jnt_axis=(jaxis, f), jnt_axis_norm=(_f64(axis_norm), f), jnt_track=(jnt_track, i),
+                  body_parent=(parent, i), body_jntadr=(jntadr, i), body_jntnum=(jntnum, i),
+                  body_pos=(bpos, f), body_quat=(bquat, f), body_mocap=(body_mocap, i),
+                  ref_points=(_f64(np.array(ref_points, dtype=np.float64), (-1, 3)), f),
+                  qt_adr=(_i64(jadr[quat_j] + np.where(jt[quat_j] == _FREE, 3, 0)), i))
+    tree, views = _tree_buffer([fields[name] for name in STATIC_FIELDS])
+    v = dict(zip(STATIC_FIELDS, views, strict=True))
+    return _Static(**v, mocapid=mid, qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=mocap_rows,
+                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None])
 
 
 _NO_TRACKS: dict[int, tuple[np.ndarray, ...]] = {}
@@ -211,19 +256,20 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
               st.jnt_qposadr, moving, rotating, tol_arr)
     tol_arr[KN.TOL_QMAG] += st.qpos0_mag
     tol_arr[KN.TOL_PATHMAG] = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
-    mp = MotionPack(
-        times=times, qpos=qpos, qpos0=st.qpos0, jnt_type=st.jnt_type, jnt_qposadr=st.jnt_qposadr,
-        jnt_pos=st.jnt_pos, jnt_axis=st.jnt_axis, jnt_axis_norm=st.jnt_axis_norm, jnt_track=st.jnt_track,
-        body_parent=st.body_parent, body_jntadr=st.body_jntadr, body_jntnum=st.body_jntnum,
-        body_pos=body_pos, body_quat=body_quat, body_mocap=st.body_mocap, body_moving=moving,
-        body_rotating=rotating, ref_points=st.ref_points, qt_adr=st.qt_adr, qt_target=target,
-        qt_half=half, qt_phi=phi, qt_cum=cum, qt_same=same, tol=tol_arr)
+    # = MotionPack(times=..., ..., tol=tol_arr), positionally in field order (no keyword parsing)
+    mp = _new_pack(MotionPack, (
+        times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis, st.jnt_axis_norm,
+        st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos, body_quat, st.body_mocap,
+        moving, rotating, st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr))
     if moving.any():
         z = np.zeros(1)
         tol_arr[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
                                          np.empty((1, nbody, 3, 3)), np.empty((1, nbody)),
                                          np.empty((1, nbody)))  # the pack shares tol_arr
     return mp
+
+
+_new_pack = tuple.__new__
 
 
 def _pack_body_motion(bm: BodyMotion) -> MotionPack:
@@ -273,24 +319,16 @@ def _plan_static(plan: object) -> _Static:
             jntadr = [js[0] if js else 0 for js in st.jnt_of_body]
             out = _static(jnt["qpos0"], jnt["type"], jnt["adr"], jnt["pos"], jnt["axis"], st.parent, jntadr,
                           [len(js) for js in st.jnt_of_body], st.body_pos, st.body_quat,
-                          plan.model.body_mocapid, st.ref)
+                          plan.model.body_mocapid, st.ref, world_identity=True)
         except (AttributeError, KeyError, TypeError):
             out = None
         if out is not None:
-            _world_identity(out)
             st._motion_pack_static = out
             return out
     m = plan.model
-    out = _static(m.qpos0, m.jnt_type, m.jnt_qposadr, m.jnt_pos, m.jnt_axis, m.body_parentid, m.body_jntadr,
-                  m.body_jntnum, m.body_pos, m.body_quat, m.body_mocapid, plan.ref_points)
-    _world_identity(out)
-    return out
-
-
-def _world_identity(st: _Static) -> None:
-    """MuJoCo's world body sits at the origin with identity orientation."""
-    st.body_pos[0] = 0.0
-    st.body_quat[0] = (1.0, 0.0, 0.0, 0.0)
+    return _static(m.qpos0, m.jnt_type, m.jnt_qposadr, m.jnt_pos, m.jnt_axis, m.body_parentid, m.body_jntadr,
+                   m.body_jntnum, m.body_pos, m.body_quat, m.body_mocapid, plan.ref_points,
+                   world_identity=True)
 
 
 def _pack_plan(plan: object) -> MotionPack:
@@ -313,37 +351,69 @@ def _pack_plan(plan: object) -> MotionPack:
                    getattr(plan, "_tol", DEFAULT))
 
 
-STATIC_FIELDS = ("qpos0", "jnt_type", "jnt_qposadr", "jnt_pos", "jnt_axis", "jnt_axis_norm", "jnt_track",
-                 "body_parent", "body_jntadr", "body_jntnum", "body_pos", "body_quat", "body_mocap",
-                 "ref_points", "qt_adr")
-"""The :class:`MotionPack` fields that depend on the model alone (for a Plan; mocap rows of
-``body_pos`` / ``body_quat`` are the plan's held poses and are excluded by :func:`static_key`)."""
+_get_static = operator.attrgetter(*STATIC_FIELDS)
 
 
-_KEY_PLAIN = tuple(f for f in STATIC_FIELDS if f not in ("body_pos", "body_quat"))
-_get_plain = operator.attrgetter(*_KEY_PLAIN)
-
-
-def static_key(mp: MotionPack) -> tuple:
+def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
     """The model-only part of a pack (its kinematic tree) as a hashable key, mocap pose rows zeroed.
 
-    (bytes of every :data:`STATIC_FIELDS` array, their shapes). Two packs with equal keys
-    compute the same forward kinematics for the same joint positions and mocap poses (the
-    compiled FK reads nothing else of the model). The world's row (body 0) is kept.
+    The bytes of every :data:`STATIC_FIELDS` array of ``mp``, back to back in that order (the
+    rows of ``body_pos`` / ``body_quat`` of mocap bodies b >= 1 zeroed), then the arrays'
+    shapes. Two packs with equal keys compute the same forward kinematics for the same joint
+    positions and mocap poses (the compiled FK reads nothing else of the model). The world's
+    row (body 0) is kept.
+
+    ``st``: the :class:`_Static` the pack was probably built from (optional). When every
+    static array of ``mp`` IS that tree's view (identity) and the pack's ``body_pos`` /
+    ``body_quat`` are the tree's or equal it outside the mocap rows, the key is the one
+    computed field by field the last time ``st.tree`` held the same bytes (one
+    ``tree.tobytes()`` and one comparison: every static array is a view of ``tree``, so an
+    in-place edit of any of them is seen); otherwise (another or a modified pack, or a tree
+    whose bytes changed) it is computed field by field. Same key either way.
     """
-    arrs = _get_plain(mp)
-    parts = [a.tobytes() for a in arrs]
-    bp, bq = mp.body_pos, mp.body_quat
+    if st is not None and st.tree is not None:
+        arrs = _get_static(mp)
+        mine = _get_static(st)
+        same = True
+        for k in () if all(map(operator.is_, arrs, mine)) else range(len(arrs)):
+            if arrs[k] is not mine[k]:
+                if k not in _POSE_IDX:
+                    same = False
+                    break
+                a, b = arrs[k], mine[k]
+                if a.shape != b.shape or a.dtype != b.dtype:
+                    same = False
+                    break
+                if st.mocap_rows.size:      # mocap rows are >= 1 (the world has no mocap id)
+                    a = a.copy()
+                    a[st.mocap_rows] = 0.0
+                if a.tobytes() != b.tobytes():
+                    same = False
+                    break
+        if same:
+            tree = st.tree.tobytes()
+            last = st.key_memo[0]       # (tree bytes, key), replaced as one object (threads)
+            if last is not None and last[0] == tree:
+                return last[1]
+            key = _field_key(mp)
+            st.key_memo[0] = (tree, key)
+            return key
+    return _field_key(mp)
+
+
+def _field_key(mp: MotionPack) -> bytes:
+    """:func:`static_key` read field by field."""
+    arrs = list(_get_static(mp))
     mocap = mp.body_mocap[1:] != 0
     if mocap.any():
         rows = np.flatnonzero(mocap) + 1
-        bp = bp.copy()
-        bq = bq.copy()
-        bp[rows] = 0.0
-        bq[rows] = 0.0
-    parts.append(bp.tobytes())
-    parts.append(bq.tobytes())
-    return b"|".join(parts), tuple([a.shape for a in arrs]), bp.shape, bq.shape
+        for k in _POSE_IDX:
+            arrs[k] = arrs[k].copy()
+            arrs[k][rows] = 0.0
+    return b"".join([a.tobytes() for a in arrs]) + b"|" + repr(tuple([a.shape for a in arrs])).encode()
+
+
+_POSE_IDX = (STATIC_FIELDS.index("body_pos"), STATIC_FIELDS.index("body_quat"))
 
 
 def probe_plan(plan: object, seed: int = 0, n: int = 4) -> object:
@@ -382,7 +452,8 @@ def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
     angles, cumulative path, same-flags: the plan's own ``QuatTrack`` objects, in joint
     order); the held mocap poses in the mocap rows of ``body_pos`` / ``body_quat``; and the
     moving / rotating flags against the plan's own (derived independently by ``Plan._setup``
-    and by the compiled ``derive``). A few microseconds for a small tree.
+    and by the compiled ``derive``). Each is one comparison of raw bytes (and shapes), the
+    tracks' arrays joined in joint order. A few microseconds for a small tree.
     """
     st = plan._st
     if not (mp.times.tobytes() == plan.times.tobytes() and mp.qpos.shape == plan.qpos.shape
@@ -391,21 +462,28 @@ def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
     if not ((mp.body_moving != 0).tobytes() == plan._moving.tobytes()
             and (mp.body_rotating != 0).tobytes() == plan._rotating.tobytes()):
         return False
-    if mp.qt_adr.shape[0] != len(st.quat_joints):
+    qj = st.quat_joints
+    if mp.qt_adr.tolist() != [a for _, a, _ in qj]:
         return False
-    if st.quat_joints:
-        tracks = plan._quat_tracks
-        for k, (j, a, _) in enumerate(st.quat_joints):
-            tr = tracks[j]
-            if not (int(mp.qt_adr[k]) == a and np.array_equal(mp.qt_target[k], tr.target)
-                    and np.array_equal(mp.qt_half[k], tr.half) and np.array_equal(mp.qt_phi[k], tr.phi)
-                    and np.array_equal(mp.qt_cum[k], tr.cum) and np.array_equal(mp.qt_same[k] != 0, tr.same)):
-                return False
+    if qj:
+        K = plan.times.shape[0]
+        n = len(qj)
+        if not (mp.qt_target.shape == (n, K - 1, 4) and mp.qt_half.shape == (n, K - 1)
+                and mp.qt_phi.shape == (n, K - 1) and mp.qt_cum.shape == (n, K)
+                and mp.qt_same.shape == (n, K - 1)):
+            return False
+        tracks = [plan._quat_tracks[j] for j, _, _ in qj]
+        join = b"".join
+        if not (mp.qt_target.tobytes() == join([tr.target.tobytes() for tr in tracks])
+                and mp.qt_half.tobytes() == join([tr.half.tobytes() for tr in tracks])
+                and mp.qt_phi.tobytes() == join([tr.phi.tobytes() for tr in tracks])
+                and mp.qt_cum.tobytes() == join([tr.cum.tobytes() for tr in tracks])
+                and (mp.qt_same != 0).tobytes() == join([tr.same.tobytes() for tr in tracks])):
+            return False
     if st.nmocap:
-        mocap = [b for b in range(1, st.nbody) if st.mocap[b]]
-        mid = np.asarray(plan.model.body_mocapid)[mocap]
-        if not (np.array_equal(mp.body_pos[mocap], plan._mocap_pos[mid])
-                and np.array_equal(mp.body_quat[mocap], plan._mocap_quat[mid])):
+        rows, mid = st.mocap_rows, st.mocap_ids   # the structure's own (its key holds body_mocapid)
+        if not (mp.body_pos[rows].tobytes() == plan._mocap_pos[mid].tobytes()
+                and mp.body_quat[rows].tobytes() == plan._mocap_quat[mid].tobytes()):
             return False
     return True
 

@@ -110,6 +110,7 @@ has no geoms.
 
 from __future__ import annotations
 
+import math
 import threading
 
 import mujoco
@@ -177,6 +178,9 @@ class _ModelStructure:
         mocap_bodies = mocap_bodies[np.argsort(np.asarray(model.body_mocapid)[mocap_bodies])]
         self.mocap_pos0 = np.array(model.body_pos[mocap_bodies], dtype=np.float64).reshape(self.nmocap, 3)
         self.mocap_quat0 = np.array(model.body_quat[mocap_bodies], dtype=np.float64).reshape(self.nmocap, 4)
+        # (M,) mocap bodies b >= 1 in body order and their mocap ids (the pack check's rows)
+        self.mocap_rows = np.flatnonzero(np.asarray(model.body_mocapid)[1:] >= 0) + 1
+        self.mocap_ids = np.array(model.body_mocapid, dtype=np.int64)[self.mocap_rows]
         # (joint, first quaternion column, label) of every ball / free joint.
         self.quat_joints: list[tuple[int, int, str]] = []
         for j in range(model.njnt):
@@ -187,6 +191,8 @@ class _ModelStructure:
         lin = np.ones(model.nq, dtype=bool)
         for _, a, _ in self.quat_joints:
             lin[a:a + 4] = False
+        # (4 * nquat,) qpos columns of every ball / free quaternion, joint by joint
+        self.quat_cols = np.array([a + c for _, a, _ in self.quat_joints for c in range(4)], dtype=np.int64)
         self.lin = lin
         self.parent = [int(x) for x in model.body_parentid]
         self.mocap = [int(x) >= 0 for x in model.body_mocapid]
@@ -273,11 +279,13 @@ class _ModelStructure:
             self.chain_both_cols = np.concatenate([cc, cr])  # (2 nbody, nq): one product for both
         # Chains (virtual joints root -> body over the moving bodies) per moving pattern.
         self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
+        # (moving, rotating, chains) per pattern of changing qpos columns (_flags_and_chains).
+        self.flag_cache: dict[bytes, tuple] = {}
         self.ref = _ref_points(model)
         self.ref.setflags(write=False)
         self.ref_norm = float(np.max(np.linalg.norm(self.ref, axis=-1), initial=0.0))
-        for arr in (self.mocap_pos0, self.mocap_quat0, self.lin, self.body_pos, self.body_quat,
-                    self.body_mat, self.vkind, *self.jnt.values()):
+        for arr in (self.mocap_pos0, self.mocap_quat0, self.mocap_rows, self.mocap_ids, self.quat_cols,
+                    self.lin, self.body_pos, self.body_quat, self.body_mat, self.vkind, *self.jnt.values()):
             if isinstance(arr, np.ndarray):
                 arr.setflags(write=False)
 
@@ -309,13 +317,17 @@ def _structure_key(model: mujoco.MjModel) -> bytes:
     """Bytes of every model array :class:`_ModelStructure` reads (its cache key).
 
     Read through the cached views of :func:`_field_views` (the same buffers as
-    ``getattr(model, field)``, without building 16 new views per plan).
+    ``getattr(model, field)``, without building 16 new views per plan); the sizes'
+    prefix is cached with them (an MjModel's sizes never change).
     """
-    sizes = (model.nq, model.nv, model.njnt, model.nbody, model.nmocap, model.ngeom)
-    return b"|".join([repr(sizes).encode()] + [v.tobytes() for v in _field_views(model)])
+    hit = _VIEWS.get(id(model))
+    if hit is None or hit[0] is not model:
+        _field_views(model)
+        hit = _VIEWS[id(model)]
+    return b"|".join([hit[2]] + [v.tobytes() for v in hit[1]])
 
 
-_VIEWS: dict[int, tuple[mujoco.MjModel, list[np.ndarray]]] = {}
+_VIEWS: dict[int, tuple[mujoco.MjModel, list[np.ndarray], bytes]] = {}
 _VIEWS_MAX = 16
 
 
@@ -330,13 +342,39 @@ def _field_views(model: mujoco.MjModel) -> list[np.ndarray]:
     if len(_VIEWS) >= _VIEWS_MAX:
         _VIEWS.pop(next(iter(_VIEWS)))
     views = [getattr(model, f) for f in _STRUCT_FIELDS]
-    _VIEWS[id(model)] = (model, views)  # the model reference keeps id(model) unique
+    sizes = (model.nq, model.nv, model.njnt, model.nbody, model.nmocap, model.ngeom)
+    _VIEWS[id(model)] = (model, views, repr(sizes).encode())  # the model reference keeps id(model) unique
     return views
 
 
+def _normalized(q: np.ndarray, tol: Tolerances) -> np.ndarray | None:
+    """``q / |q|`` for quaternions (..., 4) whose norms are all within ``tol.quat_norm_tol`` of 1, else None.
+
+    The same arithmetic as :func:`monitor.motion._kinematics.normalize_quats` (``np.linalg.norm``
+    of a real vector is ``sqrt(add.reduce(x * x))``), so the same bits; None (also for a NaN)
+    sends the caller to ``normalize_quats``, which raises with the message naming the index.
+    """
+    n = np.sqrt(np.add.reduce(q * q, axis=-1))
+    if not (np.abs(n - 1.0) <= tol.quat_norm_tol).all():
+        return None
+    return q / n[..., None]
+
+
+_LAST_STRUCT: dict[int, tuple[mujoco.MjModel, _ModelStructure]] = {}
+"""Per model object, the structure :func:`_structure` returned last (a hint: checked by its key)."""
+
+
 def _structure(model: mujoco.MjModel) -> _ModelStructure:
-    """The (cached) :class:`_ModelStructure` of ``model``'s current arrays."""
+    """The (cached) :class:`_ModelStructure` of ``model``'s current arrays.
+
+    The key is built from the model's bytes on every call; the structure returned last for
+    this model object is taken when its key is equal (one bytes comparison instead of
+    hashing the key for the cache lookup), else the cache decides as before.
+    """
     key = _structure_key(model)
+    last = _LAST_STRUCT.get(id(model))
+    if last is not None and last[0] is model and last[1].key == key:
+        return last[1]
     st = _STRUCT_CACHE.get(key)
     if st is None:
         st = _ModelStructure(model)
@@ -345,7 +383,59 @@ def _structure(model: mujoco.MjModel) -> _ModelStructure:
         if len(_STRUCT_CACHE) >= _STRUCT_CACHE_MAX:
             _STRUCT_CACHE.pop(next(iter(_STRUCT_CACHE)))
         _STRUCT_CACHE[key] = st
+    if len(_LAST_STRUCT) >= _VIEWS_MAX and id(model) not in _LAST_STRUCT:
+        _LAST_STRUCT.pop(next(iter(_LAST_STRUCT)))
+    _LAST_STRUCT[id(model)] = (model, st)  # the model reference keeps id(model) unique
     return st
+
+
+def _flags_and_chains(st: _ModelStructure, changes: np.ndarray) -> tuple:
+    """(moving, rotating, (chain_v, own_count)) of a plan whose changing qpos columns are ``changes``.
+
+    Which qpos columns change anywhere in the window, per body chain: a body moves (rotates)
+    when one of its own joints or of its ancestors' (up to the world or a mocap body, which is
+    a fixed frame) changes. Small trees: one product for both flags; else propagated one tree
+    depth at a time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
+    Chains (virtual joints root -> body over the moving bodies) are cached per moving pattern.
+    A pure function of the structure and ``changes`` (:meth:`Plan._setup` caches it per
+    ``changes`` in ``st.flag_cache``); the flag arrays are read-only (shared by plans).
+    """
+    nbody = st.nbody
+    parent = st.parent
+    if st.chain_cols is not None:  # small trees: one product for both (all False if nothing changes)
+        both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
+        moving, rotating = both[:nbody], both[nbody:]
+    else:
+        moving = np.zeros(nbody, dtype=bool)
+        rotating = np.zeros(nbody, dtype=bool)
+        if changes.any():
+            own_moving = (st.own_cols & changes).any(axis=1)
+            own_rot = (st.own_rot_cols & changes).any(axis=1)
+            for bodies, parents in st.levels:
+                moving[bodies] = own_moving[bodies] | moving[parents]
+                rotating[bodies] = own_rot[bodies] | rotating[parents]
+    moving.setflags(write=False)
+    rotating.setflags(write=False)
+    key = moving.tobytes()
+    chains = st.chains.get(key)
+    if chains is None:
+        own_v = st.own_v
+        chain_v: list[np.ndarray] = []
+        own_count: list[int] = []
+        for b in range(nbody):
+            chain: list[int] = []
+            c = b
+            while c != 0 and moving[c]:
+                chain = own_v[c] + chain
+                c = parent[c]
+            arr = np.array(chain, dtype=np.int64)
+            arr.setflags(write=False)
+            chain_v.append(arr)
+            own_count.append(len(own_v[b]) if moving[b] else 0)
+        chains = (chain_v, own_count)
+        if len(st.chains) < 64:
+            st.chains[key] = chains
+    return moving, rotating, chains
 
 
 class Plan(WindowTimes):
@@ -422,30 +512,48 @@ class Plan(WindowTimes):
         self = cls.__new__(cls)
         if times.shape[0] < 2:
             raise InvalidInputError(f"a plan needs at least 2 waypoints, got {times.shape[0]}")
-        if not (np.isfinite(times).all() and (times[1:] > times[:-1]).all()):
+        # strictly increasing with finite ends <=> finite and strictly increasing (NaN fails '>')
+        if not ((times[1:] > times[:-1]).all() and -math.inf < times[0] and times[-1] < math.inf):
             K.check_times(times)  # raises with the precise message
-        K.check_finite("qpos", qpos)
-        if mocap_pos.size:
+        qabs = float(np.abs(qpos).max(initial=0.0))   # NaN / inf -> not < inf (max propagates NaN)
+        if not qabs < math.inf:
+            K.check_finite("qpos", qpos)
+        if mocap_pos.size and not (np.isfinite(mocap_pos).all() and np.isfinite(mocap_quat).all()):
             K.check_finite("mocap_pos", mocap_pos)
             K.check_finite("mocap_quat", mocap_quat)
-        self._setup(model, st, times, qpos, mocap_pos, mocap_quat, tolerances)
+        self._setup(model, st, times, qpos, mocap_pos, mocap_quat, tolerances, qabs)
         return self
 
     def _setup(self, model: mujoco.MjModel, st: _ModelStructure, t: np.ndarray, q: np.ndarray,
-               mp: np.ndarray, mq: np.ndarray, tolerances: Tolerances) -> None:
-        """Shared tail of the constructors: validated, owned float64 arrays in."""
+               mp: np.ndarray, mq: np.ndarray, tolerances: Tolerances, qabs: float | None = None) -> None:
+        """Shared tail of the constructors: validated, owned float64 arrays in.
+
+        ``qabs``: ``max |q|`` of the given ``q`` when the caller has it (used only when no
+        quaternion is normalised here, i.e. ``q`` is not changed).
+        """
         self._model = model
         self._tol = tolerances
         self._st = st
         if mq.size:  # (0, 4) when the model has no mocap body: nothing to normalise
-            mq = K.normalize_quats("mocap_quat", mq, tolerances)
+            n = _normalized(mq, tolerances)
+            mq = K.normalize_quats("mocap_quat", mq, tolerances) if n is None else n
 
         # Joint structure.
         self._quat_tracks: dict[int, K.QuatTrack] = {}
-        for _, a, label in st.quat_joints:
-            q[:, a:a + 4] = K.normalize_quats(label, q[:, a:a + 4], tolerances)
-        for j, a, _ in st.quat_joints:
-            self._quat_tracks[j] = K.QuatTrack(q[:, a:a + 4])
+        if st.quat_joints:
+            # every ball / free quaternion at once (the same arithmetic per quaternion as
+            # normalize_quats); a norm out of tolerance: per joint, for the message naming it
+            cols = st.quat_cols
+            Kq = q.shape[0]
+            n = _normalized(q[:, cols].reshape(Kq, -1, 4), tolerances)
+            if n is None:
+                for _, a, label in st.quat_joints:
+                    q[:, a:a + 4] = K.normalize_quats(label, q[:, a:a + 4], tolerances)
+            else:
+                q[:, cols] = n.reshape(Kq, -1)
+            qabs = None
+            for j, a, _ in st.quat_joints:
+                self._quat_tracks[j] = K.QuatTrack(q[:, a:a + 4])
 
         self._times = t
         self._qpos = q
@@ -468,23 +576,13 @@ class Plan(WindowTimes):
         # mocap body, which is a fixed frame) changes. Propagated one tree depth at a
         # time (st.levels: the non-mocap bodies of each depth), no loop over bodies.
         changes = (q != q[0]).any(axis=0)  # (nq,)
-        nbody = st.nbody
-        parent = st.parent
-        moving = np.zeros(nbody, dtype=bool)
-        rotating = np.zeros(nbody, dtype=bool)
-        if changes.any():
-            if st.chain_cols is not None:  # small trees: one product each
-                both = (st.chain_both_cols @ changes.view(np.uint8)) > 0
-                moving, rotating = both[:nbody], both[nbody:]
-            else:
-                own_moving = (st.own_cols & changes).any(axis=1)
-                own_rot = (st.own_rot_cols & changes).any(axis=1)
-                for bodies, parents in st.levels:
-                    moving[bodies] = own_moving[bodies] | moving[parents]
-                    rotating[bodies] = own_rot[bodies] | rotating[parents]
-        self._moving = moving
-        self._rotating = rotating
-        self._moving.setflags(write=False)
+        ckey = changes.tobytes()
+        hit = st.flag_cache.get(ckey)   # the flags and chains are a function of (structure, changes)
+        if hit is None:
+            hit = _flags_and_chains(st, changes)
+            if len(st.flag_cache) < 256:
+                st.flag_cache[ckey] = hit
+        self._moving, self._rotating, chains = hit
 
         # Virtual joints: one per hinge/slide/ball, two per free joint (translation
         # then rotation about the body origin). kind: 0 hinge, 1 slide, 2 ball,
@@ -492,29 +590,10 @@ class Plan(WindowTimes):
         # moving bodies only (a mocap or static ancestor is a constant frame).
         self._vkind = st.vkind
         self._first_v = st.first_v
-        key = moving.tobytes()
-        chains = st.chains.get(key)
-        if chains is None:
-            own_v = st.own_v
-            chain_v: list[np.ndarray] = []
-            own_count: list[int] = []
-            for b in range(nbody):
-                chain: list[int] = []
-                c = b
-                while c != 0 and moving[c]:
-                    chain = own_v[c] + chain
-                    c = parent[c]
-                arr = np.array(chain, dtype=np.int64)
-                arr.setflags(write=False)
-                chain_v.append(arr)
-                own_count.append(len(own_v[b]) if moving[b] else 0)
-            chains = (chain_v, own_count)
-            if len(st.chains) < 64:
-                st.chains[key] = chains
         self._chain_v, self._own_count = chains
 
         self._magnitude = {
-            "q": float(np.abs(q).max(initial=0.0)) + st.qpos0_mag,
+            "q": (float(np.abs(q).max(initial=0.0)) if qabs is None else qabs) + st.qpos0_mag,
             "path": max((float(tr.cum[-1]) for tr in self._quat_tracks.values()), default=0.0),
         }
         # Waypoint poses (for translation segments and the rounding scale) and the
