@@ -10,7 +10,8 @@ The fast suite runs on pytest-xdist workers (``scripts/test.sh`` passes ``-n``; 
   the other has already run out of work;
 * each process compiles (or loads) the numba kernels once under a file lock before its first
   test (:func:`monitor.warmup.ensure_warm`), so two workers never write the same cache entries
-  at the same time, and compilation is never inside a test's own budget.
+  at the same time, and compilation is never inside a test's own budget; a wait for
+  ``scripts/test.sh``'s background warm-up is not counted in any test's duration.
 """
 
 from __future__ import annotations
@@ -53,8 +54,7 @@ def load_asset():
     return _load
 
 
-@pytest.fixture(scope="session", autouse=True)
-def _numba_kernels_warm():
+def _warm_kernels_once() -> None:
     """Compile or load the certification kernels once per process, one process at a time.
 
     numba's cache writes each file atomically, but two processes compiling different
@@ -76,6 +76,26 @@ def _numba_kernels_warm():
             ensure_warm()
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtestloop(session):
+    """Warm the kernels in each test process after collection and before its first test.
+
+    Here rather than in a fixture only, so that a wait for ``scripts/test.sh``'s warm-up (which
+    runs beside pytest's start-up and collection) is not reported as the first test's setup.
+    Not in the pytest-xdist controller (it runs no test) nor for ``--collect-only``.
+    """
+    controller = session.config.pluginmanager.has_plugin("dsession")
+    if session.items and not controller and not session.config.option.collectonly:
+        _warm_kernels_once()
+    yield
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _numba_kernels_warm():
+    """The same, for a run that does not go through :func:`pytest_runtestloop` (cheap when warm)."""
+    _warm_kernels_once()
     yield
 
 
