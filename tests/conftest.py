@@ -37,10 +37,16 @@ LONG_FIRST = (
     "tests/test_plain_mujoco.py::test_example_gates_500_steps",
     "tests/test_extrusion_exact.py::test_verdicts_and_earliest_match_oracle",
     "tests/test_bezier_motion.py::test_bezier_certify_no_false_negatives_quick",
+    "tests/test_window_kernel.py::test_same_pairs_as_the_python_pipeline_on_the_peers_cases",
+    "tests/test_window_kernel.py::test_lazy_pairs_read_like_a_tuple",
+    "tests/test_motion_bounds.py::test_random_chains_never_exceed_bound",
+    "tests/test_extrusion_pipeline.py::test_null_set_path_issues_most_certificates_on_bench_cases",
+    "tests/test_kernels.py::test_random_pairs_never_certify_a_collision",
 )
 """Node ids (without parameters) of the longest fast tests, measured with ``--durations``
-(docs/notes/issue-12-tests.md): they are scheduled first. An id that no longer exists is
-ignored; the order only changes which worker runs what, never what runs."""
+(docs/notes/issue-12-tests.md; the last five by CPU seconds per test, issue-12-suite-time.md):
+they are scheduled first. An id that no longer exists is ignored; the order only changes which
+worker runs what, never what runs."""
 
 
 @pytest.fixture
