@@ -17,15 +17,17 @@ budget counts compilation as the caller's time (call :func:`ensure_warm`, or
 (a few hundred milliseconds when the kernels load from the on-disk cache).
 
 :func:`warm_up` (``python -m monitor warmup``) does the same with an empty cache on several
-cores: first the independent entry points in child processes (the geometry of the Scene build
-and the null-set LP kernels in one, the motion packer and then the per-pair search kernel in
-another), then :func:`ensure_warm` in this process, which loads what the children cached and
-compiles only the whole-window kernel on top (numba links a cached callee's stored LLVM module
-into its caller without typing or lowering it again). numba writes each cache file by an atomic
-rename, but its index update (read the index, take the first free data-file number, write the
-index, write the data) is not atomic across processes: two processes adding different
-signatures of one function can leave the index naming the other's data file. During the
-warm-up every save takes an exclusive lock on a file next to the index (:func:`serialise_cache_saves`).
+cores: two child processes compile every entry point (one the motion packer and then the
+whole-window kernel through the certify cases, the other the Scene build's geometry, the
+null-set LP, the fat-feature kernels and then the per-pair search kernel on top of the callees
+it shares with the whole-window kernel), each waiting for the other's signal file before calling
+into its functions; then :func:`ensure_warm` in this process loads what they cached (numba links
+a cached callee's stored LLVM module into its caller without typing or lowering it again). numba
+writes each cache file by an atomic rename, but its index update (read the index, take the first
+free data-file number, write the index, write the data) is not atomic across processes: two
+processes adding different signatures of one function can leave the index naming the other's
+data file. During the warm-up every save takes an exclusive lock on a file next to the index
+(:func:`serialise_cache_saves`).
 
 The report says what was compiled: numba's ``numba:compile`` events during the warm-up
 (every function compiled in this process, nested ones included; a function loaded from
@@ -172,19 +174,59 @@ def serialise_cache_saves() -> bool:
     return True
 
 
-# Child tasks of the parallel warm-up, longest first. They compile disjoint sets of functions:
-# "motion" builds the warm-up Scene (core_distance) only once "geometry" has built it (the file
-# SCENE_READY in the shared folder, written by "geometry" or by the parent when "geometry"
-# exits), so it loads core_distance from the cache instead of compiling it a second time.
-_CHILD_TASKS = ("motion", "geometry")
-_SCENE_READY = "scene-ready"
+# Child tasks of the parallel warm-up, longest first. They compile disjoint sets of functions, in
+# an order that keeps both cores busy (docs/notes/issue-12-suite-time.md, cold CPU seconds):
+#   motion:   derive + batch (~12 s) | signal | certify cases: window_kernel with the callees it
+#             shares with pair_window (~27 s) | core_distance_batch (~1 s)
+#   geometry: Scene build: core_distance (~11 s) | signal | null-set LP kernels (~12 s) | signal |
+#             fat-feature kernels (~11 s) | pair_window on the cached callees (~12 s)
+# Each task waits, before a step that calls into another task's functions, for that task's
+# signal file in the shared folder (the parent writes a task's signals when its child exits,
+# whatever happened), or for the cache entries it needs: no function is compiled by both.
+# This process then only loads (ensure_warm), instead of compiling window_kernel alone on one core.
+_CHILD_TASKS = ("geometry", "motion")
+_SCENE_READY = "scene-ready"      # geometry: the warm-up Scene is built (core_distance cached)
+_LP_READY = "lp-ready"            # geometry: the null-set LP kernels are cached (the translating case)
+_BATCH_READY = "batch-ready"      # motion: the motion packer is cached (every trajectory_pack)
+_SIGNALS = {"geometry": (_SCENE_READY, _LP_READY), "motion": (_BATCH_READY,)}
+"""The signal files each child task writes (and the parent writes for it when the child exits)."""
 
 
-def _wait_for(path: str, parent: int, timeout: float = 900.0) -> None:
-    """Sleep until ``path`` exists, the parent process ``parent`` is gone, or ``timeout`` s passed."""
+def _wait_for(path: str | None, parent: int, timeout: float = 900.0) -> None:
+    """Sleep until ``path`` exists, the parent process ``parent`` is gone, or ``timeout`` s passed.
+
+    ``path`` None (no shared folder: the task runs alone): return at once.
+    """
+    if path is None:
+        return
     t_end = time.monotonic() + timeout
     while not os.path.exists(path) and os.getppid() == parent and time.monotonic() < t_end:
         time.sleep(0.05)
+
+
+def _is_cached(dispatcher: Any) -> bool:
+    """True when numba's on-disk cache holds an entry of ``dispatcher`` for its current source.
+
+    A cache this cannot read counts as cached (the caller then stops waiting for it).
+    """
+    try:
+        return bool(dispatcher._cache._cache_file._load_index())
+    except Exception:  # noqa: BLE001 - numba internals differ: do not wait
+        return True
+
+
+def _wait_cached(dispatchers: tuple, give_up: str | None, parent: int, timeout: float = 900.0) -> None:
+    """Sleep until every dispatcher has an on-disk cache entry (or a condition to stop waiting).
+
+    Stops early when ``give_up`` exists (the process compiling them is gone), the parent
+    process is gone, or ``timeout`` s passed.
+    """
+    t_end = time.monotonic() + timeout
+    while not all(_is_cached(d) for d in dispatchers):
+        if (give_up is not None and os.path.exists(give_up)) or os.getppid() != parent \
+                or time.monotonic() > t_end:
+            return
+        time.sleep(0.1)
 
 
 def _warm_distance_batch(scene: Any = None) -> None:
@@ -206,43 +248,77 @@ def _warm_distance_batch(scene: Any = None) -> None:
                          (R, p))
 
 
-def _child_task(task: str, shared: str | None = None) -> None:
-    """Compile one group of independent entry points (in a child process of :func:`warm_up`).
+def _pair_search(scene: Any, plan: Any) -> str | None:
+    """Call the per-pair search entry as the engine's ``_full_search`` does; its verdict (None: no pack)."""
+    from monitor.certify import kernels
 
-    ``shared``: a folder for the children's "scene built" signal (None: no waiting).
+    gp, mp = kernels.scene_pack(scene).geoms, kernels.trajectory_pack(plan)
+    if mp is None:
+        return None
+    ga, gb = (int(g) for g in scene.pair_ids[0])
+    return str(kernels.check_pair_window(gp, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3, max_tests=8)["verdict"])
+
+
+def _child_task(task: str, shared: str | None = None) -> dict[str, str | None]:
+    """Compile one group of entry points (in a child process of :func:`warm_up`); the verdicts.
+
+    ``shared``: the folder of the children's signal files (None: no waiting, no signals).
+    Returns ``{case: verdict}`` of the certify cases ("motion") or ``{"pair search entry":
+    verdict}`` ("geometry"; None when the plan has no motion pack).
     """
     import mujoco
     import numpy as np
 
+    from monitor.motion.plan import Plan
     from monitor.scene import Scene
 
-    model = mujoco.MjModel.from_xml_string(_XML)
-    if task == "geometry":        # Scene build: halfspace_distance, core_distance; then the LP kernels
-        _warm_distance_batch(Scene.from_model(model, pairs="all"))
+    parent = os.getppid()
+
+    def signal_file(name: str) -> str | None:
+        return None if shared is None else os.path.join(shared, name)
+
+    def signal(name: str) -> None:
         if shared is not None:
-            open(os.path.join(shared, _SCENE_READY), "w").close()
+            open(os.path.join(shared, name), "w").close()
+
+    model = mujoco.MjModel.from_xml_string(_XML)
+    q0 = np.zeros(model.nq)
+    if task == "geometry":
+        scene = Scene.from_model(model, pairs="all")      # halfspace_distance, core_distance
+        signal(_SCENE_READY)
         from monitor.certify.extrusion_null import warm_small_lp
 
-        warm_small_lp()
-    elif task == "motion":        # the motion packer (derive, batch), then the per-pair search kernel
+        warm_small_lp()                                    # simplex, min-norm and first-contact kernels
+        signal(_LP_READY)
+        from monitor.certify.toleranced import warm_kernels
+
+        warm_kernels()                                     # fat-feature levels, trajectory balls, screws
+        # pair_window on top of the callees it shares with window_kernel (compiled by "motion")
         from monitor.certify import kernels
-        from monitor.motion.plan import Plan
+        from monitor.motion import kernel as motion_kernel
 
-        parent = os.getppid()
-        plan = Plan(np.array([0.0, 0.1]), np.array(_CASES["rotating clear"]), model)
-        mp = kernels.trajectory_pack(plan)
+        _wait_for(signal_file(_BATCH_READY), parent)
         if shared is not None:
-            _wait_for(os.path.join(shared, _SCENE_READY), parent)
-        scene = Scene.from_model(model, pairs="all")
-        if mp is not None:
-            ga, gb = (int(g) for g in scene.pair_ids[0])
-            kernels.check_pair_window(kernels.scene_pack(scene).geoms, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3,
-                                      max_tests=8)
-        from monitor.certify.toleranced import warm_kernels  # the fat-feature stage (fat_kernels)
+            _wait_cached((kernels.posed_distance, kernels.separated_beyond, motion_kernel.body_pose),
+                         os.path.join(shared, "motion-exited"), parent)
+        plan = Plan(np.array([0.0, 0.1]), q0 + np.array(_CASES["rotating clear"]), model)
+        return {"pair search entry": _pair_search(scene, plan)}
+    if task == "motion":
+        from monitor.certify import kernels
 
-        warm_kernels()
-    else:
-        raise ValueError(f"task: unknown warm-up task {task!r}")
+        plans = {name: Plan(np.array([0.0, 0.1]), q0 + np.array(q), model) for name, q in _CASES.items()}
+        kernels.trajectory_pack(plans["rotating clear"])  # derive, batch
+        signal(_BATCH_READY)
+        _wait_for(signal_file(_SCENE_READY), parent)
+        scene = Scene.from_model(model, pairs="all")
+        out = {}
+        for name in _CASES:                                # window_kernel (+ its callees)
+            if name == "translating":                      # the extrusion path: the LP kernels
+                _wait_for(signal_file(_LP_READY), parent)
+            out[name] = _certify_case(scene, plans[name])
+        _warm_distance_batch()
+        return out
+    raise ValueError(f"task: unknown warm-up task {task!r}")
 
 
 _CHILD_CODE = """
@@ -269,7 +345,7 @@ def _cores() -> int:
 
 
 def warm_up(processes: int | str = "auto") -> dict[str, Any]:
-    """:func:`ensure_warm`, with the independent entry points first compiled in child processes.
+    """:func:`ensure_warm`, with every entry point first compiled in child processes (two cores).
 
     Args:
         processes: child processes run at once (``"auto"``: the usable cores, at most
@@ -312,7 +388,7 @@ def _children_cached() -> bool:
         from monitor.motion import kernel as motion_kernel
 
         entry_points = (_gjk.core_distance, _gjk.core_distance_batch, _gjk.halfspace_distance,
-                        motion_kernel.batch, motion_kernel.derive, kernels.pair_window,
+                        motion_kernel.batch, motion_kernel.derive, kernels.pair_window, kernels.window_kernel,
                         extrusion_null._dual_simplex_kernel, extrusion_kernels.min_norm_kernel,
                         extrusion_kernels.first_time_kernel,
                         fat_kernels.fat_level, fat_kernels.traj_balls, fat_kernels.screw_poses_bounds)
@@ -334,6 +410,9 @@ def _run_children(n: int) -> dict[str, dict[str, Any]]:
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, terminated) if main else None
     with tempfile.TemporaryDirectory(prefix="monitor-warmup-") as shared:
+        for task in set(_SIGNALS) - set(todo):  # a task that does not run here signals nothing: no waiting
+            for name in (*_SIGNALS[task], f"{task}-exited"):
+                open(os.path.join(shared, name), "a").close()
         try:
             while todo or running:
                 while todo and len(running) < n:
@@ -348,8 +427,9 @@ def _run_children(n: int) -> dict[str, dict[str, Any]]:
                     continue
                 for task in done:
                     proc, log = running.pop(task)
-                    if task == "geometry":  # whatever happened, nobody waits for the Scene any more
-                        open(os.path.join(shared, _SCENE_READY), "a").close()
+                    # whatever happened, nobody waits for this child any more
+                    for name in (*_SIGNALS.get(task, ()), f"{task}-exited"):
+                        open(os.path.join(shared, name), "a").close()
                     log.seek(0)
                     text = log.read()
                     log.close()
@@ -376,13 +456,19 @@ _CASES = {
 """Joint waypoints (yaw, pitch, slide) of the warm-up motions, at t = 0 and 0.1 s."""
 
 
+def _certify_case(scene: Any, plan: Any) -> str:
+    """Certify one warm-up motion with an unlimited budget; its verdict."""
+    from monitor.certify.common import Budget
+    from monitor.certify.engine import certify
+
+    return str(certify(scene, plan, margin=0.001, epsilon=1e-3, budget=Budget()).verdict)
+
+
 def _run_cases() -> dict[str, tuple[str, float]]:
     """Certify the warm-up motions and compile the null-set LP: ``{case: (verdict, seconds)}``."""
     import mujoco
     import numpy as np
 
-    from monitor.certify.common import Budget
-    from monitor.certify.engine import certify
     from monitor.motion.plan import Plan
     from monitor.scene import Scene
 
@@ -393,18 +479,13 @@ def _run_cases() -> dict[str, tuple[str, float]]:
     for name, q in _CASES.items():
         t = time.perf_counter()
         plan = Plan(np.array([0.0, 0.1]), q0 + np.array(q), model)
-        cert = certify(scene, plan, margin=0.001, epsilon=1e-3, budget=Budget())
-        out[name] = (str(cert.verdict), time.perf_counter() - t)
+        out[name] = (_certify_case(scene, plan), time.perf_counter() - t)
     # the per-pair search entry, called from Python by the engine when the window kernel leaves a
     # colliding pair open (engine._full_search): same argument types, so the same specialisation
-    from monitor.certify import kernels
-
     t = time.perf_counter()
-    gp, mp = kernels.scene_pack(scene).geoms, kernels.trajectory_pack(plan)
-    if mp is not None:
-        ga, gb = (int(g) for g in scene.pair_ids[0])
-        r = kernels.check_pair_window(gp, mp, ga, gb, (0.0, 0.1), 0.001, 1e-3, max_tests=8)
-        out["pair search entry"] = (str(r["verdict"]), time.perf_counter() - t)
+    verdict = _pair_search(scene, plan)
+    if verdict is not None:
+        out["pair search entry"] = (verdict, time.perf_counter() - t)
     from monitor.certify.extrusion_null import warm_small_lp  # the null-set test's compiled simplex
 
     t = time.perf_counter()

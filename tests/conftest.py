@@ -10,7 +10,8 @@ The fast suite runs on pytest-xdist workers (``scripts/test.sh`` passes ``-n``; 
   the other has already run out of work;
 * each process compiles (or loads) the numba kernels once under a file lock before its first
   test (:func:`monitor.warmup.ensure_warm`), so two workers never write the same cache entries
-  at the same time, and compilation is never inside a test's own budget.
+  at the same time, and compilation is never inside a test's own budget; a wait for
+  ``scripts/test.sh``'s background warm-up is not counted in any test's duration.
 """
 
 from __future__ import annotations
@@ -36,10 +37,16 @@ LONG_FIRST = (
     "tests/test_plain_mujoco.py::test_example_gates_500_steps",
     "tests/test_extrusion_exact.py::test_verdicts_and_earliest_match_oracle",
     "tests/test_bezier_motion.py::test_bezier_certify_no_false_negatives_quick",
+    "tests/test_window_kernel.py::test_same_pairs_as_the_python_pipeline_on_the_peers_cases",
+    "tests/test_window_kernel.py::test_lazy_pairs_read_like_a_tuple",
+    "tests/test_motion_bounds.py::test_random_chains_never_exceed_bound",
+    "tests/test_extrusion_pipeline.py::test_null_set_path_issues_most_certificates_on_bench_cases",
+    "tests/test_kernels.py::test_random_pairs_never_certify_a_collision",
 )
 """Node ids (without parameters) of the longest fast tests, measured with ``--durations``
-(docs/notes/issue-12-tests.md): they are scheduled first. An id that no longer exists is
-ignored; the order only changes which worker runs what, never what runs."""
+(docs/notes/issue-12-tests.md; the last five by CPU seconds per test, issue-12-suite-time.md):
+they are scheduled first. An id that no longer exists is ignored; the order only changes which
+worker runs what, never what runs."""
 
 
 @pytest.fixture
@@ -53,8 +60,7 @@ def load_asset():
     return _load
 
 
-@pytest.fixture(scope="session", autouse=True)
-def _numba_kernels_warm():
+def _warm_kernels_once() -> None:
     """Compile or load the certification kernels once per process, one process at a time.
 
     numba's cache writes each file atomically, but two processes compiling different
@@ -76,6 +82,26 @@ def _numba_kernels_warm():
             ensure_warm()
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtestloop(session):
+    """Warm the kernels in each test process after collection and before its first test.
+
+    Here rather than in a fixture only, so that a wait for ``scripts/test.sh``'s warm-up (which
+    runs beside pytest's start-up and collection) is not reported as the first test's setup.
+    Not in the pytest-xdist controller (it runs no test) nor for ``--collect-only``.
+    """
+    controller = session.config.pluginmanager.has_plugin("dsession")
+    if session.items and not controller and not session.config.option.collectonly:
+        _warm_kernels_once()
+    yield
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _numba_kernels_warm():
+    """The same, for a run that does not go through :func:`pytest_runtestloop` (cheap when warm)."""
+    _warm_kernels_once()
     yield
 
 

@@ -42,8 +42,11 @@ def ray_logs(tmp_path_factory):
 
 
 def test_rollouts_local_and_ray_identical():
+    # the local reference runs in this process: local 1 == 2 workers is test_rollouts.py's
+    # test_two_workers_same_verdicts (a 2-process pool here cost ~7 s of CPU for its start-up alone)
     kw = dict(episodes=4, steps=25, seeds=7, log_dir=None, progress=False)
-    local = rollouts("tunnel", RandomPolicy(hold=4), workers=2, backend="local", **kw)
+    local = rollouts("tunnel", RandomPolicy(hold=4), workers=1, backend="local", **kw)
+    assert local.workers == 1
     on_ray = rollouts("tunnel", RandomPolicy(hold=4), workers=2, backend="ray", **kw)
     assert on_ray.backend == "ray"
     assert local.counts() == on_ray.counts()

@@ -234,17 +234,38 @@ def test_concurrent_cache_saves_of_two_signatures(tmp_path, monkeypatch, locked)
 def test_child_processes_report_and_a_failed_child_is_not_fatal(monkeypatch):
     """The children's plumbing (their own interpreter, this sys.path, one report line each), warm cache.
 
-    An unknown task fails in its child: reported with its error, never raised; the geometry
-    child still signals the Scene so the motion child does not wait for it.
+    An unknown task fails in its child: reported with its error, never raised. "motion" does not
+    run here, so its signal is written before the children start and "geometry" does not wait
+    for it (both tasks' own steps: the in-process test below).
     """
-    monkeypatch.setattr(monitor.warmup, "_CHILD_TASKS", ("motion", "geometry", "no-such-task"))
+    monkeypatch.setattr(monitor.warmup, "_CHILD_TASKS", ("geometry", "no-such-task"))
     out = monitor.warmup._run_children(2)
-    assert set(out) == {"motion", "geometry", "no-such-task"}
-    for task in ("motion", "geometry"):
-        assert out[task]["ok"] and out[task]["error"] == "", out[task]
-        assert out[task]["seconds"] > 0 and out[task]["cpu"] > 0 and out[task]["compiled"]["functions"] >= 0
+    assert set(out) == {"geometry", "no-such-task"}
+    good = out["geometry"]
+    assert good["ok"] and good["error"] == "", good
+    assert good["seconds"] > 0 and good["cpu"] > 0 and good["compiled"]["functions"] >= 0
     bad = out["no-such-task"]
     assert not bad["ok"] and "unknown warm-up task" in bad["error"], bad
+
+
+def test_child_tasks_give_the_expected_verdicts_and_signal_each_step(tmp_path):
+    """Both child tasks in this process (kernels already loaded): each certify case's verdict, the
+    pair search's, and every signal file the other task waits for."""
+    w = monitor.warmup
+    for name in (w._SCENE_READY, w._LP_READY):  # as if "geometry" had run: "motion" does not wait
+        (tmp_path / name).touch()
+    expected = {"rotating clear": "certified", "colliding swing": "violation", "translating": "certified"}
+    assert w._child_task("motion", str(tmp_path)) == expected
+    assert (tmp_path / w._BATCH_READY).exists()
+    for name in (w._SCENE_READY, w._LP_READY):
+        (tmp_path / name).unlink()
+    (tmp_path / "motion-exited").touch()  # never wait for cache entries here (an unwritable cache has none)
+    assert w._child_task("geometry", str(tmp_path)) == {"pair search entry": "certified"}
+    signals = {w._BATCH_READY, w._SCENE_READY, w._LP_READY, "motion-exited"}
+    assert {p.name for p in tmp_path.iterdir()} == signals
+    assert set(w._SIGNALS) == set(w._CHILD_TASKS)
+    with pytest.raises(ValueError, match="unknown warm-up task"):
+        w._child_task("no-such-task")
 
 
 def test_warm_up_skips_the_children_when_the_cache_is_warm_and_checks_processes():
@@ -260,8 +281,8 @@ def test_warm_up_skips_the_children_when_the_cache_is_warm_and_checks_processes(
 
 @pytest.mark.slow
 def test_parallel_warmup_from_an_empty_cache_compiles_each_function_once(tmp_path):
-    """Empty numba cache, two children: every case has its verdict and this process compiles only
-    what the children do not (the whole-window kernel); a later process compiles nothing."""
+    """Empty numba cache, two children: every case has its verdict, the children compile every
+    kernel and this process none; a later process compiles nothing and starts no child."""
     import os
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
@@ -269,8 +290,6 @@ def test_parallel_warmup_from_an_empty_cache_compiles_each_function_once(tmp_pat
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "child motion" in r.stdout and "child geometry" in r.stdout and "failed" not in r.stdout, r.stdout
-    lines = r.stdout.split("entry points:")[1].splitlines()[1:]
-    entry = [x.split()[0] for x in lines if x.startswith("    ")]
-    assert entry == ["monitor.certify.kernels.window_kernel"], r.stdout
+    assert "nothing compiled in this process" in r.stdout, r.stdout
     r2 = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
     assert r2.returncode == 0 and "nothing compiled" in r2.stdout and "child" not in r2.stdout, r2.stdout

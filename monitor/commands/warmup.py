@@ -9,9 +9,9 @@ does this before starting its default budget, so compilation never makes a windo
 first gated step of every later process is fast, and so that an explicit ``budget`` is
 not spent on compilation.
 
-With an empty cache and several cores, the independent kernels compile in child processes
-first (``--processes``, default: one per usable core, at most 2), then this process compiles
-the rest on top of what they cached; each child gets one line.
+With an empty cache and several cores, the kernels compile in child processes (``--processes``,
+default: one per usable core, at most 2), then this process loads what they cached (and
+compiles whatever a failed child left); each child gets one line.
 
 Exit codes: 0 compiled (or loaded) and every case gave its expected verdict; 1 otherwise.
 """
@@ -67,6 +67,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  compiled {comp['functions']} numba functions in {comp['seconds']:.1f} s; entry points:")
         for name, seconds in sorted(comp["entry_points"].items(), key=lambda kv: -kv[1]):
             print(f"    {name:58s} {seconds:8.2f} s")
+    elif rep.get("children"):
+        print("  nothing compiled in this process: it loaded what the child processes compiled")
     else:
         print("  nothing compiled: every kernel loaded from the on-disk numba cache")
     print(f"monitor warmup: certification kernels ready in {rep.get('total_seconds', rep['seconds']):.1f} s "
