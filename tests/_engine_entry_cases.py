@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,10 +34,12 @@ def calls() -> Iterator[tuple[str, Any]]:
 
 def bench_calls(only: str | None = None) -> Iterator[tuple[str, Any]]:
     """Bench pair-windows (lerp / slerp groups) x method x margin; ``only``: "method/margin" suffix."""
-    from monitor.bench.cases import make_cases
     from monitor.certify.engine import certify
 
-    cases = [c for c in make_cases(seed=7, quick=True) if c.group in ("translating", "rotating")]
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from _bench_cases import quick_cases  # the quick set, built once per process
+
+    cases = [c for c in quick_cases() if c.group in ("translating", "rotating")]
     for c in cases:
         scene, motion = c.scene(16), c.body_motion()
         for method in ("auto", "toleranced"):

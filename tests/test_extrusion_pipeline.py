@@ -9,6 +9,8 @@ names the deciding stage; ``cert.stats["extrusion_stages"]`` counts them.
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +20,9 @@ from monitor.certify.extrusion import STAGES, TranslatingPair, check_pairs, core
 from monitor.geometry.distance import shape_distance_batch
 from monitor.geometry.polytope import box_polytope, capsule_shape, polytope_from_points, sphere_shape
 from monitor.tolerances import DEFAULT
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench_cases import quick_cases  # noqa: E402  (the quick set, built once per process)
 
 PAPER_PATH = ("sbounds", "divide_and_conquer", "null_set")
 
@@ -190,10 +195,9 @@ def test_null_set_path_issues_most_certificates_on_bench_cases():
     """The translating group of monitor.bench.cases (quick set) through monitor.certify."""
     pytest.importorskip("mujoco")
     import monitor
-    from monitor.bench.cases import make_cases
 
     stages: dict[tuple[str, str], int] = {}
-    for c in make_cases(seed=7, quick=True):
+    for c in quick_cases():
         if c.group != "translating":
             continue
         cert = monitor.certify(c.scene(), c.body_motion(), method="auto")
