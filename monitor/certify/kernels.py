@@ -99,7 +99,14 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import _search_right, body_pose, pair_bound, pair_workspace, tree_bounds
+from monitor.motion.kernel import (
+    _bounds_core,
+    _search_right,
+    body_pose,
+    bounds_workspace,
+    pair_bound,
+    pair_workspace,
+)
 
 # ---------------------------------------------------------------------------- codes
 
@@ -1041,10 +1048,14 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         trans = np.empty((T, nbody))
         ang = np.empty((T, nbody))
         step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
+        # tree_bounds per sub-range, with its scratch allocated once for the T calls (the same
+        # numbers: _bounds_core's result does not depend on the scratch's contents on entry)
+        need_all = np.ones(nbody, np.int64)
+        ws = bounds_workspace(mp)
         for t in range(T):
             ta = t * step + t0
             tb = t1 if t == T - 1 else (t + 1) * step + t0
-            tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
+            _bounds_core(mp, ta, tb, need_all, pos[t], rot[t], trans[t], ang[t], ws)
         mag = 0.0
         for t in range(T):
             for b in range(nbody):
