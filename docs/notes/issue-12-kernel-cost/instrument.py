@@ -58,9 +58,9 @@ sub("    out = np.empty(OUT_SIZE)\n    w = np.empty(3)\n    pA = np.empty(3)\n  
     "    RA = np.empty((3, 3))\n    RB = np.empty((3, 3))\n    stats = np.zeros(1)\n")
 sub("    while sp > 0:\n        if spent >= max_tests:",
     f"    _pf[{P0 + 6}] += _tick() - _c\n    while sp > 0:\n        if spent >= max_tests:")
-sub("        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws)\n",
+sub("        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)\n",
     "        _c = _tick()\n"
-    "        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws)\n"
+    "        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)\n"
     f"        _c2 = _tick()\n        _pf[{P0 + 7}] += _c2 - _c\n        _pf[{P0 + 11}] += 1.0\n")
 sub("                lb = separated_beyond(gp, ga, RA, pA, gb, RB, pB, hi, target, rel_pad, abs_pad, VA, VB, W4,\n"
     "                                      IA, IB, lam, v, vn, X)\n",

@@ -71,7 +71,7 @@ def d_fk(n, mp, t0, t1):
         _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, lm[0], lm[1], lm[2], qm)
         _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
             mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
-            qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
+            qm, need, xpos, xquat, xmat, janchor, jaxis, jframe, ws[11], ws[12])
     return njnt
 
 

@@ -85,10 +85,15 @@ def d_ib(n, gp, mp, ga, gb, t0, t1, prm):
     body_pose(mp, gp.body[ga], t0, pA, RA)
     body_pose(mp, gp.body[gb], t0, pB, RB)
     levers = np.ones(2)
+    PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+    PmA = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
+    PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+    PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
+    dref = (np.ones(PvA.shape[0]), np.ones(PmA.shape[0]), np.ones(PvB.shape[0]), np.ones(PmB.shape[0]))
     stats = np.zeros(1)
     acc = 0.0
     for _ in range(n):
-        acc += K.interval_bound(gp, mp, ga, gb, t0, t1, pA, RA, pB, RB, levers, stats, prm[K.WP_REL], pws)
+        acc += K.interval_bound(gp, mp, ga, gb, t0, t1, pA, RA, pB, RB, levers, stats, prm[K.WP_REL], pws, dref)
     return acc
 
 
