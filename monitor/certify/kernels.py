@@ -239,6 +239,16 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _acc3(init, a0, b0, a1, b1, a2, b2):
+    """((init + a0 b0) + a1 b1) + a2 b2, in that order (the former accumulation loops' rounding)."""
+    acc = init
+    acc += a0 * b0
+    acc += a1 * b1
+    acc += a2 * b2
+    return acc
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     """Max over the exact cylinder / ellipsoid g of (sign v) . x, posed by R and origin ``off``.
 
@@ -249,42 +259,46 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     pack are passed (``gp.curve[g], gp.cparam[g], gp.cframe[g], gp.ccenter[g]``), not the pack:
     a compiled function typed on the 22-array pack costs several times more to compile.
     """
-    Rg = np.empty((3, 3))
-    c = np.empty(3)
-    for r in range(3):
-        c[r] = off[r]
-        for q in range(3):
-            c[r] += R[r, q] * ccenter[q]
-            acc = 0.0
-            for j in range(3):
-                acc += R[r, j] * cframe[j, q]
-            Rg[r, q] = acc
-    dl = np.empty(3)
-    for q in range(3):
-        dl[q] = sign * (Rg[0, q] * v[0] + Rg[1, q] * v[1] + Rg[2, q] * v[2])
-    val = sign * (c[0] * v[0] + c[1] * v[1] + c[2] * v[2])
-    loc = np.empty(3)
+    # (scalars, no scratch arrays: the same sums in the same order as the former loops over
+    # arrays, ``acc = 0.0; acc += ...``, so the same numbers bit for bit; issue 12, kernel cost)
+    c0 = _acc3(off[0], R[0, 0], ccenter[0], R[0, 1], ccenter[1], R[0, 2], ccenter[2])
+    c1 = _acc3(off[1], R[1, 0], ccenter[0], R[1, 1], ccenter[1], R[1, 2], ccenter[2])
+    c2 = _acc3(off[2], R[2, 0], ccenter[0], R[2, 1], ccenter[1], R[2, 2], ccenter[2])
+    g00 = _acc3(0.0, R[0, 0], cframe[0, 0], R[0, 1], cframe[1, 0], R[0, 2], cframe[2, 0])
+    g01 = _acc3(0.0, R[0, 0], cframe[0, 1], R[0, 1], cframe[1, 1], R[0, 2], cframe[2, 1])
+    g02 = _acc3(0.0, R[0, 0], cframe[0, 2], R[0, 1], cframe[1, 2], R[0, 2], cframe[2, 2])
+    g10 = _acc3(0.0, R[1, 0], cframe[0, 0], R[1, 1], cframe[1, 0], R[1, 2], cframe[2, 0])
+    g11 = _acc3(0.0, R[1, 0], cframe[0, 1], R[1, 1], cframe[1, 1], R[1, 2], cframe[2, 1])
+    g12 = _acc3(0.0, R[1, 0], cframe[0, 2], R[1, 1], cframe[1, 2], R[1, 2], cframe[2, 2])
+    g20 = _acc3(0.0, R[2, 0], cframe[0, 0], R[2, 1], cframe[1, 0], R[2, 2], cframe[2, 0])
+    g21 = _acc3(0.0, R[2, 0], cframe[0, 1], R[2, 1], cframe[1, 1], R[2, 2], cframe[2, 1])
+    g22 = _acc3(0.0, R[2, 0], cframe[0, 2], R[2, 1], cframe[1, 2], R[2, 2], cframe[2, 2])
+    d0 = sign * (g00 * v[0] + g10 * v[1] + g20 * v[2])
+    d1 = sign * (g01 * v[0] + g11 * v[1] + g21 * v[2])
+    d2 = sign * (g02 * v[0] + g12 * v[1] + g22 * v[2])
+    val = sign * (c0 * v[0] + c1 * v[1] + c2 * v[2])
     if curve == 1:
         rad, hh = cparam[0], cparam[1]
-        rho = math.sqrt(dl[0] * dl[0] + dl[1] * dl[1])
-        val += rad * rho + hh * abs(dl[2])
+        rho = math.sqrt(d0 * d0 + d1 * d1)
+        val += rad * rho + hh * abs(d2)
         if rho > 0.0:
-            loc[0], loc[1] = rad * dl[0] / rho, rad * dl[1] / rho
+            l0, l1 = rad * d0 / rho, rad * d1 / rho
         else:
-            loc[0], loc[1] = rad, 0.0
-        loc[2] = hh if dl[2] >= 0.0 else -hh
+            l0, l1 = rad, 0.0
+        l2 = hh if d2 >= 0.0 else -hh
     else:
-        e0, e1, e2 = cparam[0] * dl[0], cparam[1] * dl[1], cparam[2] * dl[2]
+        e0, e1, e2 = cparam[0] * d0, cparam[1] * d1, cparam[2] * d2
         nrm = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         val += nrm
         if nrm > 0.0:
-            loc[0] = cparam[0] * e0 / nrm
-            loc[1] = cparam[1] * e1 / nrm
-            loc[2] = cparam[2] * e2 / nrm
+            l0 = cparam[0] * e0 / nrm
+            l1 = cparam[1] * e1 / nrm
+            l2 = cparam[2] * e2 / nrm
         else:
-            loc[0], loc[1], loc[2] = cparam[0], 0.0, 0.0
-    for r in range(3):
-        pt[r] = c[r] + Rg[r, 0] * loc[0] + Rg[r, 1] * loc[1] + Rg[r, 2] * loc[2]
+            l0, l1, l2 = cparam[0], 0.0, 0.0
+    pt[0] = c0 + g00 * l0 + g01 * l1 + g02 * l2
+    pt[1] = c1 + g10 * l0 + g11 * l1 + g12 * l2
+    pt[2] = c2 + g20 * l0 + g21 * l1 + g22 * l2
     return val
 
 
