@@ -239,16 +239,6 @@ def _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, dpad_a, dpad_b, out):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _acc3(init, a0, b0, a1, b1, a2, b2):
-    """((init + a0 b0) + a1 b1) + a2 b2, in that order (the former accumulation loops' rounding)."""
-    acc = init
-    acc += a0 * b0
-    acc += a1 * b1
-    acc += a2 * b2
-    return acc
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     """Max over the exact cylinder / ellipsoid g of (sign v) . x, posed by R and origin ``off``.
 
@@ -260,19 +250,20 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     a compiled function typed on the 22-array pack costs several times more to compile.
     """
     # (scalars, no scratch arrays: the same sums in the same order as the former loops over
-    # arrays, ``acc = 0.0; acc += ...``, so the same numbers bit for bit; issue 12, kernel cost)
-    c0 = _acc3(off[0], R[0, 0], ccenter[0], R[0, 1], ccenter[1], R[0, 2], ccenter[2])
-    c1 = _acc3(off[1], R[1, 0], ccenter[0], R[1, 1], ccenter[1], R[1, 2], ccenter[2])
-    c2 = _acc3(off[2], R[2, 0], ccenter[0], R[2, 1], ccenter[1], R[2, 2], ccenter[2])
-    g00 = _acc3(0.0, R[0, 0], cframe[0, 0], R[0, 1], cframe[1, 0], R[0, 2], cframe[2, 0])
-    g01 = _acc3(0.0, R[0, 0], cframe[0, 1], R[0, 1], cframe[1, 1], R[0, 2], cframe[2, 1])
-    g02 = _acc3(0.0, R[0, 0], cframe[0, 2], R[0, 1], cframe[1, 2], R[0, 2], cframe[2, 2])
-    g10 = _acc3(0.0, R[1, 0], cframe[0, 0], R[1, 1], cframe[1, 0], R[1, 2], cframe[2, 0])
-    g11 = _acc3(0.0, R[1, 0], cframe[0, 1], R[1, 1], cframe[1, 1], R[1, 2], cframe[2, 1])
-    g12 = _acc3(0.0, R[1, 0], cframe[0, 2], R[1, 1], cframe[1, 2], R[1, 2], cframe[2, 2])
-    g20 = _acc3(0.0, R[2, 0], cframe[0, 0], R[2, 1], cframe[1, 0], R[2, 2], cframe[2, 0])
-    g21 = _acc3(0.0, R[2, 0], cframe[0, 1], R[2, 1], cframe[1, 1], R[2, 2], cframe[2, 1])
-    g22 = _acc3(0.0, R[2, 0], cframe[0, 2], R[2, 1], cframe[1, 2], R[2, 2], cframe[2, 2])
+    # arrays, ``acc = 0.0; acc += ...``: x + a b + c d + e f is ((x + a b) + c d) + e f, so the same
+    # numbers bit for bit, -0.0 included; no helper function: one more compile; issue 12, kernel cost)
+    c0 = off[0] + R[0, 0] * ccenter[0] + R[0, 1] * ccenter[1] + R[0, 2] * ccenter[2]
+    c1 = off[1] + R[1, 0] * ccenter[0] + R[1, 1] * ccenter[1] + R[1, 2] * ccenter[2]
+    c2 = off[2] + R[2, 0] * ccenter[0] + R[2, 1] * ccenter[1] + R[2, 2] * ccenter[2]
+    g00 = 0.0 + R[0, 0] * cframe[0, 0] + R[0, 1] * cframe[1, 0] + R[0, 2] * cframe[2, 0]
+    g01 = 0.0 + R[0, 0] * cframe[0, 1] + R[0, 1] * cframe[1, 1] + R[0, 2] * cframe[2, 1]
+    g02 = 0.0 + R[0, 0] * cframe[0, 2] + R[0, 1] * cframe[1, 2] + R[0, 2] * cframe[2, 2]
+    g10 = 0.0 + R[1, 0] * cframe[0, 0] + R[1, 1] * cframe[1, 0] + R[1, 2] * cframe[2, 0]
+    g11 = 0.0 + R[1, 0] * cframe[0, 1] + R[1, 1] * cframe[1, 1] + R[1, 2] * cframe[2, 1]
+    g12 = 0.0 + R[1, 0] * cframe[0, 2] + R[1, 1] * cframe[1, 2] + R[1, 2] * cframe[2, 2]
+    g20 = 0.0 + R[2, 0] * cframe[0, 0] + R[2, 1] * cframe[1, 0] + R[2, 2] * cframe[2, 0]
+    g21 = 0.0 + R[2, 0] * cframe[0, 1] + R[2, 1] * cframe[1, 1] + R[2, 2] * cframe[2, 1]
+    g22 = 0.0 + R[2, 0] * cframe[0, 2] + R[2, 1] * cframe[1, 2] + R[2, 2] * cframe[2, 2]
     d0 = sign * (g00 * v[0] + g10 * v[1] + g20 * v[2])
     d1 = sign * (g01 * v[0] + g11 * v[1] + g21 * v[2])
     d2 = sign * (g02 * v[0] + g12 * v[1] + g22 * v[2])
@@ -456,29 +447,25 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _lever(P, ref):
-    """Max over the core vertices P (n, 3) of a geom of |v - ref| (body frame), padded.
+def _lever(P, ref, dist_out):
+    """Max over the points P (n, 3) of a geom of |v - ref| (body frame), padded; dist_out[i] = |P_i - ref|.
 
-    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]``, not the pack (compile cost).
+    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]`` (or its mass points), not the
+    pack (compile cost). ``dist_out`` (n,) is :func:`_rel_terms`'s ``dP`` (issue 12, kernel cost).
     """
     lv = 0.0
     for i in range(P.shape[0]):
-        lv = max(lv, _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2]))
+        d = _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2])
+        dist_out[i] = d
+        lv = max(lv, d)
     return lv * (1.0 + 4.0 * 2.0**-52)
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _ref_dists(P, ref, out):
-    """out[i] = |P_i - ref| (body frame, m) for the rows of P: :func:`_rel_terms`'s ``dP``."""
-    for i in range(P.shape[0]):
-        out[i] = _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2])
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rel_terms(P, dP, TA, chA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     """Relative displacement bound delta_rel over the rows of P (points of A, body frame).
 
-    ``dP`` (n,): |P_i - c_A| from :func:`_ref_dists`, fixed for a pair and computed once per search
+    ``dP`` (n,): |P_i - c_A| from :func:`_lever`, fixed for a pair and computed once per search
     (the same expression as before, so the same numbers; it was one of the two square roots per
     point and test: issue 12, kernel cost).
 
@@ -523,7 +510,7 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
     ``pws``: :func:`monitor.motion.kernel.pair_workspace` scratch (allocated once per search).
     ``dref``: (|v - c_A| over A's vertices, over A's mass points, the same for B) from
-    :func:`_ref_dists` (once per search).
+    :func:`_lever` (once per search).
 
     Both bodies' motion bounds come from ONE :func:`monitor.motion.kernel.pair_bound` pass
     (the same numbers as two ``body_bound`` calls, without the second FK of their common
@@ -713,10 +700,6 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                   mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
-    if gp.kind[ga] != -1:
-        levers[0] = _lever(gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]], mp.ref_points[gp.body[ga]])
-    if gp.kind[gb] != -1:
-        levers[1] = _lever(gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]], mp.ref_points[gp.body[gb]])
     # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
     refA, refB = mp.ref_points[gp.body[ga]], mp.ref_points[gp.body[gb]]
     PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
@@ -724,10 +707,14 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
     PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
     dref = (np.empty(PvA.shape[0]), np.empty(PmA.shape[0]), np.empty(PvB.shape[0]), np.empty(PmB.shape[0]))
-    _ref_dists(PvA, refA, dref[0])
-    _ref_dists(PmA, refA, dref[1])
-    _ref_dists(PvB, refB, dref[2])
-    _ref_dists(PmB, refB, dref[3])
+    lv_a = _lever(PvA, refA, dref[0])
+    _lever(PmA, refA, dref[1])
+    lv_b = _lever(PvB, refB, dref[2])
+    _lever(PmB, refB, dref[3])
+    if gp.kind[ga] != -1:
+        levers[0] = lv_a
+    if gp.kind[gb] != -1:
+        levers[1] = lv_b
     lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
     rsum = gp.radius[ga] + gp.radius[gb]
     VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
