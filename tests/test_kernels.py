@@ -417,7 +417,7 @@ def test_separated_beyond_resumed_second_call_equals_a_fresh_one():
             na = gp.vstart[2] - gp.vstart[1]
             nb = gp.vstart[3] - gp.vstart[2]
 
-            def work(rows):
+            def work(rows, na=na, nb=nb):
                 return (np.empty((na, 3)), np.empty((nb, 3)), np.zeros((4, 3)), np.zeros(4, np.int64),
                         np.zeros(4, np.int64), np.zeros(4), np.empty(3), np.empty(3), np.empty((rows, 3)))
 
