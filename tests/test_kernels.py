@@ -389,3 +389,50 @@ def test_separated_beyond_bound_is_a_lower_bound_and_tightens_to_the_floor():
                     n += 1
                     above += lb > floor
     assert n >= 30 and above >= 0.9 * n, (above, n)
+
+
+def test_separated_beyond_resumed_second_call_equals_a_fresh_one():
+    """pair_window's second early-exit GJK call on the same poses resumes the first (issue 12, kernel cost).
+
+    Oracle: the same call started afresh (X with 4 rows: no resumable state). For every
+    first call (hi, target) that leaves the second call (target, floor) to be made, the
+    resumed result and the final direction v must be the fresh call's bit for bit, for
+    random cores (all kinds, curved and not) at random distances, including overlap.
+    """
+    rng = np.random.default_rng(20261124)
+    made, resumed = 0, 0
+    for ka, kb in KINDS + [("cylinder", "box"), ("ellipsoid", "hull")]:
+        for _ in range(12):
+            try:
+                shapes = [_random_shape(rng, ka).convex_shape(), _random_shape(rng, kb).convex_shape()]
+            except (KeyError, ValueError):
+                break
+            gp = pack_shapes([None, *shapes], [0, 1, 2])
+            Ra = Rotation.random(random_state=rng).as_matrix()
+            Rb = Rotation.random(random_state=rng).as_matrix()
+            pa = rng.uniform(-1, 1, 3)
+            pb = pa + rng.uniform(0.0, 1.5) * _unit(rng)
+            core_up = shape_distance(shapes[0], (Ra, pa), shapes[1], (Rb, pb)).upper
+            core_up += shapes[0].radius + shapes[1].radius
+            na = gp.vstart[2] - gp.vstart[1]
+            nb = gp.vstart[3] - gp.vstart[2]
+
+            def work(rows, na=na, nb=nb):
+                return (np.empty((na, 3)), np.empty((nb, 3)), np.zeros((4, 3)), np.zeros(4, np.int64),
+                        np.zeros(4, np.int64), np.zeros(4), np.empty(3), np.empty(3), np.empty((rows, 3)))
+
+            for f_hi, f_t, f_fl in ((2.0, 1.2, 0.5), (4.0, 1.05, 0.9), (1.5, 0.7, 0.2), (3.0, 1.0, -1.0)):
+                hi, target, floor = f_hi * abs(core_up) + 1e-3, f_t * abs(core_up), f_fl * abs(core_up)
+                ws = work(5)
+                ws[8][4, 2] = 0.0
+                lb1 = K.separated_beyond(gp, 1, Ra, pa, 2, Rb, pb, hi, target, 1e-15, 1e-15, *ws)
+                if lb1 > target or lb1 > floor:
+                    continue            # pair_window makes no second call
+                made += 1
+                resumed += ws[8][4, 2] == 1.0
+                lb2 = K.separated_beyond(gp, 1, Ra, pa, 2, Rb, pb, target, floor, 1e-15, 1e-15, *ws)
+                wf = work(4)
+                lbf = K.separated_beyond(gp, 1, Ra, pa, 2, Rb, pb, target, floor, 1e-15, 1e-15, *wf)
+                assert lb2 == lbf or (np.isnan(lb2) and np.isnan(lbf)), (ka, kb, lb2, lbf)
+                assert np.array_equal(ws[6], wf[6]), (ka, kb)
+    assert made >= 40 and resumed >= 20, (made, resumed)

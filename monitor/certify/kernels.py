@@ -99,7 +99,14 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
-from monitor.motion.kernel import _search_right, body_pose, pair_bound, pair_workspace, tree_bounds
+from monitor.motion.kernel import (
+    _bounds_core,
+    _search_right,
+    body_pose,
+    bounds_workspace,
+    pair_bound,
+    pair_workspace,
+)
 
 # ---------------------------------------------------------------------------- codes
 
@@ -242,42 +249,47 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     pack are passed (``gp.curve[g], gp.cparam[g], gp.cframe[g], gp.ccenter[g]``), not the pack:
     a compiled function typed on the 22-array pack costs several times more to compile.
     """
-    Rg = np.empty((3, 3))
-    c = np.empty(3)
-    for r in range(3):
-        c[r] = off[r]
-        for q in range(3):
-            c[r] += R[r, q] * ccenter[q]
-            acc = 0.0
-            for j in range(3):
-                acc += R[r, j] * cframe[j, q]
-            Rg[r, q] = acc
-    dl = np.empty(3)
-    for q in range(3):
-        dl[q] = sign * (Rg[0, q] * v[0] + Rg[1, q] * v[1] + Rg[2, q] * v[2])
-    val = sign * (c[0] * v[0] + c[1] * v[1] + c[2] * v[2])
-    loc = np.empty(3)
+    # (scalars, no scratch arrays: the same sums in the same order as the former loops over
+    # arrays, ``acc = 0.0; acc += ...``: x + a b + c d + e f is ((x + a b) + c d) + e f, so the same
+    # numbers bit for bit, -0.0 included; no helper function: one more compile; issue 12, kernel cost)
+    c0 = off[0] + R[0, 0] * ccenter[0] + R[0, 1] * ccenter[1] + R[0, 2] * ccenter[2]
+    c1 = off[1] + R[1, 0] * ccenter[0] + R[1, 1] * ccenter[1] + R[1, 2] * ccenter[2]
+    c2 = off[2] + R[2, 0] * ccenter[0] + R[2, 1] * ccenter[1] + R[2, 2] * ccenter[2]
+    g00 = 0.0 + R[0, 0] * cframe[0, 0] + R[0, 1] * cframe[1, 0] + R[0, 2] * cframe[2, 0]
+    g01 = 0.0 + R[0, 0] * cframe[0, 1] + R[0, 1] * cframe[1, 1] + R[0, 2] * cframe[2, 1]
+    g02 = 0.0 + R[0, 0] * cframe[0, 2] + R[0, 1] * cframe[1, 2] + R[0, 2] * cframe[2, 2]
+    g10 = 0.0 + R[1, 0] * cframe[0, 0] + R[1, 1] * cframe[1, 0] + R[1, 2] * cframe[2, 0]
+    g11 = 0.0 + R[1, 0] * cframe[0, 1] + R[1, 1] * cframe[1, 1] + R[1, 2] * cframe[2, 1]
+    g12 = 0.0 + R[1, 0] * cframe[0, 2] + R[1, 1] * cframe[1, 2] + R[1, 2] * cframe[2, 2]
+    g20 = 0.0 + R[2, 0] * cframe[0, 0] + R[2, 1] * cframe[1, 0] + R[2, 2] * cframe[2, 0]
+    g21 = 0.0 + R[2, 0] * cframe[0, 1] + R[2, 1] * cframe[1, 1] + R[2, 2] * cframe[2, 1]
+    g22 = 0.0 + R[2, 0] * cframe[0, 2] + R[2, 1] * cframe[1, 2] + R[2, 2] * cframe[2, 2]
+    d0 = sign * (g00 * v[0] + g10 * v[1] + g20 * v[2])
+    d1 = sign * (g01 * v[0] + g11 * v[1] + g21 * v[2])
+    d2 = sign * (g02 * v[0] + g12 * v[1] + g22 * v[2])
+    val = sign * (c0 * v[0] + c1 * v[1] + c2 * v[2])
     if curve == 1:
         rad, hh = cparam[0], cparam[1]
-        rho = math.sqrt(dl[0] * dl[0] + dl[1] * dl[1])
-        val += rad * rho + hh * abs(dl[2])
+        rho = math.sqrt(d0 * d0 + d1 * d1)
+        val += rad * rho + hh * abs(d2)
         if rho > 0.0:
-            loc[0], loc[1] = rad * dl[0] / rho, rad * dl[1] / rho
+            l0, l1 = rad * d0 / rho, rad * d1 / rho
         else:
-            loc[0], loc[1] = rad, 0.0
-        loc[2] = hh if dl[2] >= 0.0 else -hh
+            l0, l1 = rad, 0.0
+        l2 = hh if d2 >= 0.0 else -hh
     else:
-        e0, e1, e2 = cparam[0] * dl[0], cparam[1] * dl[1], cparam[2] * dl[2]
+        e0, e1, e2 = cparam[0] * d0, cparam[1] * d1, cparam[2] * d2
         nrm = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         val += nrm
         if nrm > 0.0:
-            loc[0] = cparam[0] * e0 / nrm
-            loc[1] = cparam[1] * e1 / nrm
-            loc[2] = cparam[2] * e2 / nrm
+            l0 = cparam[0] * e0 / nrm
+            l1 = cparam[1] * e1 / nrm
+            l2 = cparam[2] * e2 / nrm
         else:
-            loc[0], loc[1], loc[2] = cparam[0], 0.0, 0.0
-    for r in range(3):
-        pt[r] = c[r] + Rg[r, 0] * loc[0] + Rg[r, 1] * loc[1] + Rg[r, 2] * loc[2]
+            l0, l1, l2 = cparam[0], 0.0, 0.0
+    pt[0] = c0 + g00 * l0 + g01 * l1 + g02 * l2
+    pt[1] = c1 + g10 * l0 + g11 * l1 + g12 * l2
+    pt[2] = c2 + g20 * l0 + g21 * l1 + g22 * l2
     return val
 
 
@@ -300,7 +312,24 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
     only while that point is farther than ``floor`` (< target) and no bound above
     ``floor`` has been found, to tighten the bound the caller compares with ``floor``.
     Work arrays: VA, VB (>= vertex counts, 3), W (4, 3), IA, IB (4,) int64, lam (4,),
-    v, vn (3,), X (4, 3). Both geoms must be cores (no half-spaces). A circumscribed
+    v, vn (3,), X (4, 3) or (5, 3).
+
+    Resuming (X with 5 rows; issue 12, kernel cost): the caller's second call on the SAME
+    poses (exclusion first, then the witness floor; :func:`pair_window`) continues where the
+    first one returned instead of replaying its GJK iterations from the first vertices. Each
+    iteration starts by storing (k, best) in ``X[4, :2]`` and ``X[4, 2] = 1``; a return
+    before the simplex is changed leaves W, IA, IB, lam, v as they were at that iteration's
+    start, so a call with ``X[4, 2] == 1`` restarts exactly that iteration (returns after the
+    simplex changed set ``X[4, 2] = 0``: the next call starts afresh). This gives the same
+    result, bit for bit, as a fresh call: GJK's iterates do not depend on target / floor, and
+    when the second call's target is at most the first call's target and equal to its floor
+    (pair_window: (hi, target) then (target, floor)), a fresh second call cannot return at an
+    iterate the first one passed: it returns there only if lb > target2 (then the first
+    call's best exceeds target2, and the caller makes no second call) or if sv < target2 - pad
+    (then sv < target1 - pad and sv <= floor1, where the first call returned). The caller
+    clears ``X[4, 2]`` before a call on new poses.
+
+    Both geoms must be cores (no half-spaces). A circumscribed
     cylinder / ellipsoid (``gp.curve > 0``) is replaced by
     its exact geom through :func:`_curved_support`: the exact geom lies inside the polytope
     (checked when packing), so S (from the polytope's vertices) still bounds its
@@ -335,16 +364,26 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
         off_b[r] = pb[r] - pa[r]
     xa = X[2]
     xb = X[3]
-    best = -np.inf
-    k = 1
-    IA[0] = 0
-    IB[0] = 0
-    lam[0] = 1.0
-    for r in range(3):
-        W[0, r] = VA[0, r] - VB[0, r]
-        v[r] = W[0, r]
+    keep = X.shape[0] >= 5          # X[4]: (k, best, resumable) at the start of the last iteration
+    if keep and X[4, 2] == 1.0:
+        # resume the caller's previous call on these poses (see the docstring)
+        k = int(X[4, 0])
+        best = X[4, 1]
+    else:
+        best = -np.inf
+        k = 1
+        IA[0] = 0
+        IB[0] = 0
+        lam[0] = 1.0
+        for r in range(3):
+            W[0, r] = VA[0, r] - VB[0, r]
+            v[r] = W[0, r]
     vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
     for _it in range(64):
+        if keep:
+            X[4, 0] = k
+            X[4, 1] = best
+            X[4, 2] = 1.0
         if not vv > tiny * tiny:
             return best
         sv = math.sqrt(vv)
@@ -392,6 +431,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
         IA[k] = ia
         IB[k] = ib
         k += 1
+        if keep:
+            X[4, 2] = 0.0           # the simplex changes from here on: not resumable
         mask, inside = _subalgorithm(W, k, lam, vn, tiny_len2, tiny_area2)
         if inside:
             return best
@@ -406,20 +447,27 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _lever(P, ref):
-    """Max over the core vertices P (n, 3) of a geom of |v - ref| (body frame), padded.
+def _lever(P, ref, dist_out):
+    """Max over the points P (n, 3) of a geom of |v - ref| (body frame), padded; dist_out[i] = |P_i - ref|.
 
-    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]``, not the pack (compile cost).
+    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]`` (or its mass points), not the
+    pack (compile cost). ``dist_out`` (n,) is :func:`_rel_terms`'s ``dP`` (issue 12, kernel cost).
     """
     lv = 0.0
     for i in range(P.shape[0]):
-        lv = max(lv, _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2]))
+        d = _norm3(P[i, 0] - ref[0], P[i, 1] - ref[1], P[i, 2] - ref[2])
+        dist_out[i] = d
+        lv = max(lv, d)
     return lv * (1.0 + 4.0 * 2.0**-52)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
+def _rel_terms(P, dP, TA, chA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     """Relative displacement bound delta_rel over the rows of P (points of A, body frame).
+
+    ``dP`` (n,): |P_i - c_A| from :func:`_lever`, fixed for a pair and computed once per search
+    (the same expression as before, so the same numbers; it was one of the two square roots per
+    point and test: issue 12, kernel cost).
 
     Returns max_i delta_rel(P_i) if ``weighted == 0.0``, else sqrt(sum_i w_i delta_rel(P_i)^2) (= R).
     ``weighted`` is a float, not a bool: numba compiles a separate copy for each literal
@@ -434,7 +482,7 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     acc = 0.0
     for i in range(P.shape[0]):
         x0, x1, x2 = P[i, 0], P[i, 1], P[i, 2]
-        dA = _norm3(x0 - cA[0], x1 - cA[1], x2 - cA[2])
+        dA = dP[i]
         y0 = RA[0, 0] * x0 + RA[0, 1] * x1 + RA[0, 2] * x2 - qb0
         y1 = RA[1, 0] * x0 + RA[1, 1] * x1 + RA[1, 2] * x2 - qb1
         y2 = RA[2, 0] * x0 + RA[2, 1] * x1 + RA[2, 2] * x2 - qb2
@@ -454,13 +502,15 @@ def _rel_terms(P, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
 # callers still get a compiled pair_window. Small helpers stay separate functions (inlining them
 # per call site costs more compile time), and nothing Python never calls gets a CPython wrapper.
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
-def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws):
+def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
     Poses at the midpoint are written into (pA, RA), (pB, RB). ``levers`` (2,) are the
     precomputed max |v - ref| of A and B. ``stats[0]`` is incremented when a paper
     ball (§5, R rho_max) gives the smallest bound. Returns inf when nothing applies.
     ``pws``: :func:`monitor.motion.kernel.pair_workspace` scratch (allocated once per search).
+    ``dref``: (|v - c_A| over A's vertices, over A's mass points, the same for B) from
+    :func:`_lever` (once per search).
 
     Both bodies' motion bounds come from ONE :func:`monitor.motion.kernel.pair_bound` pass
     (the same numbers as two ``body_bound`` calls, without the second FK of their common
@@ -486,24 +536,24 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
         best = TA + chA * levers[0] + TB + chB * levers[1]
     if not hsA:
         PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
-        d = _rel_terms(PA, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, gp.mw, 0.0)
+        d = _rel_terms(PA, dref[0], TA, chA, RA, pA, TB, chB, cB, RB, pB, gp.mw, 0.0)
         if d < best:
             best = d
         M = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
         W = gp.mw[gp.mstart[ga]:gp.mstart[ga + 1]]
-        d = _rel_terms(M, TA, chA, cA, RA, pA, TB, chB, cB, RB, pB, W, 1.0) * gp.rho_max[ga]
+        d = _rel_terms(M, dref[1], TA, chA, RA, pA, TB, chB, cB, RB, pB, W, 1.0) * gp.rho_max[ga]
         if d < best:
             best = d
             paper = True
     if not hsB:
         PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
-        d = _rel_terms(PB, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, gp.mw, 0.0)
+        d = _rel_terms(PB, dref[2], TB, chB, RB, pB, TA, chA, cA, RA, pA, gp.mw, 0.0)
         if d < best:
             best = d
             paper = False
         M = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
         W = gp.mw[gp.mstart[gb]:gp.mstart[gb + 1]]
-        d = _rel_terms(M, TB, chB, cB, RB, pB, TA, chA, cA, RA, pA, W, 1.0) * gp.rho_max[gb]
+        d = _rel_terms(M, dref[3], TB, chB, RB, pB, TA, chA, cA, RA, pA, W, 1.0) * gp.rho_max[gb]
         if d < best:
             best = d
             paper = True
@@ -650,10 +700,21 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                   mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
+    # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
+    refA, refB = mp.ref_points[gp.body[ga]], mp.ref_points[gp.body[gb]]
+    PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+    PmA = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
+    PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+    PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
+    dref = (np.empty(PvA.shape[0]), np.empty(PmA.shape[0]), np.empty(PvB.shape[0]), np.empty(PmB.shape[0]))
+    lv_a = _lever(PvA, refA, dref[0])
+    _lever(PmA, refA, dref[1])
+    lv_b = _lever(PvB, refB, dref[2])
+    _lever(PmB, refB, dref[3])
     if gp.kind[ga] != -1:
-        levers[0] = _lever(gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]], mp.ref_points[gp.body[ga]])
+        levers[0] = lv_a
     if gp.kind[gb] != -1:
-        levers[1] = _lever(gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]], mp.ref_points[gp.body[gb]])
+        levers[1] = lv_b
     lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
     rsum = gp.radius[ga] + gp.radius[gb]
     VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
@@ -664,7 +725,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     lam = np.zeros(4)
     v = np.empty(3)
     vn = np.empty(3)
-    X = np.empty((4, 3))
+    X = np.empty((5, 3))           # row 4: separated_beyond's resumable state
     spent = 0
     sp = int(res[R_SP])
     mem = stack.shape[0] - 1       # last stack row: the step controller's memory (m, gap, valid)
@@ -725,7 +786,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             if b > a:
                 depth = max(0.0, math.ceil(math.log2(W / (b - a)) - 1e-9))
         m = 0.5 * (a + b)
-        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws)
+        bound = interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)
         spent += 1
         res[R_TESTS] += 1.0
         if depth > res[R_DEPTH]:
@@ -740,6 +801,7 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             floor = margin + rsum + approx
             floor += 2.0 * rel_pad * (abs(floor) + margin) + abs_pad
             lb = -np.inf
+            X[4, 2] = 0.0              # new poses: no separated_beyond state to resume
             if sweep:
                 # ask for _STEP_HEADROOM x the bound (a distance estimate for the step control);
                 # with floor = target, GJK returns a value > target whenever it can prove one
@@ -1041,10 +1103,14 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         trans = np.empty((T, nbody))
         ang = np.empty((T, nbody))
         step = (t1 - t0) / T      # the edges of np.linspace(t0, t1, T + 1), bit for bit
+        # tree_bounds per sub-range, with its scratch allocated once for the T calls (the same
+        # numbers: _bounds_core's result does not depend on the scratch's contents on entry)
+        need_all = np.ones(nbody, np.int64)
+        ws = bounds_workspace(mp)
         for t in range(T):
             ta = t * step + t0
             tb = t1 if t == T - 1 else (t + 1) * step + t0
-            tree_bounds(mp, ta, tb, pos[t], rot[t], trans[t], ang[t])
+            _bounds_core(mp, ta, tb, need_all, pos[t], rot[t], trans[t], ang[t], ws)
         mag = 0.0
         for t in range(T):
             for b in range(nbody):

@@ -141,42 +141,48 @@ def _subalgorithm(W, k, lam_out, v_out, tiny_len2, tiny_area2):
     Returns:
         (mask, inside): bit mask of the supporting sub-simplex; ``inside`` True
         when k == 4 and the origin lies in the tetrahedron (v_out = 0).
+
+    No array is allocated (issue 12, kernel cost: the nine scratch arrays of each call were
+    a third of an early-exit GJK's time): the cross and dot products are written out on
+    scalars with the same operations in the same order as ``_cross`` / ``_dot``, so the
+    results are bit for bit those of the array version; the running best is kept in
+    ``lam_out`` / ``v_out`` (zeros / the best point so far; only written, never read).
     """
     best = np.inf
     best_mask = 0
-    e = np.empty(3)
-    f = np.empty(3)
-    n = np.empty(3)
-    v = np.empty(3)
-    tmp = np.empty(3)
-    tmp2 = np.empty(3)
-    c = np.empty(3)
-    lam = np.zeros(4)
+    for q in range(4):
+        lam_out[q] = 0.0
     # tetrahedron: origin inside?
     if k == 4:
         # barycentric coordinates of the origin by signed volumes
-        vol = 0.0
-        lt = np.zeros(4)
-        for i in range(3):
-            e[i] = W[1, i] - W[0, i]
-            f[i] = W[2, i] - W[0, i]
-            tmp[i] = W[3, i] - W[0, i]
-        _cross(f, tmp, n)
-        vol = _dot(e, n)
+        e0, e1, e2 = W[1, 0] - W[0, 0], W[1, 1] - W[0, 1], W[1, 2] - W[0, 2]
+        f0, f1, f2 = W[2, 0] - W[0, 0], W[2, 1] - W[0, 1], W[2, 2] - W[0, 2]
+        g0, g1, g2 = W[3, 0] - W[0, 0], W[3, 1] - W[0, 1], W[3, 2] - W[0, 2]
+        # n = f x g
+        n0 = f1 * g2 - f2 * g1
+        n1 = f2 * g0 - f0 * g2
+        n2 = f0 * g1 - f1 * g0
+        vol = e0 * n0 + e1 * n1 + e2 * n2
         if vol != 0.0:
             # lam_j = det with column j replaced by -W0
-            for i in range(3):
-                c[i] = -W[0, i]
-            _cross(f, tmp, n)
-            lt[1] = _dot(c, n) / vol
-            _cross(c, tmp, n)
-            lt[2] = _dot(e, n) / vol
-            _cross(f, c, n)
-            lt[3] = _dot(e, n) / vol
-            lt[0] = 1.0 - lt[1] - lt[2] - lt[3]
-            if lt[0] >= 0.0 and lt[1] >= 0.0 and lt[2] >= 0.0 and lt[3] >= 0.0:
-                for j in range(4):
-                    lam_out[j] = lt[j]
+            c0, c1, c2 = -W[0, 0], -W[0, 1], -W[0, 2]
+            lt1 = (c0 * n0 + c1 * n1 + c2 * n2) / vol
+            # n = c x g
+            m0 = c1 * g2 - c2 * g1
+            m1 = c2 * g0 - c0 * g2
+            m2 = c0 * g1 - c1 * g0
+            lt2 = (e0 * m0 + e1 * m1 + e2 * m2) / vol
+            # n = f x c
+            m0 = f1 * c2 - f2 * c1
+            m1 = f2 * c0 - f0 * c2
+            m2 = f0 * c1 - f1 * c0
+            lt3 = (e0 * m0 + e1 * m1 + e2 * m2) / vol
+            lt0 = 1.0 - lt1 - lt2 - lt3
+            if lt0 >= 0.0 and lt1 >= 0.0 and lt2 >= 0.0 and lt3 >= 0.0:
+                lam_out[0] = lt0
+                lam_out[1] = lt1
+                lam_out[2] = lt2
+                lam_out[3] = lt3
                 v_out[0] = 0.0
                 v_out[1] = 0.0
                 v_out[2] = 0.0
@@ -188,80 +194,79 @@ def _subalgorithm(W, k, lam_out, v_out, tiny_len2, tiny_area2):
             best = d
             best_mask = 1 << i
             for j in range(4):
-                lam[j] = 0.0
-            lam[i] = 1.0
+                lam_out[j] = 0.0
+            lam_out[i] = 1.0
             for j in range(3):
-                v[j] = W[i, j]
+                v_out[j] = W[i, j]
     # edges
     for i in range(k):
         for j in range(i + 1, k):
-            for r in range(3):
-                e[r] = W[j, r] - W[i, r]
-            ee = _dot(e, e)
+            e0, e1, e2 = W[j, 0] - W[i, 0], W[j, 1] - W[i, 1], W[j, 2] - W[i, 2]
+            ee = e0 * e0 + e1 * e1 + e2 * e2
             if ee <= tiny_len2:
                 continue
-            t = -(_dot(W[i], e)) / ee
+            t = -(W[i, 0] * e0 + W[i, 1] * e1 + W[i, 2] * e2) / ee
             if not (t > 0.0 and t < 1.0):
                 continue
-            for r in range(3):
-                tmp[r] = W[i, r] + t * e[r]
+            p0, p1, p2 = W[i, 0] + t * e0, W[i, 1] + t * e1, W[i, 2] + t * e2
             # re-orthogonalise: removes the along-edge rounding residue
-            s = _dot(tmp, e) / ee
-            for r in range(3):
-                tmp[r] -= s * e[r]
-            d = _dot(tmp, tmp)
+            s = (p0 * e0 + p1 * e1 + p2 * e2) / ee
+            p0 -= s * e0
+            p1 -= s * e1
+            p2 -= s * e2
+            d = p0 * p0 + p1 * p1 + p2 * p2
             if d < best:
                 best = d
                 best_mask = (1 << i) | (1 << j)
                 for q in range(4):
-                    lam[q] = 0.0
-                lam[i] = 1.0 - t
-                lam[j] = t
-                for r in range(3):
-                    v[r] = tmp[r]
+                    lam_out[q] = 0.0
+                lam_out[i] = 1.0 - t
+                lam_out[j] = t
+                v_out[0] = p0
+                v_out[1] = p1
+                v_out[2] = p2
     # triangles
     for i in range(k):
         for j in range(i + 1, k):
             for m in range(j + 1, k):
-                for r in range(3):
-                    e[r] = W[j, r] - W[i, r]
-                    f[r] = W[m, r] - W[i, r]
-                _cross(e, f, n)
-                nn = _dot(n, n)
+                e0, e1, e2 = W[j, 0] - W[i, 0], W[j, 1] - W[i, 1], W[j, 2] - W[i, 2]
+                f0, f1, f2 = W[m, 0] - W[i, 0], W[m, 1] - W[i, 1], W[m, 2] - W[i, 2]
+                n0 = e1 * f2 - e2 * f1
+                n1 = e2 * f0 - e0 * f2
+                n2 = e0 * f1 - e1 * f0
+                nn = n0 * n0 + n1 * n1 + n2 * n2
                 if nn <= tiny_area2:
                     continue
-                s = _dot(n, W[i]) / nn
-                for r in range(3):
-                    tmp[r] = s * n[r]
-                # barycentric coordinates of tmp (in the plane) by signed areas
-                for r in range(3):
-                    e[r] = W[j, r] - tmp[r]
-                    f[r] = W[m, r] - tmp[r]
-                _cross(e, f, tmp2)
-                li = _dot(tmp2, n) / nn
-                for r in range(3):
-                    e[r] = W[m, r] - tmp[r]
-                    f[r] = W[i, r] - tmp[r]
-                _cross(e, f, tmp2)
-                lj = _dot(tmp2, n) / nn
+                s = (n0 * W[i, 0] + n1 * W[i, 1] + n2 * W[i, 2]) / nn
+                p0, p1, p2 = s * n0, s * n1, s * n2
+                # barycentric coordinates of p (in the plane) by signed areas
+                e0, e1, e2 = W[j, 0] - p0, W[j, 1] - p1, W[j, 2] - p2
+                f0, f1, f2 = W[m, 0] - p0, W[m, 1] - p1, W[m, 2] - p2
+                x0 = e1 * f2 - e2 * f1
+                x1 = e2 * f0 - e0 * f2
+                x2 = e0 * f1 - e1 * f0
+                li = (x0 * n0 + x1 * n1 + x2 * n2) / nn
+                e0, e1, e2 = W[m, 0] - p0, W[m, 1] - p1, W[m, 2] - p2
+                f0, f1, f2 = W[i, 0] - p0, W[i, 1] - p1, W[i, 2] - p2
+                x0 = e1 * f2 - e2 * f1
+                x1 = e2 * f0 - e0 * f2
+                x2 = e0 * f1 - e1 * f0
+                lj = (x0 * n0 + x1 * n1 + x2 * n2) / nn
                 lm = 1.0 - li - lj
                 if not (li > 0.0 and lj > 0.0 and lm > 0.0):
                     continue
-                d = _dot(tmp, tmp)
+                d = p0 * p0 + p1 * p1 + p2 * p2
                 if d < best:
                     best = d
                     best_mask = (1 << i) | (1 << j) | (1 << m)
                     for q in range(4):
-                        lam[q] = 0.0
-                    lam[i] = li
-                    lam[j] = lj
-                    lam[m] = lm
-                    for r in range(3):
-                        v[r] = tmp[r]
-    for q in range(4):
-        lam_out[q] = lam[q]
-    for r in range(3):
-        v_out[r] = v[r]
+                        lam_out[q] = 0.0
+                    lam_out[i] = li
+                    lam_out[j] = lj
+                    lam_out[m] = lm
+                    v_out[0] = p0
+                    v_out[1] = p1
+                    v_out[2] = p2
     return best_mask, False
 
 
@@ -365,29 +370,29 @@ def _tetra_inradius(W, pad_coord, rel_pad):
     ``pad_coord`` bounds the coordinate error of every W row; the plane
     distance pads cover that perturbation and the cross-product rounding.
     """
-    e = np.empty(3)
-    f = np.empty(3)
-    n = np.empty(3)
-    g = np.empty(3)
+    # (scalars, no scratch arrays: the same operations in the same order as _cross / _dot,
+    # so the same numbers bit for bit; issue 12, kernel cost)
     r_min = np.inf
     for o in range(4):
         i = (o + 1) % 4
         j = (o + 2) % 4
         m = (o + 3) % 4
-        for r in range(3):
-            e[r] = W[j, r] - W[i, r]
-            f[r] = W[m, r] - W[i, r]
-            g[r] = W[o, r] - W[i, r]
-        _cross(e, f, n)
-        nn = np.sqrt(_dot(n, n))
+        e0, e1, e2 = W[j, 0] - W[i, 0], W[j, 1] - W[i, 1], W[j, 2] - W[i, 2]
+        f0, f1, f2 = W[m, 0] - W[i, 0], W[m, 1] - W[i, 1], W[m, 2] - W[i, 2]
+        g0, g1, g2 = W[o, 0] - W[i, 0], W[o, 1] - W[i, 1], W[o, 2] - W[i, 2]
+        n0 = e1 * f2 - e2 * f1
+        n1 = e2 * f0 - e0 * f2
+        n2 = e0 * f1 - e1 * f0
+        nn = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
         if not nn > 0.0:
             return 0.0
         # outward: away from the opposite vertex
-        sgn = -1.0 if _dot(n, g) > 0.0 else 1.0
-        dist = sgn * _dot(n, W[i]) / nn  # distance from origin to the plane, + if inside
-        le = np.sqrt(_dot(e, e))
-        lf = np.sqrt(_dot(f, f))
-        lw = np.sqrt(_dot(W[i], W[i]))
+        sgn = -1.0 if n0 * g0 + n1 * g1 + n2 * g2 > 0.0 else 1.0
+        # distance from origin to the plane, + if inside
+        dist = sgn * (n0 * W[i, 0] + n1 * W[i, 1] + n2 * W[i, 2]) / nn
+        le = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        lf = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
+        lw = np.sqrt(W[i, 0] * W[i, 0] + W[i, 1] * W[i, 1] + W[i, 2] * W[i, 2])
         dn = 4.0 * pad_coord * (le + lf) + 4.0 * rel_pad * le * lf
         pad = pad_coord + 2.0 * dn * lw / nn + rel_pad * abs(dist)
         r = dist - pad
@@ -404,21 +409,21 @@ def _face_plane(P, i, j, k, pad_coord, rel_pad, nout):
     (positive when the origin is on the inner side) and that distance minus a pad
     covering vertex perturbations of ``pad_coord`` and the cross-product rounding.
     """
-    e = np.empty(3)
-    f = np.empty(3)
-    for r in range(3):
-        e[r] = P[j, r] - P[i, r]
-        f[r] = P[k, r] - P[i, r]
-    _cross(e, f, nout)
-    nn = np.sqrt(_dot(nout, nout))
+    # (scalars, no scratch arrays: the same operations in the same order as _cross / _dot)
+    e0, e1, e2 = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+    f0, f1, f2 = P[k, 0] - P[i, 0], P[k, 1] - P[i, 1], P[k, 2] - P[i, 2]
+    nout[0] = e1 * f2 - e2 * f1
+    nout[1] = e2 * f0 - e0 * f2
+    nout[2] = e0 * f1 - e1 * f0
+    nn = np.sqrt(nout[0] * nout[0] + nout[1] * nout[1] + nout[2] * nout[2])
     if not nn > 0.0:
         return -np.inf, -np.inf
     for r in range(3):
         nout[r] /= nn
-    dist = _dot(nout, P[i])
-    le = np.sqrt(_dot(e, e))
-    lf = np.sqrt(_dot(f, f))
-    lw = np.sqrt(_dot(P[i], P[i]))
+    dist = nout[0] * P[i, 0] + nout[1] * P[i, 1] + nout[2] * P[i, 2]
+    le = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    lf = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
+    lw = np.sqrt(P[i, 0] * P[i, 0] + P[i, 1] * P[i, 1] + P[i, 2] * P[i, 2])
     dn = 4.0 * pad_coord * (le + lf) + 4.0 * rel_pad * le * lf
     pad = pad_coord + 2.0 * dn * lw / nn + 2.0 * rel_pad * (abs(dist) + lw)
     return dist, dist - pad
@@ -789,7 +794,12 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
             tA (add tA for world), pad, iterations.
     """
     any_polytope = kind_a == KIND_POLYTOPE or kind_b == KIND_POLYTOPE
-    xc = np.empty(3)
+    # the scratch vectors as rows of three arrays (three allocations instead of fifteen; the rows
+    # are C-contiguous, so the helpers keep their one specialisation; issue 12, kernel cost)
+    fbuf = np.zeros((15, 3))
+    ibuf = np.zeros((4, 4), np.int64)
+    lbuf = np.zeros((2, 4))
+    xc = fbuf[14]
     na = PA.shape[0]
     nb = PB.shape[0]
     VA, VB, WNA, WNB = pose_relative(PA, RA, tA, NA, PB, RB, tB, NB)
@@ -806,18 +816,18 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
     tiny_len2 = (1e-14 * S) ** 2
     tiny_area2 = (1e-14 * S * S) ** 2
 
-    W = np.zeros((4, 3))
-    IA = np.zeros(4, np.int64)
-    IB = np.zeros(4, np.int64)
-    lam = np.zeros(4)
-    v = np.empty(3)
-    vn = np.empty(3)
-    w = np.empty(3)
+    W = fbuf[0:4]
+    IA = ibuf[0]
+    IB = ibuf[1]
+    lam = lbuf[0]
+    v = fbuf[8]
+    vn = fbuf[9]
+    w = fbuf[10]
     # best snapshot
-    bW = np.zeros((4, 3))
-    bIA = np.zeros(4, np.int64)
-    bIB = np.zeros(4, np.int64)
-    blam = np.zeros(4)
+    bW = fbuf[4:8]
+    bIA = ibuf[2]
+    bIB = ibuf[3]
+    blam = lbuf[1]
     # start: the pair of first vertices
     k = 1
     IA[0] = 0
@@ -893,9 +903,9 @@ def core_distance(PA, RA, tA, EA, NA, PB, RB, tB, EB, NB, kind_a, kind_b, dpad_a
     ls = 0.0
     for q in range(k):
         ls += lam[q]
-    pa = np.zeros(3)
-    pb = np.zeros(3)
-    dv = np.zeros(3)
+    pa = fbuf[11]
+    pb = fbuf[12]
+    dv = fbuf[13]
     lw = 0.0
     for q in range(k):
         lq = lam[q] / ls

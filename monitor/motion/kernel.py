@@ -271,7 +271,8 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         body_jntadr: np.ndarray, body_jntnum: np.ndarray, jnt_type: np.ndarray, jnt_qposadr: np.ndarray,
         jnt_pos: np.ndarray, jnt_axis: np.ndarray, jnt_axis_norm: np.ndarray, qpos0: np.ndarray,
         q: np.ndarray, need: np.ndarray, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray,
-        janchor: np.ndarray, jaxis: np.ndarray, jframe: np.ndarray) -> None:
+        janchor: np.ndarray, jaxis: np.ndarray, jframe: np.ndarray, tmp3: np.ndarray,
+        qloc: np.ndarray) -> None:
     """MuJoCo's mj_kinematics for the bodies with need[b] != 0 (their ancestors must be needed too).
 
     Args:
@@ -280,10 +281,10 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         xpos, xquat, xmat: (nbody, 3), (nbody, 4), (nbody, 3, 3) outputs (world).
         janchor, jaxis: (njnt, 3) world joint anchors and (unnormalised) axes, before each joint acts.
         jframe: (njnt, 4) world orientation of the frame each joint acts in (before the joint).
+        tmp3, qloc: (>= 3,), (4,) scratch (contents on entry do not matter; passed in so that
+            the bound kernels' per-sub-interval FK allocates nothing: issue 12, kernel cost).
     """
     nbody = xpos.shape[0]
-    tmp3 = np.empty(3)
-    qloc = np.empty(4)
     for b in range(nbody):
         if need[b] == 0:
             continue
@@ -372,23 +373,37 @@ def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
-    """World pose of ``body`` at time ``t``: origin p_W_out (3,) m and rotation R_WB_out (3, 3)."""
+    """World pose of ``body`` at time ``t``: origin p_W_out (3,) m and rotation R_WB_out (3, 3).
+
+    The float scratch is one array carved into C-contiguous views (two allocations instead of
+    ten; the views have the types of the former arrays, so ``_fk`` keeps one specialisation;
+    issue 12, kernel cost: ``window_kernel`` calls this twice per surviving pair).
+    """
     nbody = mp.body_parent.shape[0]
     njnt = mp.jnt_type.shape[0]
+    nq = mp.qpos.shape[1]
     need = np.empty(nbody, dtype=np.int64)
     _ancestors(mp.body_parent, body, need)
-    q = np.empty(mp.qpos.shape[1])
+    buf = np.empty(nq + 16 * nbody + 10 * njnt + 8)
+    o = nq
+    q = buf[0:o]
+    xpos = buf[o:o + 3 * nbody].reshape((nbody, 3))
+    o += 3 * nbody
+    xquat = buf[o:o + 4 * nbody].reshape((nbody, 4))
+    o += 4 * nbody
+    xmat = buf[o:o + 9 * nbody].reshape((nbody, 3, 3))
+    o += 9 * nbody
+    ja = buf[o:o + 3 * njnt].reshape((njnt, 3))
+    o += 3 * njnt
+    jx = buf[o:o + 3 * njnt].reshape((njnt, 3))
+    o += 3 * njnt
+    jf = buf[o:o + 4 * njnt].reshape((njnt, 4))
+    o += 4 * njnt
     i, s, at_end = _locate(mp.times, t)
     _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
-    xpos = np.empty((nbody, 3))
-    xquat = np.empty((nbody, 4))
-    xmat = np.empty((nbody, 3, 3))
-    ja = np.empty((njnt, 3))
-    jx = np.empty((njnt, 3))
-    jf = np.empty((njnt, 4))
     _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
         mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
-        q, need, xpos, xquat, xmat, ja, jx, jf)
+        q, need, xpos, xquat, xmat, ja, jx, jf, buf[o:o + 4], buf[o + 4:o + 8])
     for r in range(3):
         p_W_out[r] = xpos[body, r]
         for c in range(3):
@@ -410,7 +425,7 @@ def tree_poses(mp, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray) -> None:
     jf = np.empty((njnt, 4))
     _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
         mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
-        q, need, p_W_out, xquat, R_WB_out, ja, jx, jf)
+        q, need, p_W_out, xquat, R_WB_out, ja, jx, jf, np.empty(4), np.empty(4))
 
 
 # ------------------------------------------------------------------ joint deviations
@@ -607,7 +622,7 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, lm[0], lm[1], lm[2], qm)
     _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum, mp.jnt_type,
         mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
-        qm, need, xpos, xquat, xmat, janchor, jaxis, jframe)
+        qm, need, xpos, xquat, xmat, janchor, jaxis, jframe, om, qu)   # (om, qu: scratch until set below)
 
     # Single-segment sub-interval: the velocity bound applies.
     seg = lm[0]
