@@ -9,18 +9,22 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import sys
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 
 import monitor
-from monitor.bench.cases import make_cases
 from monitor.bench.suites import scaling_scene
 from monitor.certify import engine
 from monitor.certify import kernels as K
 from monitor.certify.broadphase import sphere_pair_gaps, swept_geom_spheres
 from monitor.certify.certificate import Certificate
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench_cases import quick_cases  # noqa: E402  (the bench's quick set, built once per process)
 
 _HINGE_XML = """<mujoco><worldbody>
   <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.5 0 0"/>
@@ -48,7 +52,7 @@ def test_same_pairs_as_the_python_pipeline_on_the_peers_cases(monkeypatch):
     numpy, equal up to rounding) and a whole-shape witness's point / distance (the kernel's
     exact static test at the same time instead of the Python re-confirmation; both below
     the margin)."""
-    cases = [c for c in make_cases(seed=7, quick=True) if "1e-04" not in c.name]  # 1e-4: fat-feature checker
+    cases = [c for c in quick_cases() if "1e-04" not in c.name]  # 1e-4: fat-feature checker
     assert len(cases) >= 20
     for c in cases:
         scene, bm = c.scene(16), c.body_motion()
@@ -134,7 +138,7 @@ def test_new_trajectory_objects_never_reuse_a_dead_ones_pack():
 
 
 def test_lazy_pairs_read_like_a_tuple(monkeypatch):
-    c = [c for c in make_cases(seed=7, quick=True) if c.name == "rot-box-box-collide"][0]
+    c = [c for c in quick_cases() if c.name == "rot-box-box-collide"][0]
     scene, bm = c.scene(16), c.body_motion()
     fast, old = _both(monkeypatch, scene, bm, method="toleranced")
     assert "_pairs_store" in fast.__dict__ and not isinstance(fast.__dict__["_pairs_store"], tuple)
