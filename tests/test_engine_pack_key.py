@@ -91,3 +91,28 @@ def test_mocap_rows_are_not_part_of_the_key():
     bp = mp.body_pos.copy()
     bp[4] += 0.25                                                   # the mocap body's held pose
     assert PK.static_key(mp._replace(body_pos=bp), st) == PK.static_key(mp, st)
+
+
+def test_cached_kernel_parameter_row_is_never_written():
+    """``engine._plan_inputs`` keeps the kernel's ``prm`` row per plan and reuses it on later calls.
+
+    That is sound only while ``window_kernel`` reads ``prm`` and never writes it: after calls with
+    two margins on one plan, each cached row must still hold exactly the values it was built from.
+    """
+    from monitor.certify import engine
+    from monitor.certify.kernels import trajectory_pack_memo
+
+    model = mujoco.MjModel.from_xml_string(_XML.format(mocap=""))
+    scene = monitor.Scene.from_model(model, pairs="all")
+    q0 = model.qpos0.copy()
+    q1 = q0.copy()
+    q1[0] += 0.4
+    plan = monitor.Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), model=model)
+    for margin in (0.0, 0.01, 0.0):
+        monitor.certify(scene, plan, margin=margin, epsilon=1e-3)
+        _, memo = trajectory_pack_memo(plan)
+        t0, t1, m, eps, tol, prm = memo["prm"]
+        assert m == margin
+        want = np.array([t0, t1, m, eps, tol.rel_pad, tol.abs_pad, tol.scale_pad, float(tol.max_depth),
+                         float(engine._kernels().WHOLE_SHAPE_MAX_TESTS)])
+        np.testing.assert_array_equal(prm, want)
