@@ -11,6 +11,9 @@ import numpy as np
 
 from monitor.bench.cases import make_cases
 
+QUICK_CASES_GROUP = "bench_quick_cases"
+"""``xdist_group`` of the fast tests that read :func:`quick_cases`: one worker builds the set once."""
+
 
 @functools.cache
 def quick_cases(seed: int = 7) -> tuple:

@@ -22,7 +22,7 @@ from monitor.geometry.polytope import box_polytope, capsule_shape, polytope_from
 from monitor.tolerances import DEFAULT
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _bench_cases import quick_cases  # noqa: E402  (the quick set, built once per process)
+from _bench_cases import QUICK_CASES_GROUP, quick_cases  # noqa: E402  (the quick set, built once per process)
 
 PAPER_PATH = ("sbounds", "divide_and_conquer", "null_set")
 
@@ -191,6 +191,7 @@ def test_null_set_path_issues_most_certificates_on_seeded_set():
     assert paper > exact and null > exact
 
 
+@pytest.mark.xdist_group(QUICK_CASES_GROUP)
 def test_null_set_path_issues_most_certificates_on_bench_cases():
     """The translating group of monitor.bench.cases (quick set) through monitor.certify."""
     pytest.importorskip("mujoco")

@@ -24,7 +24,7 @@ from monitor.certify.broadphase import sphere_pair_gaps, swept_geom_spheres
 from monitor.certify.certificate import Certificate
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _bench_cases import quick_cases  # noqa: E402  (the bench's quick set, built once per process)
+from _bench_cases import QUICK_CASES_GROUP, quick_cases  # noqa: E402  (the bench's quick set, built once per process)
 
 _HINGE_XML = """<mujoco><worldbody>
   <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.5 0 0"/>
@@ -45,6 +45,7 @@ def _both(monkeypatch, scene, plan, **kw):
     return fast, old
 
 
+@pytest.mark.xdist_group(QUICK_CASES_GROUP)
 def test_same_pairs_as_the_python_pipeline_on_the_peers_cases(monkeypatch):
     """Verdicts, methods, intervals, clearances and witness times equal the Python pipeline's.
 
@@ -137,6 +138,7 @@ def test_new_trajectory_objects_never_reuse_a_dead_ones_pack():
         bm.times[1] = 0.2
 
 
+@pytest.mark.xdist_group(QUICK_CASES_GROUP)
 def test_lazy_pairs_read_like_a_tuple(monkeypatch):
     c = [c for c in quick_cases() if c.name == "rot-box-box-collide"][0]
     scene, bm = c.scene(16), c.body_motion()
