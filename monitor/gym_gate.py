@@ -162,6 +162,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             gymnasium's step-determinism check in ``check_env``; the time is always
             in ``gate.last_report.certify_us`` and ``gate.summary()``.
         brake: recoverability check with a committed brake (see :class:`monitor.Gate`).
+        brake_horizon: longest braking tail (s of simulation time, default 0.25): a tail
+            shorter than the robot's stopping time leaves it unable to stop before an
+            obstacle (docs/notes/session-2026-11-24-late/horizon_sweep.py); see :class:`monitor.Gate`.
         allowed, hazards, allow, ongoing, penetration_tol: pair policy and the
             ongoing-contact rule, see :class:`monitor.Gate` (defaults ``"auto"``, None,
             None, ``"deepen"``, 0.005 m).
@@ -177,12 +180,12 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                  on_violation: str = "block", fallback: Any = None, budget: Any = None, log: Any = None,
                  unsafe: str = "uncertain", timing: bool = False, brake: bool = True,
                  allowed: Any = "auto", hazards: Any = None, allow: Any = None, ongoing: str = "deepen",
-                 penetration_tol: float = DEFAULT_PENETRATION_TOL) -> None:
+                 penetration_tol: float = DEFAULT_PENETRATION_TOL, brake_horizon: float = 0.25) -> None:
         gymnasium.utils.RecordConstructorArgs.__init__(
             self, predictor=predictor, pairs=pairs, margin=margin, epsilon=epsilon,
             on_violation=on_violation, fallback=fallback, budget=budget, log=log, unsafe=unsafe,
             timing=timing, brake=brake, allowed=allowed, hazards=hazards, allow=allow, ongoing=ongoing,
-            penetration_tol=penetration_tol)
+            penetration_tol=penetration_tol, brake_horizon=brake_horizon)
         gymnasium.Wrapper.__init__(self, env)
         u = env.unwrapped
         model, data = getattr(u, "model", None), getattr(u, "data", None)
@@ -227,7 +230,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          fallback=gate_fallback, brake=brake,
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
                          action_shape=inner_shape, allowed=allowed, hazards=hazards, allow=allow,
-                         ongoing=ongoing, penetration_tol=penetration_tol)
+                         ongoing=ongoing, penetration_tol=penetration_tol, brake_horizon=brake_horizon)
         self._unwrapped = u
         self._obs: Any = None
         self._commit_ok = predictor == "rollout" and _steps_like_mujoco_env(u)
