@@ -30,9 +30,8 @@ def ncon_between(m, d, a, b):
 def run(policy, horizon):
     env = gym.make("monitor/Arm-v0", max_episode_steps=STEPS + 1)
     if horizon is not None:
-        env = SafetyGate(env, on_violation="block", brake=horizon != 0)
-        if horizon:   # SafetyGate does not take brake_horizon: set the Gate's step count as Gate() would
-            env.gate.brake_steps = max(1, int(np.ceil(horizon / env.unwrapped.model.opt.timestep)))
+        kw = {"brake_horizon": horizon} if horizon else {"brake": False}
+        env = SafetyGate(env, on_violation="block", **kw)
     u = env.unwrapped
     m = u.model
     body_of = [m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)]
