@@ -9,7 +9,6 @@ import sys
 import time
 
 import gymnasium as gym
-import mujoco
 import numpy as np
 
 import monitor.envs  # noqa: F401
