@@ -1086,8 +1086,9 @@ class Gate:
         """The file the gate writes (None until the first window, or when not logging to a path)."""
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
-                      "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0, "committed": 0, "joint": 0}
+                      "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
+                      "tail_replay_differs": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0,
+                      "committed": 0, "joint": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -1434,16 +1435,20 @@ class Gate:
         """The committed tail's certificate if it contains the next ``n`` substeps.
 
         That is the case when the live state equals a tail waypoint bit for bit
-        (time, qpos, qvel, mocap) and the window ends inside the tail: the
-        committed brake then reproduces the tail exactly, and margin, epsilon,
-        tolerances and the scene version are those the tail was certified under.
-        Else None.
+        (time, qpos, qvel, mocap), the window ends inside the tail, margin, epsilon,
+        tolerances and the scene version are those the tail was certified under, and
+        the window of the committed brake, integrated now from the live data with the
+        live model (:meth:`Rollout._window`), gives the tail's next ``n`` rows (time,
+        qpos) bit for bit. The replay is what makes the reuse sound: a state equal to a
+        tail waypoint does not imply the same motion after an in-place edit of the
+        dynamics (``opt.gravity``, ``opt.timestep``, gains, masses, damping: none is in
+        the scene version). It leaves the scratch holding the applied window, so the
+        caller commits it instead of stepping again. Else None.
         """
         if self._tail is None or self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
-        plan, cert, qvel = self._tail
-        if isinstance(plan, _Tail):
-            plan = plan.plan  # built now, on the rare path that reads it
+        tail, cert, qvel = self._tail
+        plan = tail.plan  # built now, on the rare path that reads it
         if not cert.certified:
             return None
         hits = np.flatnonzero(plan.times == data.time)
@@ -1455,6 +1460,11 @@ class Gate:
                 or qvel[k].tobytes() != data.qvel.tobytes()
                 or plan.mocap_pos.tobytes() != data.mocap_pos.tobytes()
                 or plan.mocap_quat.tobytes() != data.mocap_quat.tobytes()):
+            return None
+        # replay: the brake's window under the live model must be the certified tail's rows
+        rows = self._rollout._window(data, self._committed, n)
+        if rows[1:].tobytes() != np.ascontiguousarray(tail.rows[k + 1:k + n + 1]).tobytes():
+            self.stats["tail_replay_differs"] += 1
             return None
         return cert
 
@@ -1536,13 +1546,13 @@ class Gate:
                 # no proposal can ever be rejected, so the tail and its brake are never used.
                 brake_verdict = "certified"
             elif not unsafe and brake_on:
-                if tail is None:
-                    tail, brake_next, tail_qvel = self._rollout.brake_tail(
+                if tail is None:  # raw rows kept: a committed tail is replayed against them (_tail_covers)
+                    rows, brake_next = self._rollout.brake_rows(
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
-                else:  # simulated for the joint call
-                    tail = tail.plan
-                tail_cert, tail_us = self._certify(tail)
+                    tail = _Tail(rows, self.model, data)
+                    tail_qvel = tail.qvel
+                tail_cert, tail_us = self._certify(tail.plan)
                 us += tail_us
                 brake_verdict = tail_cert.verdict
                 if self.is_unsafe(brake_verdict):

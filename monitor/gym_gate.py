@@ -357,6 +357,47 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{type(self.env.unwrapped).__name__}, or its step, changed the action in a way the gate "
                 "cannot predict; the window that ran was not certified")
 
+    def _live_frame_skip(self) -> int:
+        """The env's ``frame_skip`` as it is now (read every step; a user may change it after construction).
+
+        The gate certifies windows of this many substeps: a count read once at construction
+        would certify a shorter window than the env then simulates.
+
+        Raises:
+            InvalidInputError: ``env.unwrapped.frame_skip`` is not an integer >= 1.
+        """
+        fs = getattr(self._unwrapped, "frame_skip", 1)
+        if isinstance(fs, (bool, np.bool_)) or not isinstance(fs, (int, np.integer)) or fs < 1:
+            raise InvalidInputError(f"env.unwrapped.frame_skip must be an integer >= 1, got {fs!r}")
+        fs = int(fs)
+        if fs != self.gate.frame_skip:
+            self.gate.frame_skip = fs
+        return fs
+
+    def _check_elapsed(self, t_start: float, nstep: int) -> None:
+        """Raise if the env simulated past the certified window's end (rollout predictor).
+
+        ``mj_step`` advances ``data.time`` by ``opt.timestep`` per substep; the same float
+        additions from the window's start time give the certified window's end time. An env
+        whose ``step`` simulates more substeps (``do_simulation`` called twice, an extra
+        ``mj_step``, another count than ``frame_skip``) ran a motion the gate did not
+        certify: never silently. Fewer substeps under the certified control are a prefix of
+        the certified window (an env simulating its own way, or not at all, is not refused).
+        """
+        if self.predictor_mode != "rollout":
+            return
+        dt = self._unwrapped.model.opt.timestep
+        t_end = t_start
+        for _ in range(nstep):
+            t_end += dt
+        t_now = float(self._unwrapped.data.time)
+        if t_now > t_end:
+            raise InvalidInputError(
+                f"env: the step advanced data.time from {t_start!r} to {t_now!r} s, but the gate certified "
+                f"{nstep} substep(s) of {dt!r} s (to {t_end!r} s): {type(self._unwrapped).__name__}.step "
+                "simulated another motion than the certified window (e.g. do_simulation called twice or "
+                "with another count than frame_skip); the extra motion was not certified")
+
     def _fallback_fn(self) -> Callable[[], np.ndarray] | None:
         fb = self.user_fallback
         if fb is None:
@@ -387,9 +428,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             raise InvalidInputError(f"action contains NaN or inf: {arr}")
         if self.action_chain:
             action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
-        report: StepReport = self.gate.decide(self._unwrapped.data, action, predict=self._predict_fn(),
-                                              fallback=self._fallback_fn(), cast=self._as_inner)
         u = self._unwrapped
+        nstep = self._live_frame_skip()
+        t_start = float(u.data.time)
+        report: StepReport = self.gate.decide(u.data, action, nstep=nstep, predict=self._predict_fn(),
+                                              fallback=self._fallback_fn(), cast=self._as_inner)
         hook = self._commit_ok and self.commit and "_step_mujoco_simulation" not in u.__dict__
         if hook:  # instance attribute: shadows MujocoEnv._step_mujoco_simulation for this call only
             u._step_mujoco_simulation = self._commit_sim
@@ -399,6 +442,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             if hook:
                 del u._step_mujoco_simulation
         self._check_applied_ctrl(report.applied_ctrl)
+        self._check_elapsed(t_start, nstep)
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)
