@@ -174,9 +174,88 @@ class _TwiceTunnel(MujocoEnv):
 
 def test_env_step_that_simulates_two_windows_is_detected():
     """On main the second ``do_simulation`` ran uncertified and silently (the ctrl check passes:
-    the control is the certified one); now the step raises InvalidInputError naming the time."""
+    the control is the certified one). Now, with the commit hook, the second simulation is
+    refused before it runs (one window's time elapsed); without it (``commit=False``) the step
+    raises right after, naming data.time."""
     env = SafetyGate(_TwiceTunnel())
     env.reset(seed=0)
+    d = env.unwrapped.data
+    with pytest.raises(InvalidInputError, match="second simulation"):
+        env.step(np.array([1.0]))
+    assert d.time == 0.01  # the certified window ran, the second one did not
+    env.commit = False
     with pytest.raises(InvalidInputError, match="data.time"):
+        env.step(np.array([1.0]))
+    env.close()
+
+
+# --------------------------------------------------------------------------- SafetyGate: the env's step edits
+_MOCAP_XML = """<mujoco><option timestep="0.01" gravity="0 0 0" integrator="implicitfast"/><worldbody>
+<body name="wall" mocap="true" pos="0.3 0 0">
+  <geom name="wall" type="box" size="0.005 0.2 0.2" contype="0" conaffinity="0"/></body>
+<body name="ball"><joint name="x" type="slide" axis="1 0 0"/>
+  <geom name="ball" type="sphere" size="0.01" mass="0.01" contype="0" conaffinity="0"/></body>
+</worldbody><actuator><velocity name="vx" joint="x" kv="10" ctrlrange="-6 6"/></actuator></mujoco>"""
+
+
+class _MovingWall(MujocoEnv):
+    """A user's env whose ``step`` moves a mocap obstacle 0.1 m toward the ball, then simulates."""
+
+    metadata = {"render_modes": ["human", "rgb_array", "depth_array", "rgbd_tuple"], "render_fps": 100}
+
+    def __init__(self, path: str, edit: str = "mocap") -> None:
+        self.edit = edit
+        MujocoEnv.__init__(self, path, 1,
+                           observation_space=gym.spaces.Box(-np.inf, np.inf, shape=(2,), dtype=np.float64))
+
+    def step(self, action):
+        if self.edit == "mocap":
+            self.data.mocap_pos[0, 0] -= 0.1  # the obstacle moves (the env's own dynamics)
+        else:
+            self.model.actuator_gainprm[0, 0] *= 100.0  # domain randomisation inside step
+            self.model.actuator_biasprm[0, 2] *= 100.0
+        self.do_simulation(action, self.frame_skip)
+        return np.array([self.data.qpos[0], self.data.qvel[0]]), 0.0, False, False, {}
+
+    def reset_model(self):
+        self.set_state(np.zeros(1), np.zeros(1))
+        return np.zeros(2)
+
+
+@pytest.fixture
+def mocap_xml(tmp_path):
+    path = tmp_path / "moving_wall.xml"
+    path.write_text(_MOCAP_XML)
+    return str(path)
+
+
+@pytest.mark.parametrize("commit", [True, False])
+def test_env_step_moving_a_mocap_obstacle_is_not_certified(mocap_xml, commit):
+    """On main step 2 ran with the wall overlapping the ball (closed-form distance -0.015 m) and
+    reported ``applied_verdict == "certified"`` (the plan held the mocap pose of the decision).
+    Now: with the commit hook the step is refused BEFORE the motion runs (time unchanged);
+    without it (``commit=False``) right after, never silently."""
+    env = SafetyGate(_MovingWall(mocap_xml), pairs=[("ball", "wall")])
+    env.commit = commit
+    env.reset(seed=0)
+    d = env.unwrapped.data
+    with pytest.raises(InvalidInputError, match="mocap"):
+        for _ in range(3):
+            t0 = float(d.time)
+            info = env.step(np.array([0.0]))[4]
+            gap = abs(float(d.mocap_pos[0, 0]) - float(d.qpos[0])) - 0.015  # closed form
+            assert not (gap < 0.0 and info["safety"]["applied_verdict"] == "certified")
+    if commit:
+        assert float(d.time) == t0  # refused before simulating
+    env.close()
+
+
+def test_env_step_editing_the_dynamics_is_detected_without_commit(mocap_xml):
+    """``commit=False`` and a gain edit inside ``step``: the motion that ran is not the
+    certified window (the qpos row differs): InvalidInputError after the step, never silent."""
+    env = SafetyGate(_MovingWall(mocap_xml, edit="gain"), pairs=[("ball", "wall")])
+    env.commit = False
+    env.reset(seed=0)
+    with pytest.raises(InvalidInputError, match="qpos"):
         env.step(np.array([1.0]))
     env.close()
