@@ -842,6 +842,10 @@ def _json_items(items: Any) -> Any:
     return [x if isinstance(x, str) else [str(v) for v in x] for x in items]
 
 
+_MODEL_EDITS_KEY = "model_edits"
+"""Run metadata key ``monitor.log.topics.MODEL_EDITS_KEY`` (spelled here: gate.py imports no mcap)."""
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -1073,6 +1077,7 @@ class Gate:
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
         self._tail_record: tuple[Certificate, int] | None = None  # (tail certificate, its log record index)
+        self._noted_version: int | None = None  # scene version the log last compared the model at
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
         self.tolerances = tolerances
@@ -1676,7 +1681,8 @@ class Gate:
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,
                     # the certify settings at open (ongoing rule, tolerances, budget, ...): request id 0;
                     # each certificate names its own (a setting changed later gets a new record)
-                    "request": self.request.to_json(), **self._policy_metadata()}
+                    "request": self.request.to_json(), **self._policy_metadata(),
+                    _MODEL_EDITS_KEY: "logged"}  # note_model before every window on an edited model
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
@@ -1684,7 +1690,10 @@ class Gate:
             self._log = spec
             add = getattr(spec, "add_metadata", None)
             if callable(add):  # a user's MonitorLog: the pair policy of the windows this gate writes
-                add(self._policy_metadata())  # (requests: per certificate, by the log itself)
+                meta = self._policy_metadata()  # (requests: per certificate, by the log itself)
+                if callable(getattr(spec, "note_model", None)):
+                    meta[_MODEL_EDITS_KEY] = "logged"
+                add(meta)
         return self._log
 
     def _policy_metadata(self) -> dict[str, Any]:
@@ -1709,6 +1718,12 @@ class Gate:
         log = self._open_log()
         if log is None:
             return
+        version = getattr(self._scene, "version", 0)
+        if version != self._noted_version:  # the first window, or the scene was rebuilt after a model edit
+            self._noted_version = version
+            note = getattr(log, "note_model", None)
+            if callable(note):  # the log records what changed, so review re-derives on the model as certified
+                note(self.model)
         why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
         if not r.replaced:  # the window that ran is this one; it may commit a braking tail
             self._log_accepted = log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl,

@@ -259,3 +259,90 @@ def test_env_step_editing_the_dynamics_is_detected_without_commit(mocap_xml):
     with pytest.raises(InvalidInputError, match="qpos"):
         env.step(np.array([1.0]))
     env.close()
+
+
+# --------------------------------------------------------------------------- model edits in the log (item 3)
+def _edited_run(path, *, note: bool = True) -> tuple[list[str], int]:
+    """A gate run on the ball/wall model whose wall is moved onto the ball's path at step 4.
+
+    Returns the logged verdicts and the log index of the first window after the edit.
+    """
+    m = _model()
+    d = mujoco.MjData(m)
+    d.qvel[0] = 1.0  # coasts along +x
+    wall = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "wall")
+    m.geom_pos[wall] = (2.0, 0.0, 0.0)  # far away at the start
+    gate = Gate(m, pairs=[("ball", "wall")], frame_skip=10, brake=False, on_violation="warn", log=str(path))
+    verdicts = []
+    for k in range(8):
+        if k == 4:
+            m.geom_pos[wall] = (float(d.qpos[0]) + 0.11, 0.0, 0.0)  # gap 1 cm: reached in the next window
+        verdicts.append(str(gate.step(d, np.zeros(1)).verdict))
+    gate.close()
+    return verdicts, 4
+
+
+def test_review_rederives_windows_on_the_model_as_edited(tmp_path):
+    """The wall moved onto the ball's path mid-run: the gate's later windows are violations.
+
+    On main the log did not say so: review re-derived every window on the model attached at
+    open (wall 2 m away) and flagged the genuine violations as CRITICAL flips
+    (``critical == 4``). Now the edit is logged before the first window certified on it and
+    review re-derives each window on the model as edited: 0 critical, exit 0, a note names it.
+    """
+    from monitor.log.reader import read_log
+    from monitor.review import verify, verify_exit_code
+
+    verdicts, first = _edited_run(tmp_path / "edit.mcap")
+    assert verdicts[:first] == ["certified"] * first and "violation" in verdicts[first:]
+    contents = read_log(tmp_path / "edit.mcap")
+    ver = verify(contents, progress=False)
+    assert ver["checked"] == ver["windows"] == 8
+    assert ver["critical"] == 0 and not ver["mismatches"], ver["mismatches"]
+    assert [e["window"] for e in contents.model_edits] == [first]
+    assert verify_exit_code(ver) == 0
+    assert any("model edit" in n and "geom_pos" in n for n in ver["notes"])
+
+
+def test_review_malformed_model_edit_is_unverifiable(tmp_path):
+    """A model edit record the attached model cannot take (an unknown field): the windows from
+    its index are UNVERIFIABLE (exit 2), never re-derived on a model the run did not certify on."""
+    from monitor.log import topics
+    from monitor.log.reader import read_log
+    from monitor.log.writer import MonitorLog
+    from monitor.review import verify, verify_exit_code
+
+    m = _model()
+    d = mujoco.MjData(m)
+    d.qvel[0] = 1.0
+    path = tmp_path / "bad_edit.mcap"
+    with MonitorLog(path, model=m, foxglove=False) as log:
+        gate = Gate(m, pairs=[("ball", "wall")], frame_skip=10, brake=False, log=log)
+        for k in range(4):
+            if k == 2:
+                log.add_metadata({"window": log.windows, "fields": {"geom_rgba": {"shape": [2, 4],
+                                  "values": [0.0] * 8}}}, name=topics.METADATA_MODEL_EDIT)
+            gate.step(d, np.zeros(1))
+    ver = verify(read_log(path), progress=False)
+    assert ver["checked"] == 2 and ver["critical"] == 0
+    assert any("malformed" in f["reason"] for f in ver["findings"])
+    assert verify_exit_code(ver) == 2
+
+
+def test_model_edit_record_round_trips_the_arrays(tmp_path):
+    """``MonitorLog.note_model``: the changed fields only, values exact, nothing when unchanged."""
+    from monitor.log.reader import read_log
+    from monitor.log.writer import MonitorLog
+
+    m = _model()
+    path = tmp_path / "note.mcap"
+    with MonitorLog(path, model=m, foxglove=False) as log:
+        assert log.note_model(m) == []
+        m.geom_size[1, 0] = 0.1 + 1e-13
+        m.opt.disableflags = int(m.opt.disableflags) | int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        assert sorted(log.note_model(m)) == ["geom_size", "opt.disableflags"]
+        assert log.note_model(m) == []
+    rec = read_log(path).model_edits
+    assert len(rec) == 1 and rec[0]["window"] == 0
+    assert np.array_equal(np.reshape(rec[0]["fields"]["geom_size"]["values"], (2, 3)), m.geom_size)
+    assert rec[0]["disableflags"] == int(m.opt.disableflags)
