@@ -846,6 +846,32 @@ _MODEL_EDITS_KEY = "model_edits"
 """Run metadata key ``monitor.log.topics.MODEL_EDITS_KEY`` (spelled here: gate.py imports no mcap)."""
 
 
+def _check_nstep(n: Any, name: str) -> int:
+    """``n`` as a substep count: an integer >= 1 (not a bool, a float or a string), else InvalidInputError."""
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InvalidInputError(f"{name} must be an integer >= 1, got {n!r}")
+    return int(n)
+
+
+def _check_decide_inputs(model: mujoco.MjModel, data: Any, ctrl: np.ndarray, shape: tuple[int, ...]) -> None:
+    """Typed errors for what :meth:`Gate.decide` cannot certify: another model's data, a bad action.
+
+    ``ctrl`` (already an array) must be numeric, finite and of the gate's action shape: MuJoCo
+    silently zeroes a NaN control (``mjWARN_BADCTRL``), so without this check a NaN proposal
+    would come back ``certified`` for a motion under another control.
+    """
+    if not isinstance(data, mujoco.MjData):
+        raise InvalidInputError(f"data must be a mujoco.MjData, got {type(data).__name__}")
+    if data.qpos.shape[0] != model.nq or data.qvel.shape[0] != model.nv or data.ctrl.shape[0] != model.nu:
+        raise InvalidInputError(
+            f"data has nq={data.qpos.shape[0]}, nv={data.qvel.shape[0]}, nu={data.ctrl.shape[0]} but the "
+            f"gate's model has nq={model.nq}, nv={model.nv}, nu={model.nu}: MjData of another model")
+    if ctrl.dtype.kind not in "fiub" or ctrl.shape != shape:
+        raise InvalidInputError(f"ctrl must be a numeric array of shape {shape}, got {ctrl!r}")
+    if not np.isfinite(ctrl).all():
+        raise InvalidInputError(f"ctrl contains NaN or inf: {ctrl!r}")
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -1041,8 +1067,7 @@ class Gate:
             raise InvalidInputError(f"unsafe must be one of {UNSAFE}, got {unsafe!r}")
         if not (callable(predictor) or predictor in PREDICTORS):
             raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
-        if int(frame_skip) < 1:
-            raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
+        _check_nstep(frame_skip, "frame_skip")
         _make_budget(budget)  # validate early
         self._margin, self._epsilon, self._tolerances = 0.0, 1e-3, DEFAULT  # set below (validated)
         _check_log(log)
@@ -1503,10 +1528,9 @@ class Gate:
         Returns:
             the :class:`StepReport` (``stepped=False``).
         """
-        n = self.frame_skip if nstep is None else int(nstep)
-        if n < 1:
-            raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
+        n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         ctrl = np.asarray(ctrl)
+        _check_decide_inputs(self.model, data, ctrl, self._fallback_shape)
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             # (before the scene is built: `allowed="auto"` frees the pairs touching at THIS pose)
             self.reference_qpos = np.array(data.qpos)
@@ -1626,7 +1650,7 @@ class Gate:
         Returns:
             the :class:`StepReport` (``stepped=True``).
         """
-        n = self.frame_skip if nstep is None else int(nstep)
+        n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         try:
             ctrl = np.asarray(ctrl, dtype=np.float64)
         except (TypeError, ValueError) as e:

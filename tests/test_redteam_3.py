@@ -346,3 +346,37 @@ def test_model_edit_record_round_trips_the_arrays(tmp_path):
     assert len(rec) == 1 and rec[0]["window"] == 0
     assert np.array_equal(np.reshape(rec[0]["fields"]["geom_size"]["values"], (2, 3)), m.geom_size)
     assert rec[0]["disableflags"] == int(m.opt.disableflags)
+
+
+# --------------------------------------------------------------------------- bad input to Gate.decide / step
+@pytest.mark.parametrize("ctrl", [np.array([np.nan]), np.array([np.inf]), np.array(["a"]), np.zeros(3), None])
+def test_decide_refuses_a_bad_control(ctrl):
+    """On main ``Gate.decide(data, [nan])`` answered ``certified`` (MuJoCo zeroes a NaN control,
+    so the window certified was the zero control's, not the proposal's), ``None`` too; a string
+    or a wrong shape gave a bare ValueError. Now: InvalidInputError naming ctrl."""
+    m = _model()
+    gate = Gate(m, pairs=[("ball", "wall")], frame_skip=10)
+    with pytest.raises(InvalidInputError, match="ctrl"):
+        gate.decide(mujoco.MjData(m), ctrl)
+
+
+def test_decide_refuses_data_of_another_model():
+    """On main: ``InvalidInputError: reference must be a finite (nq,) = (1,) qpos`` (misleading)."""
+    m = _model()
+    other = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><freejoint/><geom size="0.1"/></body></worldbody></mujoco>')
+    gate = Gate(m, pairs=[("ball", "wall")], frame_skip=10)
+    with pytest.raises(InvalidInputError, match="another model"):
+        gate.step(mujoco.MjData(other), np.zeros(1))
+
+
+@pytest.mark.parametrize("bad", [2.5, "3", True, 0])
+def test_substep_counts_are_integers(bad):
+    """On main ``nstep=2.5`` ran 2 substeps, ``"3"`` ran 3 and ``True`` 1, silently (``int()``);
+    ``Gate(frame_skip=2.5)`` likewise. Now InvalidInputError naming the argument."""
+    m = _model()
+    gate = Gate(m, pairs=[("ball", "wall")])
+    with pytest.raises(InvalidInputError, match="nstep"):
+        gate.step(mujoco.MjData(m), np.zeros(1), nstep=bad)
+    with pytest.raises(InvalidInputError, match="frame_skip"):
+        Gate(m, frame_skip=bad)
