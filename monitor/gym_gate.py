@@ -499,6 +499,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         if self.action_chain:
             action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
         u = self._unwrapped
+        if u.model is not self.gate.model:
+            raise InvalidInputError(
+                f"env: {type(u).__name__}.model is not the MjModel the gate was built on (the env replaced "
+                "it, e.g. recompiled a spec at reset): the gate would certify against the old model; "
+                "edit the model in place (the gate re-reads it) or build a new SafetyGate")
         nstep = self._live_frame_skip()
         t_start = float(u.data.time)
         mocap_start = u.data.mocap_pos.tobytes() + u.data.mocap_quat.tobytes()  # held over the window

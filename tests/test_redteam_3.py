@@ -380,3 +380,35 @@ def test_substep_counts_are_integers(bad):
         gate.step(mujoco.MjData(m), np.zeros(1), nstep=bad)
     with pytest.raises(InvalidInputError, match="frame_skip"):
         Gate(m, frame_skip=bad)
+
+
+@pytest.mark.parametrize("commit", [True, False])
+def test_env_that_replaced_its_model_is_refused(commit):
+    """The env recompiled its model (wall moved to x = -0.25) after the gate was built.
+
+    On main the gate kept certifying on the old model: step 1 went x -0.2745 -> -0.2250 through
+    the new wall (band |x + 0.25| <= 0.015, closed form), ``certified`` (with or without the
+    commit hook). Now the step is refused before anything is certified or simulated.
+    """
+    import monitor.envs  # noqa: F401
+    from monitor.envs.assets import scene
+
+    env = SafetyGate(gym.make("monitor/Tunnel-v0"))
+    env.commit = commit
+    env.reset(seed=0)
+    u = env.unwrapped
+    spec = mujoco.MjSpec.from_file(str(scene("tunnel")))
+    spec.geom("wall").pos = [-0.25, 0.0, 0.0]
+    u.model = spec.compile()
+    u.data = mujoco.MjData(u.model)
+    mujoco.mj_resetDataKeyframe(u.model, u.data, 0)
+    d = u.data
+    with pytest.raises(InvalidInputError, match="MjModel"):
+        for k in range(3):
+            x0 = float(d.qpos[0])
+            info = env.step(np.array([5.0]))[4]
+            x1 = float(d.qpos[0])
+            touches = min(x0, x1) <= -0.25 + BAND and max(x0, x1) >= -0.25 - BAND
+            assert not (touches and info["safety"]["applied_verdict"] == "certified"), (k, x0, x1)
+    assert float(d.time) == 0.0  # nothing ran
+    env.close()
