@@ -969,7 +969,8 @@ def _apply_model_edit(model: Any, edit: tuple[int, dict[str, np.ndarray], int | 
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
            limit: int | None = None, tolerances: dict[str, Any] | None = None,
-           expect_pairs: str | None = None, max_penetration: float | None = None) -> dict[str, Any]:
+           expect_pairs: str | None = None, max_penetration: float | None = None,
+           trust_model_edits: bool = False) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
@@ -1003,6 +1004,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
     setting changed during the run and an added record look the same).
 
+    In-place model edits the run logged (``monitor.model_edit`` records, written by a gate
+    before the first window certified on the edited model) are applied in window order to
+    the attached model, so each window is re-derived on the model it was certified on (flips
+    there are critical as usual). A malformed record makes its windows unverifiable. A valid
+    record is still the run's unsigned claim (an added record shrinking an obstacle reads like
+    a genuine edit): the windows from the first edit are one unverifiable finding unless
+    ``trust_model_edits`` (the auditor trusts the run's edit records), then a note.
+
     Args:
         contents: a read log.
         model_source: ``"auto" | "xml" | "mjb"`` (see :func:`monitor.log.reader.load_model`).
@@ -1016,6 +1025,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             answered under ``ongoing="deepen"`` with a larger ``penetration_tol`` is critical
             (a log that consistently claims a loose rule is otherwise only reported in a note).
             0 requires the plain rule.
+        trust_model_edits: accept the logged model edits as the run's model (see above).
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -1156,6 +1166,15 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            "applied_checked": 0}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     edits, edits_bad_from = _model_edits(contents, model, find, notes)
+    if edits and not trust_model_edits:
+        first_edit = edits[0][0]
+        n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
+                      for c in certs)
+        if n_after:
+            find(UNVERIFIABLE, f"{n_after} window(s) from index {first_edit} were certified on in-place "
+                               f"model edits the run logged: re-derived on them, but an unsigned log cannot "
+                               f"show that the edits happened (an added edit record reads the same; "
+                               f"trust_model_edits accepts them)")
     if edits or edits_bad_from is not None:
         certs = sorted(certs, key=lambda c: c["index"])  # edits apply in window order
     unverifiable_after_edit: list[int] = []

@@ -288,7 +288,9 @@ def test_review_rederives_windows_on_the_model_as_edited(tmp_path):
     On main the log did not say so: review re-derived every window on the model attached at
     open (wall 2 m away) and flagged the genuine violations as CRITICAL flips
     (``critical == 4``). Now the edit is logged before the first window certified on it and
-    review re-derives each window on the model as edited: 0 critical, exit 0, a note names it.
+    review re-derives each window on the model as edited: 0 critical, a note names it; exit 2 by
+    default (the edit record is the run's unsigned claim: a forger could add one), exit 0 when the
+    auditor trusts the run's edit records.
     """
     from monitor.log.reader import read_log
     from monitor.review import verify, verify_exit_code
@@ -300,8 +302,23 @@ def test_review_rederives_windows_on_the_model_as_edited(tmp_path):
     assert ver["checked"] == ver["windows"] == 8
     assert ver["critical"] == 0 and not ver["mismatches"], ver["mismatches"]
     assert [e["window"] for e in contents.model_edits] == [first]
-    assert verify_exit_code(ver) == 0
     assert any("model edit" in n and "geom_pos" in n for n in ver["notes"])
+    assert verify_exit_code(ver) == 2 and ver["unverifiable"] == 1
+    trusted = verify(contents, progress=False, trust_model_edits=True)
+    assert trusted["critical"] == 0 and trusted["unverifiable"] == 0 and verify_exit_code(trusted) == 0
+
+
+def test_review_of_an_edit_record_removed_is_critical(tmp_path):
+    """The same run re-read without its edit record (a forger dropping it, or a pre-edit-logging
+    gate): the genuine violations re-derive as certified on the attached model: CRITICAL flips."""
+    from monitor.log.reader import read_log
+    from monitor.review import verify, verify_exit_code
+
+    _edited_run(tmp_path / "edit.mcap")
+    contents = read_log(tmp_path / "edit.mcap")
+    contents.model_edits.clear()
+    ver = verify(contents, progress=False)
+    assert ver["critical"] >= 1 and verify_exit_code(ver) == 1
 
 
 def test_review_malformed_model_edit_is_unverifiable(tmp_path):
