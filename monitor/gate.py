@@ -75,6 +75,14 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
 _WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
+_UNSTABLE = tuple(int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                                   mujoco.mjtWarning.mjWARN_BADQACC))
+"""MuJoCo warnings of an unstable simulation (NaN, Inf or huge qpos/qvel/qacc; MuJoCo resets the state)."""
+
+
+def _unstable_count(d: mujoco.MjData) -> int:
+    w = d.warning
+    return sum(w[i].number for i in _UNSTABLE)
 _TAIL_CHUNK = 32  # longest run of braking-tail substeps between two (vectorised) stop tests
 
 
@@ -203,9 +211,16 @@ class Rollout:
         # The integration state begins with time, qpos (mj_getState writes its parts in
         # mjtState bit order: TIME, QPOS, QVEL, ...): row 0 is its first 1 + nq entries.
         rows[0] = key[:ncol]
+        unstable = _unstable_count(s)
         for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
+        if _unstable_count(s) != unstable:
+            raise InvalidInputError(
+                f"the predicted window from t = {float(rows[0, 0])!r} s ({nstep} substep(s) under ctrl = "
+                f"{np.array2string(self._key_ctrl)}) is an unstable simulation (MuJoCo: NaN, Inf or huge "
+                "qpos/qvel/qacc; it resets the state): no motion to certify. Lower opt.timestep, use an "
+                "implicit integrator, or check the control and the model's gains")
         self._key_nstep = int(nstep)
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.

@@ -429,3 +429,22 @@ def test_env_that_replaced_its_model_is_refused(commit):
             assert not (touches and info["safety"]["applied_verdict"] == "certified"), (k, x0, x1)
     assert float(d.time) == 0.0  # nothing ran
     env.close()
+
+
+@pytest.mark.parametrize("flag", ["", '<flag autoreset="disable"/>'])
+def test_unstable_window_says_so(flag):
+    """Explicit Euler with kv * dt / m = 10: the window diverges and MuJoCo resets the state.
+
+    On main a typed error with a misleading message (``times must be strictly increasing:
+    times[9] = 0.01 <= times[8] = 0.08``; with autoreset off ``X_b: translation beyond 1e+09 m``).
+    Now the error says the predicted window is an unstable simulation. Never certified.
+    """
+    xml = f"""<mujoco><option timestep="0.01" gravity="0 0 0">{flag}</option><worldbody>
+      <geom name="wall" type="box" pos="5 0 0" size="0.005 0.2 0.2" contype="0" conaffinity="0"/>
+      <body name="ball"><joint name="x" type="slide" axis="1 0 0"/>
+        <geom name="ball" type="sphere" size="0.01" mass="0.01" contype="0" conaffinity="0"/></body>
+      </worldbody><actuator><velocity name="vx" joint="x" kv="10" ctrlrange="-6 6"/></actuator></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    gate = Gate(m, pairs=[("ball", "wall")], frame_skip=20)
+    with pytest.raises(InvalidInputError, match="unstable simulation"):
+        gate.step(mujoco.MjData(m), np.array([1.0]))
