@@ -75,14 +75,15 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
 _WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
-_UNSTABLE = tuple(int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
-                                   mujoco.mjtWarning.mjWARN_BADQACC))
+_UNSTABLE = slice(int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQACC) + 1)
 """MuJoCo warnings of an unstable simulation (NaN, Inf or huge qpos/qvel/qacc; MuJoCo resets the state)."""
+assert (_UNSTABLE.stop - _UNSTABLE.start == 3
+        and int(mujoco.mjtWarning.mjWARN_BADQVEL) == _UNSTABLE.start + 1)  # BADQPOS, BADQVEL, BADQACC
 
 
-def _unstable_count(d: mujoco.MjData) -> int:
-    w = d.warning
-    return sum(w[i].number for i in _UNSTABLE)
+def _unstable_counts(d: mujoco.MjData) -> np.ndarray:
+    """A live view of ``d``'s warning counters BADQPOS, BADQVEL, BADQACC (3,) int."""
+    return d.warning.number[_UNSTABLE]
 _TAIL_CHUNK = 32  # longest run of braking-tail substeps between two (vectorised) stop tests
 
 
@@ -129,6 +130,7 @@ class Rollout:
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
+        self._s_warn = _unstable_counts(self.scratch)  # a view too: the unstable-simulation counters
         self.c_tail = True
         """Run braking tails in ``mujoco.rollout`` where exact (False: always the ``mj_step`` loop)."""
         self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
@@ -144,6 +146,7 @@ class Rollout:
         """
         state = self.__dict__.copy()
         state.pop("_s_ctrl", None)
+        state.pop("_s_warn", None)
         state["_roll"] = None
         state["_tail_bufs"] = None
         return state
@@ -151,6 +154,7 @@ class Rollout:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._s_ctrl = self.scratch.ctrl
+        self._s_warn = _unstable_counts(self.scratch)
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
@@ -211,11 +215,12 @@ class Rollout:
         # The integration state begins with time, qpos (mj_getState writes its parts in
         # mjtState bit order: TIME, QPOS, QVEL, ...): row 0 is its first 1 + nq entries.
         rows[0] = key[:ncol]
-        unstable = _unstable_count(s)
+        warn = self._s_warn
+        unstable = warn.tobytes()
         for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
-        if _unstable_count(s) != unstable:
+        if warn.tobytes() != unstable:
             raise InvalidInputError(
                 f"the predicted window from t = {float(rows[0, 0])!r} s ({nstep} substep(s) under ctrl = "
                 f"{np.array2string(self._key_ctrl)}) is an unstable simulation (MuJoCo: NaN, Inf or huge "
