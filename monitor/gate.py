@@ -325,7 +325,24 @@ class Rollout:
             # a MuJoCo warning in the tail: redo it in the loop (the rollout stops stepping there)
             mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
             s.ctrl[:] = brake
-        return self._tail_by_loop(n, vel_tol), brake
+        warn = _unstable_counts(s)
+        warn[:] = 0  # the private tail scratch (never committed): MuJoCo's reset keeps only the new count
+        rows = self._tail_by_loop(n, vel_tol)
+        if warn.any() and not (np.isfinite(rows).all() and (np.diff(rows[:, 0]) > 0).all()):
+            self.tail_unstable = True  # rows as MuJoCo gives them (reset included); the gate refuses them
+        return rows, brake
+
+    tail_unstable = False
+    """True after :meth:`brake_rows` gave the rows of an unstable simulation (MuJoCo reset the state)."""
+
+    def check_tail(self) -> None:
+        """Raise (and clear the flag) if the last braking tail was an unstable simulation."""
+        if self.tail_unstable:
+            self.tail_unstable = False
+            raise InvalidInputError(
+                "the braking tail after the window is an unstable simulation (MuJoCo: NaN, Inf or huge "
+                "qpos/qvel/qacc; it resets the state): no motion to certify. Lower opt.timestep, use an "
+                "implicit integrator, or check the model's gains")
 
     def _tail_by_loop(self, n: int, vel_tol: float) -> np.ndarray:
         """Up to ``n`` substeps of the tail scratch (state and brake control set), one ``mj_step`` each.
@@ -1577,6 +1594,7 @@ class Gate:
             rows, brake_next = self._rollout.brake_rows(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol,
                 window_fresh=True)  # states() ran just above on this data, ctrl and n
+            self._rollout.check_tail()
             tail = _Tail(rows, self.model, data)
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
@@ -1599,6 +1617,7 @@ class Gate:
                     rows, brake_next = self._rollout.brake_rows(
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
+                    self._rollout.check_tail()
                     tail = _Tail(rows, self.model, data)
                     tail_qvel = tail.qvel
                 tail_cert, tail_us = self._certify(tail.plan)

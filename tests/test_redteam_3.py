@@ -448,3 +448,23 @@ def test_unstable_window_says_so(flag):
     gate = Gate(m, pairs=[("ball", "wall")], frame_skip=20)
     with pytest.raises(InvalidInputError, match="unstable simulation"):
         gate.step(mujoco.MjData(m), np.array([1.0]))
+
+
+def test_unstable_braking_tail_says_so():
+    """A stable 10 ms window, then a braking tail under a stiff position servo (kp dt^2 / m = 10,
+    explicit Euler) that diverges; MuJoCo resets the state and the tail "stops" at rest.
+
+    On main: ``times must be strictly increasing: times[11] = 0.01 <= times[10] = 0.1`` (the joint
+    plan). Now the error names the braking tail as an unstable simulation. Never certified.
+    """
+    xml = """<mujoco><option timestep="0.01" gravity="0 0 0"/><worldbody>
+      <geom name="wall" type="box" pos="5 0 0" size="0.005 0.2 0.2" contype="0" conaffinity="0"/>
+      <body name="ball"><joint name="x" type="slide" axis="1 0 0"/>
+        <geom name="ball" type="sphere" size="0.01" mass="0.01" contype="0" conaffinity="0"/></body>
+      </worldbody><actuator><position name="px" joint="x" kp="1000"/></actuator></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    d.qvel[0] = 1.0
+    gate = Gate(m, pairs=[("ball", "wall")])
+    with pytest.raises(InvalidInputError, match="braking tail .* unstable simulation"):
+        gate.step(d, np.zeros(1))
