@@ -51,6 +51,7 @@ import math
 import os
 import time
 import warnings
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -890,19 +891,23 @@ def _check_nstep(n: Any, name: str) -> int:
     return int(n)
 
 
-def _check_decide_inputs(model: mujoco.MjModel, data: Any, ctrl: np.ndarray, shape: tuple[int, ...]) -> None:
-    """Typed errors for what :meth:`Gate.decide` cannot certify: another model's data, a bad action.
-
-    ``ctrl`` (already an array) must be numeric, finite and of the gate's action shape: MuJoCo
-    silently zeroes a NaN control (``mjWARN_BADCTRL``), so without this check a NaN proposal
-    would come back ``certified`` for a motion under another control.
-    """
+def _check_data(model: mujoco.MjModel, data: Any) -> None:
+    """InvalidInputError unless ``data`` is an ``MjData`` of ``model``'s sizes."""
     if not isinstance(data, mujoco.MjData):
         raise InvalidInputError(f"data must be a mujoco.MjData, got {type(data).__name__}")
     if data.qpos.shape[0] != model.nq or data.qvel.shape[0] != model.nv or data.ctrl.shape[0] != model.nu:
         raise InvalidInputError(
             f"data has nq={data.qpos.shape[0]}, nv={data.qvel.shape[0]}, nu={data.ctrl.shape[0]} but the "
             f"gate's model has nq={model.nq}, nv={model.nv}, nu={model.nu}: MjData of another model")
+
+
+def _check_ctrl(ctrl: np.ndarray, shape: tuple[int, ...]) -> None:
+    """Typed errors for a control :meth:`Gate.decide` cannot certify.
+
+    ``ctrl`` (already an array) must be numeric, finite and of the gate's action shape: MuJoCo
+    silently zeroes a NaN control (``mjWARN_BADCTRL``), so without this check a NaN proposal
+    would come back ``certified`` for a motion under another control.
+    """
     if ctrl.dtype.kind not in "fiub" or ctrl.shape != shape:
         raise InvalidInputError(f"ctrl must be a numeric array of shape {shape}, got {ctrl!r}")
     if not np.isfinite(ctrl).all():
@@ -1140,6 +1145,7 @@ class Gate:
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
         self._tail_record: tuple[Certificate, int] | None = None  # (tail certificate, its log record index)
         self._noted_version: int | None = None  # scene version the log last compared the model at
+        self._data_checked: Any = None  # weakref to the MjData whose sizes decide() last checked
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
         self.tolerances = tolerances
@@ -1567,7 +1573,10 @@ class Gate:
         """
         n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         ctrl = np.asarray(ctrl)
-        _check_decide_inputs(self.model, data, ctrl, self._fallback_shape)
+        if self._data_checked is None or self._data_checked() is not data:  # checked once per MjData
+            _check_data(self.model, data)
+            self._data_checked = weakref.ref(data)
+        _check_ctrl(ctrl, self._fallback_shape)
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             # (before the scene is built: `allowed="auto"` frees the pairs touching at THIS pose)
             self.reference_qpos = np.array(data.qpos)
@@ -1697,9 +1706,7 @@ class Gate:
                 f"ctrl must be a numeric array of shape ({self.model.nu},), got {ctrl!r}") from e
         if ctrl.shape != (self.model.nu,):
             raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
-        if not np.isfinite(ctrl).all():
-            raise InvalidInputError("ctrl contains NaN or inf")
-        report = self.decide(data, ctrl, nstep=n)
+        report = self.decide(data, ctrl, nstep=n)  # (NaN / inf refused there)
         # The scratch usually holds the applied window already (the proposal's, or the
         # fallback's when it was predicted): copy it instead of integrating again (exact,
         # see Rollout.commit). Otherwise (a window inside the committed tail) step.
@@ -1838,6 +1845,12 @@ class Gate:
             if self._log_lock is not None:
                 self._log_lock.close()  # releases the flock
                 self._log_lock = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle state: everything but the weak reference to the last checked ``MjData``."""
+        state = self.__dict__.copy()
+        state["_data_checked"] = None
+        return state
 
     def __enter__(self) -> Gate:
         return self

@@ -468,3 +468,15 @@ def test_unstable_braking_tail_says_so():
     gate = Gate(m, pairs=[("ball", "wall")])
     with pytest.raises(InvalidInputError, match="braking tail .* unstable simulation"):
         gate.step(d, np.zeros(1))
+
+
+def test_gate_still_pickles_after_a_step():
+    """The gate remembers which MjData it size-checked by a weak reference: not pickled."""
+    import pickle
+
+    m = _model()
+    d = mujoco.MjData(m)
+    gate = Gate(m, pairs=[("ball", "wall")])
+    gate.step(d, np.zeros(1))
+    again = pickle.loads(pickle.dumps(gate))
+    assert again.step(d, np.zeros(1)).verdict == "certified"
