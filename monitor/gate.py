@@ -51,6 +51,7 @@ import math
 import os
 import time
 import warnings
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -75,6 +76,15 @@ _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 _TAIL_ROW = (mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS
              | mujoco.mjtState.mjSTATE_QVEL)  # state layout: time, qpos (nq), qvel (nv)
 _WINDOW_ROW = mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS  # time, qpos (nq)
+_UNSTABLE = slice(int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQACC) + 1)
+"""MuJoCo warnings of an unstable simulation (NaN, Inf or huge qpos/qvel/qacc; MuJoCo resets the state)."""
+assert (_UNSTABLE.stop - _UNSTABLE.start == 3
+        and int(mujoco.mjtWarning.mjWARN_BADQVEL) == _UNSTABLE.start + 1)  # BADQPOS, BADQVEL, BADQACC
+
+
+def _unstable_counts(d: mujoco.MjData) -> np.ndarray:
+    """A live view of ``d``'s warning counters BADQPOS, BADQVEL, BADQACC (3,) int."""
+    return d.warning.number[_UNSTABLE]
 _TAIL_CHUNK = 32  # longest run of braking-tail substeps between two (vectorised) stop tests
 
 
@@ -121,6 +131,7 @@ class Rollout:
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
+        self._s_warn = _unstable_counts(self.scratch)  # a view too: the unstable-simulation counters
         self.c_tail = True
         """Run braking tails in ``mujoco.rollout`` where exact (False: always the ``mj_step`` loop)."""
         self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
@@ -136,6 +147,7 @@ class Rollout:
         """
         state = self.__dict__.copy()
         state.pop("_s_ctrl", None)
+        state.pop("_s_warn", None)
         state["_roll"] = None
         state["_tail_bufs"] = None
         return state
@@ -143,6 +155,7 @@ class Rollout:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._s_ctrl = self.scratch.ctrl
+        self._s_warn = _unstable_counts(self.scratch)
 
     def window_matches(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int) -> bool:
         """True when the scratch holds the end of ``nstep`` substeps of ``data`` under ``ctrl``.
@@ -203,9 +216,17 @@ class Rollout:
         # The integration state begins with time, qpos (mj_getState writes its parts in
         # mjtState bit order: TIME, QPOS, QVEL, ...): row 0 is its first 1 + nq entries.
         rows[0] = key[:ncol]
+        warn = self._s_warn
+        unstable = warn.tobytes()
         for k in range(1, nstep + 1):
             mujoco.mj_step(m, s)
             mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
+        if warn.tobytes() != unstable:
+            raise InvalidInputError(
+                f"the predicted window from t = {float(rows[0, 0])!r} s ({nstep} substep(s) under ctrl = "
+                f"{np.array2string(self._key_ctrl)}) is an unstable simulation (MuJoCo: NaN, Inf or huge "
+                "qpos/qvel/qacc; it resets the state): no motion to certify. Lower opt.timestep, use an "
+                "implicit integrator, or check the control and the model's gains")
         self._key_nstep = int(nstep)
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
@@ -305,7 +326,24 @@ class Rollout:
             # a MuJoCo warning in the tail: redo it in the loop (the rollout stops stepping there)
             mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
             s.ctrl[:] = brake
-        return self._tail_by_loop(n, vel_tol), brake
+        warn = _unstable_counts(s)
+        warn[:] = 0  # the private tail scratch (never committed): MuJoCo's reset keeps only the new count
+        rows = self._tail_by_loop(n, vel_tol)
+        if warn.any() and not (np.isfinite(rows).all() and (np.diff(rows[:, 0]) > 0).all()):
+            self.tail_unstable = True  # rows as MuJoCo gives them (reset included); the gate refuses them
+        return rows, brake
+
+    tail_unstable = False
+    """True after :meth:`brake_rows` gave the rows of an unstable simulation (MuJoCo reset the state)."""
+
+    def check_tail(self) -> None:
+        """Raise (and clear the flag) if the last braking tail was an unstable simulation."""
+        if self.tail_unstable:
+            self.tail_unstable = False
+            raise InvalidInputError(
+                "the braking tail after the window is an unstable simulation (MuJoCo: NaN, Inf or huge "
+                "qpos/qvel/qacc; it resets the state): no motion to certify. Lower opt.timestep, use an "
+                "implicit integrator, or check the model's gains")
 
     def _tail_by_loop(self, n: int, vel_tol: float) -> np.ndarray:
         """Up to ``n`` substeps of the tail scratch (state and brake control set), one ``mj_step`` each.
@@ -842,6 +880,40 @@ def _json_items(items: Any) -> Any:
     return [x if isinstance(x, str) else [str(v) for v in x] for x in items]
 
 
+_MODEL_EDITS_KEY = "model_edits"
+"""Run metadata key ``monitor.log.topics.MODEL_EDITS_KEY`` (spelled here: gate.py imports no mcap)."""
+
+
+def _check_nstep(n: Any, name: str) -> int:
+    """``n`` as a substep count: an integer >= 1 (not a bool, a float or a string), else InvalidInputError."""
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InvalidInputError(f"{name} must be an integer >= 1, got {n!r}")
+    return int(n)
+
+
+def _check_data(model: mujoco.MjModel, data: Any) -> None:
+    """InvalidInputError unless ``data`` is an ``MjData`` of ``model``'s sizes."""
+    if not isinstance(data, mujoco.MjData):
+        raise InvalidInputError(f"data must be a mujoco.MjData, got {type(data).__name__}")
+    if data.qpos.shape[0] != model.nq or data.qvel.shape[0] != model.nv or data.ctrl.shape[0] != model.nu:
+        raise InvalidInputError(
+            f"data has nq={data.qpos.shape[0]}, nv={data.qvel.shape[0]}, nu={data.ctrl.shape[0]} but the "
+            f"gate's model has nq={model.nq}, nv={model.nv}, nu={model.nu}: MjData of another model")
+
+
+def _check_ctrl(ctrl: np.ndarray, shape: tuple[int, ...]) -> None:
+    """Typed errors for a control :meth:`Gate.decide` cannot certify.
+
+    ``ctrl`` (already an array) must be numeric, finite and of the gate's action shape: MuJoCo
+    silently zeroes a NaN control (``mjWARN_BADCTRL``), so without this check a NaN proposal
+    would come back ``certified`` for a motion under another control.
+    """
+    if ctrl.dtype.kind not in "fiub" or ctrl.shape != shape:
+        raise InvalidInputError(f"ctrl must be a numeric array of shape {shape}, got {ctrl!r}")
+    if not np.isfinite(ctrl).all():
+        raise InvalidInputError(f"ctrl contains NaN or inf: {ctrl!r}")
+
+
 def _make_budget(budget: Any) -> Any:
     """A fresh :class:`Budget` per certification from the user's spec (or None)."""
     if budget is None:
@@ -1037,8 +1109,7 @@ class Gate:
             raise InvalidInputError(f"unsafe must be one of {UNSAFE}, got {unsafe!r}")
         if not (callable(predictor) or predictor in PREDICTORS):
             raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
-        if int(frame_skip) < 1:
-            raise InvalidInputError(f"frame_skip must be >= 1, got {frame_skip!r}")
+        _check_nstep(frame_skip, "frame_skip")
         _make_budget(budget)  # validate early
         self._margin, self._epsilon, self._tolerances = 0.0, 1e-3, DEFAULT  # set below (validated)
         _check_log(log)
@@ -1073,6 +1144,8 @@ class Gate:
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
         self._tail_record: tuple[Certificate, int] | None = None  # (tail certificate, its log record index)
+        self._noted_version: int | None = None  # scene version the log last compared the model at
+        self._data_checked: Any = None  # weakref to the MjData whose sizes decide() last checked
         self._tail_context: tuple[Any, ...] | None = None  # settings + geometry the tail was certified under
         self._scene = None
         self.tolerances = tolerances
@@ -1086,8 +1159,9 @@ class Gate:
         """The file the gate writes (None until the first window, or when not logging to a path)."""
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
-                      "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0, "certify_us": 0.0,
-                      "reused_pairs": 0, "pairs": 0, "committed": 0, "joint": 0}
+                      "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
+                      "tail_replay_differs": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0,
+                      "committed": 0, "joint": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -1434,16 +1508,20 @@ class Gate:
         """The committed tail's certificate if it contains the next ``n`` substeps.
 
         That is the case when the live state equals a tail waypoint bit for bit
-        (time, qpos, qvel, mocap) and the window ends inside the tail: the
-        committed brake then reproduces the tail exactly, and margin, epsilon,
-        tolerances and the scene version are those the tail was certified under.
-        Else None.
+        (time, qpos, qvel, mocap), the window ends inside the tail, margin, epsilon,
+        tolerances and the scene version are those the tail was certified under, and
+        the window of the committed brake, integrated now from the live data with the
+        live model (:meth:`Rollout._window`), gives the tail's next ``n`` rows (time,
+        qpos) bit for bit. The replay is what makes the reuse sound: a state equal to a
+        tail waypoint does not imply the same motion after an in-place edit of the
+        dynamics (``opt.gravity``, ``opt.timestep``, gains, masses, damping: none is in
+        the scene version). It leaves the scratch holding the applied window, so the
+        caller commits it instead of stepping again. Else None.
         """
         if self._tail is None or self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
-        plan, cert, qvel = self._tail
-        if isinstance(plan, _Tail):
-            plan = plan.plan  # built now, on the rare path that reads it
+        tail, cert, qvel = self._tail
+        plan = tail.plan  # built now, on the rare path that reads it
         if not cert.certified:
             return None
         hits = np.flatnonzero(plan.times == data.time)
@@ -1455,6 +1533,11 @@ class Gate:
                 or qvel[k].tobytes() != data.qvel.tobytes()
                 or plan.mocap_pos.tobytes() != data.mocap_pos.tobytes()
                 or plan.mocap_quat.tobytes() != data.mocap_quat.tobytes()):
+            return None
+        # replay: the brake's window under the live model must be the certified tail's rows
+        rows = self._rollout._window(data, self._committed, n)
+        if rows[1:].tobytes() != np.ascontiguousarray(tail.rows[k + 1:k + n + 1]).tobytes():
+            self.stats["tail_replay_differs"] += 1
             return None
         return cert
 
@@ -1488,10 +1571,12 @@ class Gate:
         Returns:
             the :class:`StepReport` (``stepped=False``).
         """
-        n = self.frame_skip if nstep is None else int(nstep)
-        if n < 1:
-            raise InvalidInputError(f"nstep must be >= 1, got {nstep!r}")
+        n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         ctrl = np.asarray(ctrl)
+        if self._data_checked is None or self._data_checked() is not data:  # checked once per MjData
+            _check_data(self.model, data)
+            self._data_checked = weakref.ref(data)
+        _check_ctrl(ctrl, self._fallback_shape)
         if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
             # (before the scene is built: `allowed="auto"` frees the pairs touching at THIS pose)
             self.reference_qpos = np.array(data.qpos)
@@ -1518,6 +1603,7 @@ class Gate:
             rows, brake_next = self._rollout.brake_rows(
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol,
                 window_fresh=True)  # states() ran just above on this data, ctrl and n
+            self._rollout.check_tail()
             tail = _Tail(rows, self.model, data)
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
@@ -1536,13 +1622,14 @@ class Gate:
                 # no proposal can ever be rejected, so the tail and its brake are never used.
                 brake_verdict = "certified"
             elif not unsafe and brake_on:
-                if tail is None:
-                    tail, brake_next, tail_qvel = self._rollout.brake_tail(
+                if tail is None:  # raw rows kept: a committed tail is replayed against them (_tail_covers)
+                    rows, brake_next = self._rollout.brake_rows(
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
-                else:  # simulated for the joint call
-                    tail = tail.plan
-                tail_cert, tail_us = self._certify(tail)
+                    self._rollout.check_tail()
+                    tail = _Tail(rows, self.model, data)
+                    tail_qvel = tail.qvel
+                tail_cert, tail_us = self._certify(tail.plan)
                 us += tail_us
                 brake_verdict = tail_cert.verdict
                 if self.is_unsafe(brake_verdict):
@@ -1611,7 +1698,7 @@ class Gate:
         Returns:
             the :class:`StepReport` (``stepped=True``).
         """
-        n = self.frame_skip if nstep is None else int(nstep)
+        n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         try:
             ctrl = np.asarray(ctrl, dtype=np.float64)
         except (TypeError, ValueError) as e:
@@ -1619,9 +1706,7 @@ class Gate:
                 f"ctrl must be a numeric array of shape ({self.model.nu},), got {ctrl!r}") from e
         if ctrl.shape != (self.model.nu,):
             raise InvalidInputError(f"ctrl must have shape ({self.model.nu},), got {ctrl.shape}")
-        if not np.isfinite(ctrl).all():
-            raise InvalidInputError("ctrl contains NaN or inf")
-        report = self.decide(data, ctrl, nstep=n)
+        report = self.decide(data, ctrl, nstep=n)  # (NaN / inf refused there)
         # The scratch usually holds the applied window already (the proposal's, or the
         # fallback's when it was predicted): copy it instead of integrating again (exact,
         # see Rollout.commit). Otherwise (a window inside the committed tail) step.
@@ -1666,7 +1751,8 @@ class Gate:
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,
                     # the certify settings at open (ongoing rule, tolerances, budget, ...): request id 0;
                     # each certificate names its own (a setting changed later gets a new record)
-                    "request": self.request.to_json(), **self._policy_metadata()}
+                    "request": self.request.to_json(), **self._policy_metadata(),
+                    _MODEL_EDITS_KEY: "logged"}  # note_model before every window on an edited model
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
@@ -1674,7 +1760,10 @@ class Gate:
             self._log = spec
             add = getattr(spec, "add_metadata", None)
             if callable(add):  # a user's MonitorLog: the pair policy of the windows this gate writes
-                add(self._policy_metadata())  # (requests: per certificate, by the log itself)
+                meta = self._policy_metadata()  # (requests: per certificate, by the log itself)
+                if callable(getattr(spec, "note_model", None)):
+                    meta[_MODEL_EDITS_KEY] = "logged"
+                add(meta)
         return self._log
 
     def _policy_metadata(self) -> dict[str, Any]:
@@ -1699,6 +1788,12 @@ class Gate:
         log = self._open_log()
         if log is None:
             return
+        version = getattr(self._scene, "version", 0)
+        if version != self._noted_version:  # the first window, or the scene was rebuilt after a model edit
+            self._noted_version = version
+            note = getattr(log, "note_model", None)
+            if callable(note):  # the log records what changed, so review re-derives on the model as certified
+                note(self.model)
         why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
         if not r.replaced:  # the window that ran is this one; it may commit a braking tail
             self._log_accepted = log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl,
@@ -1750,6 +1845,12 @@ class Gate:
             if self._log_lock is not None:
                 self._log_lock.close()  # releases the flock
                 self._log_lock = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle state: everything but the weak reference to the last checked ``MjData``."""
+        state = self.__dict__.copy()
+        state["_data_checked"] = None
+        return state
 
     def __enter__(self) -> Gate:
         return self

@@ -234,6 +234,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self._unwrapped = u
         self._obs: Any = None
         self._commit_ok = predictor == "rollout" and _steps_like_mujoco_env(u)
+        self._expected: tuple[np.ndarray, int, bytes] | None = None  # the certified window (see _commit_sim)
         self.commit = True
         """Commit the gate's own integration of the applied window instead of simulating it
         again when the env steps (see :meth:`_commit_sim`); False: the env always simulates.
@@ -342,7 +343,34 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             mujoco.mj_rnePostConstraint(u.model, u.data)
             self.gate.stats["committed"] += 1
         else:
+            why = self._uncertified_simulation(ctrl, int(n_frames))
+            if why:  # refused BEFORE the motion runs
+                raise InvalidInputError(
+                    f"env: {type(u).__name__}.step is about to simulate a window the gate did not certify: "
+                    f"{why}; nothing was simulated")
             type(u)._step_mujoco_simulation(u, ctrl, n_frames)
+        self._expected = None  # one window per step: a second simulation in the same step is refused
+
+    def _uncertified_simulation(self, ctrl: Any, n_frames: int) -> str:
+        """Why the simulation about to run (hooked ``_step_mujoco_simulation``) is not the certified window.
+
+        Empty when nothing identifiable differs (the env then simulates as gymnasium does).
+        """
+        exp = self._expected
+        if exp is None:
+            return "a second simulation in one env step (do_simulation called again)"
+        applied, nstep, mocap_start = exp
+        d = self._unwrapped.data
+        c = np.asarray(ctrl, dtype=np.float64)
+        if c.shape != applied.shape or c.tobytes() != applied.tobytes():
+            return (f"ctrl {np.array2string(c)} instead of the certified ctrl {np.array2string(applied)}")
+        if n_frames != nstep:
+            return f"{n_frames} substeps instead of the certified {nstep} (frame_skip)"
+        if d.mocap_pos.tobytes() + d.mocap_quat.tobytes() != mocap_start:
+            return "a mocap body was moved (data.mocap_pos/mocap_quat) after the gate decided"
+        if self._unwrapped.model is not self.gate.model:
+            return "env.unwrapped.model is not the model the gate certified against"
+        return "the simulator state (time, qpos, qvel, act, ...) was changed after the gate decided"
 
     def _check_applied_ctrl(self, applied: Any) -> None:
         """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
@@ -356,6 +384,89 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{np.array2string(expected)}: something between SafetyGate and "
                 f"{type(self.env.unwrapped).__name__}, or its step, changed the action in a way the gate "
                 "cannot predict; the window that ran was not certified")
+
+    def _live_frame_skip(self) -> int:
+        """The env's ``frame_skip`` as it is now (read every step; a user may change it after construction).
+
+        The gate certifies windows of this many substeps: a count read once at construction
+        would certify a shorter window than the env then simulates.
+
+        Raises:
+            InvalidInputError: ``env.unwrapped.frame_skip`` is not an integer >= 1.
+        """
+        fs = getattr(self._unwrapped, "frame_skip", 1)
+        if isinstance(fs, (bool, np.bool_)) or not isinstance(fs, (int, np.integer)) or fs < 1:
+            raise InvalidInputError(f"env.unwrapped.frame_skip must be an integer >= 1, got {fs!r}")
+        fs = int(fs)
+        if fs != self.gate.frame_skip:
+            self.gate.frame_skip = fs
+        return fs
+
+    def _check_elapsed(self, t_start: float, nstep: int) -> None:
+        """Raise if the env simulated past the certified window's end (rollout predictor).
+
+        ``mj_step`` advances ``data.time`` by ``opt.timestep`` per substep; the same float
+        additions from the window's start time give the certified window's end time. An env
+        whose ``step`` simulates more substeps (``do_simulation`` called twice, an extra
+        ``mj_step``, another count than ``frame_skip``) ran a motion the gate did not
+        certify: never silently. Fewer substeps under the certified control are a prefix of
+        the certified window (an env simulating its own way, or not at all, is not refused).
+        """
+        if self.predictor_mode != "rollout":
+            return
+        dt = self._unwrapped.model.opt.timestep
+        t_end = t_start
+        for _ in range(nstep):
+            t_end += dt
+        t_now = float(self._unwrapped.data.time)
+        if t_now > t_end:
+            raise InvalidInputError(
+                f"env: the step advanced data.time from {t_start!r} to {t_now!r} s, but the gate certified "
+                f"{nstep} substep(s) of {dt!r} s (to {t_end!r} s): {type(self._unwrapped).__name__}.step "
+                "simulated another motion than the certified window (e.g. do_simulation called twice or "
+                "with another count than frame_skip); the extra motion was not certified")
+
+    def _check_window_ran(self, applied: Any, nstep: int, mocap_start: bytes, committed: bool) -> None:
+        """Raise if the motion the env ran is not the certified window (rollout predictor).
+
+        * Mocap poses: the window's plan holds them at their values when the gate decided; an
+          env whose ``step`` moves a mocap body (an obstacle, a mocap-driven gripper) before
+          it simulates ran against geometry the gate never saw.
+        * When the env simulated itself (not committed from the gate's scratch): ``data.qpos``
+          must be the certified window's row at ``data.time`` bit for bit (MuJoCo is
+          deterministic: the same state, control and model give the same rows); a ``step``
+          that edits the model's dynamics, ``data.eq_active``, ``qfrc_applied`` or the state
+          before simulating, or changes ``qpos`` after it, ran another motion.
+
+        Raises:
+            InvalidInputError: naming what differed; the motion that ran was not certified.
+        """
+        if self.predictor_mode != "rollout":
+            return
+        d = self._unwrapped.data
+        if d.mocap_pos.tobytes() + d.mocap_quat.tobytes() != mocap_start:
+            raise InvalidInputError(
+                f"env: {type(self._unwrapped).__name__}.step moved a mocap body (data.mocap_pos/mocap_quat) "
+                "after the gate certified the window with the mocap poses as they were: the motion that "
+                "ran was not certified (move mocap bodies before calling step, or use predictor='plan' "
+                "with a plan that carries them)")
+        if committed:
+            return
+        ro = self.gate._rollout
+        rows = ro.window_rows
+        c = np.asarray(applied, dtype=np.float64)
+        if rows is None or len(rows) != nstep + 1 or c.tobytes() != ro._key_ctrl_bytes:
+            return  # the scratch does not hold the applied window (not the gate's own rollout)
+        hits = np.flatnonzero(rows[1:, 0] == d.time)
+        if len(hits) != 1:
+            return  # no substep ran (time checked by _check_elapsed; fewer substeps: a prefix)
+        row = rows[1 + int(hits[0]), 1:]
+        if row.tobytes() != d.qpos.tobytes():
+            raise InvalidInputError(
+                f"env: after the step data.qpos = {np.array2string(d.qpos)} but the certified window has "
+                f"{np.array2string(row)} at t = {d.time!r} s: {type(self._unwrapped).__name__}.step "
+                "simulated another motion than the certified one (model or state edited inside step?); "
+                "the motion that ran was not certified")
 
     def _fallback_fn(self) -> Callable[[], np.ndarray] | None:
         fb = self.user_fallback
@@ -387,18 +498,31 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             raise InvalidInputError(f"action contains NaN or inf: {arr}")
         if self.action_chain:
             action = self._inner_action(self.to_ctrl(action), "action")  # T evaluated once per step
-        report: StepReport = self.gate.decide(self._unwrapped.data, action, predict=self._predict_fn(),
-                                              fallback=self._fallback_fn(), cast=self._as_inner)
         u = self._unwrapped
+        if u.model is not self.gate.model:
+            raise InvalidInputError(
+                f"env: {type(u).__name__}.model is not the MjModel the gate was built on (the env replaced "
+                "it, e.g. recompiled a spec at reset): the gate would certify against the old model; "
+                "edit the model in place (the gate re-reads it) or build a new SafetyGate")
+        nstep = self._live_frame_skip()
+        t_start = float(u.data.time)
+        mocap_start = u.data.mocap_pos.tobytes() + u.data.mocap_quat.tobytes()  # held over the window
+        committed_before = self.gate.stats["committed"]
+        report: StepReport = self.gate.decide(u.data, action, nstep=nstep, predict=self._predict_fn(),
+                                              fallback=self._fallback_fn(), cast=self._as_inner)
         hook = self._commit_ok and self.commit and "_step_mujoco_simulation" not in u.__dict__
         if hook:  # instance attribute: shadows MujocoEnv._step_mujoco_simulation for this call only
             u._step_mujoco_simulation = self._commit_sim
+            self._expected = (np.asarray(report.applied_ctrl, dtype=np.float64), nstep, mocap_start)
         try:
             obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
         finally:
             if hook:
                 del u._step_mujoco_simulation
         self._check_applied_ctrl(report.applied_ctrl)
+        self._check_elapsed(t_start, nstep)
+        self._check_window_ran(report.applied_ctrl, nstep, mocap_start,
+                               self.gate.stats["committed"] != committed_before)
         self._obs = obs
         info = dict(info)
         info["safety"] = report.info(timing=self.timing)

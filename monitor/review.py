@@ -898,9 +898,79 @@ def _pair_key(geoms: Any) -> frozenset:
     return frozenset(map(str, geoms))
 
 
+def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], notes: list[str]
+                 ) -> tuple[list[tuple[int, dict[str, np.ndarray], int | None]], int | None]:
+    """The logged in-place model edits (``monitor.model_edit`` records), checked against ``model``.
+
+    Returns:
+        (edits in file order as (window index, field -> new array, disableflags or None),
+        the first window index from which the edits are unusable (a malformed record: those
+        windows are reported UNVERIFIABLE, never re-derived on a model the run did not certify
+        on), or None).
+    """
+    from monitor.scene import SYNC_FIELDS
+
+    out: list[tuple[int, dict[str, np.ndarray], int | None]] = []
+    bad_from: int | None = None
+    last = 0
+    for n, rec in enumerate(contents.model_edits):
+        w = rec.get("window") if isinstance(rec, dict) else None
+        problem = None
+        if not _is_int(w) or w < last:
+            problem = f"window {_short(w, 40)} is not an integer >= {last} (records in window order)"
+        fields = rec.get("fields") if isinstance(rec, dict) else None
+        arrays: dict[str, np.ndarray] = {}
+        if problem is None and not isinstance(fields, dict):
+            problem = "fields is not an object"
+        for name, val in (fields.items() if problem is None else ()):
+            if name not in SYNC_FIELDS:
+                problem = f"field {_short(name, 40)} is not a model array a certificate depends on"
+                break
+            ref = getattr(model, name)
+            try:
+                shape = tuple(int(x) for x in val["shape"])
+                arr = np.asarray(val["values"], dtype=np.float64)
+            except (TypeError, ValueError, KeyError) as exc:
+                problem = f"field {name}: {type(exc).__name__}"
+                break
+            if shape != ref.shape or arr.size != ref.size or not np.isfinite(arr).all():
+                problem = f"field {name}: shape {shape} / {arr.size} values, the model's is {ref.shape}"
+                break
+            arrays[name] = arr.reshape(shape).astype(ref.dtype)
+            if not np.array_equal(arrays[name], arr.reshape(shape)):
+                problem = f"field {name}: values not representable as {ref.dtype}"
+                break
+        flags = rec.get("disableflags") if isinstance(rec, dict) else None
+        if problem is None and flags is not None and not _is_int(flags):
+            problem = f"disableflags {_short(flags, 40)} is not an integer"
+        if problem is not None:
+            find(UNVERIFIABLE, f"model edit record {n} is malformed: {problem}")
+            bad_from = w if _is_int(w) and w >= last else last
+            break
+        last = int(w)
+        out.append((int(w), arrays, None if flags is None else int(flags)))
+    if out:
+        names = sorted({k for _, a, _ in out for k in a} | ({"opt.disableflags"} if any(
+            f is not None for _, _, f in out) else set()))
+        notes.append(f"{len(out)} in-place model edit(s) logged by the run (first at window {out[0][0]}; "
+                     f"fields: {', '.join(names)}): each window re-derived on the model as edited before "
+                     f"it (the run's record, like its requests: a forged record reads like a genuine one)")
+    return out, bad_from
+
+
+def _apply_model_edit(model: Any, edit: tuple[int, dict[str, np.ndarray], int | None]) -> None:
+    """Write one logged edit into ``model`` in place (review's own copy of the attached model)."""
+    _, arrays, flags = edit
+    for name, arr in arrays.items():
+        getattr(model, name)[...] = arr
+    if flags is not None:
+        model.opt.disableflags = flags
+
+
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
            limit: int | None = None, tolerances: dict[str, Any] | None = None,
-           expect_pairs: str | None = None, max_penetration: float | None = None) -> dict[str, Any]:
+           expect_pairs: str | None = None, max_penetration: float | None = None,
+           trust_model_edits: bool = False) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
@@ -934,6 +1004,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
     setting changed during the run and an added record look the same).
 
+    In-place model edits the run logged (``monitor.model_edit`` records, written by a gate
+    before the first window certified on the edited model) are applied in window order to
+    the attached model, so each window is re-derived on the model it was certified on (flips
+    there are critical as usual). A malformed record makes its windows unverifiable. A valid
+    record is still the run's unsigned claim (an added record shrinking an obstacle reads like
+    a genuine edit): the windows from the first edit are one unverifiable finding unless
+    ``trust_model_edits`` (the auditor trusts the run's edit records), then a note.
+
     Args:
         contents: a read log.
         model_source: ``"auto" | "xml" | "mjb"`` (see :func:`monitor.log.reader.load_model`).
@@ -947,6 +1025,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             answered under ``ongoing="deepen"`` with a larger ``penetration_tol`` is critical
             (a log that consistently claims a loose rule is otherwise only reported in a note).
             0 requires the plain rule.
+        trust_model_edits: accept the logged model edits as the run's model (see above).
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -1086,6 +1165,19 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            "unverifiable": 0, "missing_plans": 0, "errors": [], "pairs_differ": 0,
                            "applied_checked": 0}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
+    edits, edits_bad_from = _model_edits(contents, model, find, notes)
+    if edits and not trust_model_edits:
+        first_edit = edits[0][0]
+        n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
+                      for c in certs)
+        if n_after:
+            find(UNVERIFIABLE, f"{n_after} window(s) from index {first_edit} were certified on in-place "
+                               f"model edits the run logged: re-derived on them, but an unsigned log cannot "
+                               f"show that the edits happened (an added edit record reads the same; "
+                               f"trust_model_edits accepts them)")
+    if edits or edits_bad_from is not None:
+        certs = sorted(certs, key=lambda c: c["index"])  # edits apply in window order
+    unverifiable_after_edit: list[int] = []
     it = certs
     if progress is None:
         progress = len(certs) > 200
@@ -1096,6 +1188,19 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     for c in it:
         k = c["index"]
         verdict = c["verdict"]
+        if edits and edits[0][0] <= k and (edits_bad_from is None or k < edits_bad_from):
+            while edits and edits[0][0] <= k:  # the model as the run certified this window on
+                _apply_model_edit(model, edits.pop(0))
+            if scene is not None:
+                try:
+                    scene.sync()
+                    scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs)
+                except MonitorError as exc:
+                    find(UNVERIFIABLE, f"the logged model edit cannot be applied to the scene: {exc}", k)
+                    edits_bad_from = k if edits_bad_from is None else min(edits_bad_from, k)
+        if edits_bad_from is not None and k >= edits_bad_from:
+            unverifiable_after_edit.append(k)
+            continue
         if verdict not in VERDICTS:
             find(CRITICAL, f"unknown verdict {verdict[:40]!r}", k)
         method = c["method"]
@@ -1176,6 +1281,10 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
                                       "reason": "budget exhausted when logged" if budget else None})
+    if unverifiable_after_edit:
+        find(UNVERIFIABLE, f"{len(unverifiable_after_edit)} window(s) from index "
+                           f"{unverifiable_after_edit[0]} were certified on a model edit the log does not "
+                           f"describe validly: not re-derived")
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
     applied = _applied_findings(contents, good, plan_msgs, find, notes)
     out.update(applied)

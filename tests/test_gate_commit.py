@@ -70,9 +70,9 @@ def test_tunnel_gate_step_is_bit_identical_to_an_ungated_oracle(steps):
     gate = _run_against_oracle(m, steps, _tunnel_ctrl(1))
     s = gate.summary()
     # every kind of window was exercised: accepted, blocked with a predicted fallback,
-    # blocked inside the committed tail (stepped, not committed)
+    # blocked inside the committed tail (replayed against the tail's rows, then committed too)
     assert s["replaced"] > 0 and s["tail_reused"] > 0
-    assert s["committed"] > 0 and s["committed"] + s["tail_reused"] == steps
+    assert s["committed"] == steps and s["tail_replay_differs"] == 0
 
 
 def test_arm_gate_step_with_substeps_is_bit_identical_to_an_ungated_oracle():
@@ -188,7 +188,7 @@ def test_safety_gate_commit_is_bit_identical_to_an_ungated_env(env_id, kw):
     s = _gym_against_oracle(env_id, 30, **kw)
     assert s["committed"] > 0
     if env_id == "monitor/Arm-v0":  # rejections too: fallbacks predicted, or inside the committed tail
-        assert s["replaced"] > 0 and s["committed"] + s["tail_reused"] == s["windows"]
+        assert s["replaced"] > 0 and s["tail_reused"] > 0 and s["committed"] == s["windows"]
     else:
         assert s["committed"] == s["windows"]
 

@@ -135,6 +135,8 @@ class LogContents:
         requests: the decoded ``monitor.request`` records (:data:`topics.METADATA_REQUEST`)
             in file order, one dict per record (NOT merged: two records naming one request
             id stay two entries, so review can see a redefinition).
+        model_edits: the decoded ``monitor.model_edit`` records (:data:`topics.METADATA_MODEL_EDIT`)
+            in file order, not merged.
         attachments: attachment name -> bytes (attachments with a wrong CRC are dropped
             and counted as bad records).
         schemas: schema name -> (encoding, data bytes) of every schema seen.
@@ -162,6 +164,7 @@ class LogContents:
     problems: list[str] = field(default_factory=list)
     metadata: dict[str, dict[str, Any]] = field(default_factory=dict)
     requests: list[dict[str, Any]] = field(default_factory=list)
+    model_edits: list[dict[str, Any]] = field(default_factory=list)
     attachments: dict[str, bytes] = field(default_factory=dict)
     schemas: dict[str, tuple[str, bytes]] = field(default_factory=dict)
     records_walked: int = 0
@@ -542,6 +545,8 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                     decoded = _decode_metadata(rec.metadata)
                     if rec.name == topics.METADATA_REQUEST:
                         out.requests.append(decoded)
+                    elif rec.name == topics.METADATA_MODEL_EDIT:
+                        out.model_edits.append(decoded)
                     merged = out.metadata.setdefault(rec.name, {})
                     merged.update(decoded)
                 elif isinstance(rec, Attachment):

@@ -77,6 +77,18 @@ certificates answer (``{"id": int, "request": CertifyRequest.to_json() with wind
 written before the first certificate that names it; each certificate payload carries
 ``"request_id"``. Id 0 may instead be the ``monitor.run`` record's ``"request"`` (a gate logs its
 request at open): then no ``monitor.request`` record repeats it."""
+METADATA_MODEL_EDIT = "monitor.model_edit"
+"""Metadata record, one per in-place model edit a gate saw during the run (domain randomisation,
+tuning), written before the first window certified on the edited model:
+``{"window": i, "fields": {name: {"shape": [...], "values": [...]}}, "disableflags": int}`` with
+``i`` the index of that window and, for every :data:`monitor.scene.SYNC_FIELDS` array (everything a
+certificate depends on) that differs from the model as last attached or recorded, its full new
+value (row-major). ``review --verify`` applies the records in order to the attached model, so each
+window is re-derived on the model as it was certified. A gate writes ``"model_edits": "logged"``
+(:data:`MODEL_EDITS_KEY`) in the run metadata."""
+MODEL_EDITS_KEY = "model_edits"
+"""``monitor.run`` key a gate writes (value ``"logged"``): every in-place model edit the gate certified
+on is in a :data:`METADATA_MODEL_EDIT` record."""
 APPLIED_MOTIONS_KEY = "applied_motions"
 """``monitor.run`` key a gate writes (value ``"logged"``) when every replaced action of its log names
 the record of the motion actually applied: the action payload's ``applied_window`` is the index of a
@@ -112,7 +124,8 @@ def schema(topic: str) -> dict[str, Any]:
 
 __all__ = [
     "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
-    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
+    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY",
+    "METADATA_MODEL_EDIT", "MODEL_EDITS_KEY", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",
 ]

@@ -165,6 +165,19 @@ def package_versions() -> dict[str, str]:
     return out
 
 
+# --------------------------------------------------------------------------- model edits
+_DISABLEFLAGS = "opt.disableflags"
+
+
+def _model_fields(model: Any) -> dict[str, np.ndarray]:
+    """Copies of the model arrays a certificate depends on (``SYNC_FIELDS``) and ``opt.disableflags``."""
+    from monitor.scene import SYNC_FIELDS
+
+    out = {k: np.array(getattr(model, k)) for k in SYNC_FIELDS}
+    out[_DISABLEFLAGS] = np.array([int(model.opt.disableflags)])
+    return out
+
+
 # --------------------------------------------------------------------------- model export
 
 
@@ -395,8 +408,10 @@ class MonitorLog:
         if isinstance(run.get("request"), dict):
             self._requests[_request_key(run["request"])] = 0
         self.add_metadata(run)
+        self._model_base: dict[str, np.ndarray] | None = None  # SYNC_FIELDS as attached / last recorded
         if model is not None:
             self._attach_model(model)
+            self._model_base = _model_fields(model)
         self._flush()
 
     # ----------------------------------------------------------------- context manager
@@ -405,6 +420,44 @@ class MonitorLog:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    def note_model(self, model: Any) -> list[str]:
+        """Record an in-place edit of the attached model (a ``monitor.model_edit`` record), if any.
+
+        Compares every :data:`monitor.scene.SYNC_FIELDS` array and ``opt.disableflags`` of
+        ``model`` with the attached model (or the last record) and, when some differ, writes
+        their full new values, tagged with the index of the next window (see
+        :data:`topics.METADATA_MODEL_EDIT`). Call it before writing a window certified on an
+        edited model; a gate calls it whenever its scene was rebuilt.
+
+        Args:
+            model: the ``MjModel`` the next window was certified on (the attached one, edited).
+
+        Returns:
+            the names of the fields recorded (empty: nothing changed or no model attached).
+
+        Raises:
+            InvalidInputError: ``model`` does not have the attached model's array shapes.
+        """
+        self._check_open()
+        base = self._model_base
+        if base is None:
+            return []
+        now = _model_fields(model)
+        if any(now[k].shape != v.shape for k, v in base.items()):
+            raise InvalidInputError("model: its arrays do not have the shapes of the model attached to the "
+                                    "log (another model, not an in-place edit)")
+        changed = [k for k, v in base.items() if now[k].tobytes() != v.tobytes()]
+        if not changed:
+            return []
+        fields = {k: {"shape": list(now[k].shape), "values": now[k].ravel().tolist()}
+                  for k in changed if k != _DISABLEFLAGS}
+        rec: dict[str, Any] = {"window": self._index, "fields": fields}
+        if _DISABLEFLAGS in changed:
+            rec["disableflags"] = int(now[_DISABLEFLAGS][0])
+        self.add_metadata(rec, name=topics.METADATA_MODEL_EDIT)
+        self._model_base = now
+        return changed
 
     @property
     def windows(self) -> int:
