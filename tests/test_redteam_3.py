@@ -480,3 +480,16 @@ def test_gate_still_pickles_after_a_step():
     gate.step(d, np.zeros(1))
     again = pickle.loads(pickle.dumps(gate))
     assert again.step(d, np.zeros(1)).verdict == "certified"
+
+
+def test_review_cli_trust_model_edits_flag(tmp_path, capsys):
+    """``python -m monitor review --verify`` on the edited run: exit 2 by default (the edit record is
+    unverifiable), exit 0 with ``--trust-model-edits``; the flag is refused with ``--ray`` (not wired)."""
+    from monitor.cli import main
+
+    _edited_run(tmp_path / "edit.mcap")
+    log = str(tmp_path / "edit.mcap")
+    assert main(["review", log, "--verify", "--no-progress"]) == 2
+    assert main(["review", log, "--verify", "--no-progress", "--trust-model-edits"]) == 0
+    assert main(["review", log, "--ray", "--trust-model-edits"]) == 2
+    assert "--trust-model-edits" in capsys.readouterr().err

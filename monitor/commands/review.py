@@ -58,6 +58,11 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                    help="--verify requires every window's ongoing-contact rule to allow at most M metres "
                         "of penetration (a window certified under ongoing='deepen' with a larger "
                         "penetration_tol is critical; 0 requires the plain rule); default: reported")
+    p.add_argument("--trust-model-edits", action="store_true",
+                   help="--verify accepts the log's model-edit records (monitor.model_edit: arrays the run "
+                        "changed in place) as the model the windows were certified on; default: such "
+                        "windows are re-derived on the edited model but reported unverifiable (exit 2), "
+                        "because an unsigned edit record could be forged to shrink an obstacle")
     p.add_argument("--tolerances", metavar="JSON", default=None,
                    help="tolerance fields for --verify, e.g. '{\"abs_pad\": 1e-10}' (default: the library's; "
                         "logged tolerances are only compared, never used)")
@@ -121,7 +126,8 @@ def _review_one(path: str, args: argparse.Namespace,
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
                                      limit=args.limit, tolerances=getattr(args, "tolerance_values", None),
                                      expect_pairs=getattr(args, "expect_pairs", None),
-                                     max_penetration=getattr(args, "max_penetration", None))
+                                     max_penetration=getattr(args, "max_penetration", None),
+                                     trust_model_edits=bool(getattr(args, "trust_model_edits", False)))
         except ImportError as exc:
             entry["verify"] = {"error": f"verification needs the certification engine: {exc}"}
         except (MonitorError, ValueError) as exc:
@@ -176,9 +182,10 @@ def run(args: argparse.Namespace) -> int:
     if mp is not None and not (math.isfinite(mp) and mp >= 0):
         print(f"error: --max-penetration must be a finite number >= 0 (m), got {mp}", file=sys.stderr)
         return 2
-    if (args.tolerance_values or getattr(args, "expect_pairs", None) or mp is not None) \
-            and getattr(args, "ray", False):
-        print("error: --tolerances, --expect-pairs and --max-penetration are not supported with --ray yet",
+    if (args.tolerance_values or getattr(args, "expect_pairs", None) or mp is not None
+            or getattr(args, "trust_model_edits", False)) and getattr(args, "ray", False):
+        print("error: --tolerances, --expect-pairs, --max-penetration and --trust-model-edits are not "
+              "supported with --ray yet",
               file=sys.stderr)
         return 2
     paths = expand_logs(args.logs)
