@@ -1316,6 +1316,40 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
             ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
             gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
             name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
+    ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
+    # issue 12: the compiled exact swept test first (one call per pair, extrusion_swept);
+    # the pairs it cannot settle go to the Python checker below, unchanged
+    fast: list[PairOutcome | None] = [None] * len(eps_pairs)
+    if _SWEPT_FIRST and not bud.exhausted:
+        from monitor.certify.extrusion_swept import decide_pair
+        n_fast = 0
+        for k, p in enumerate(eps_pairs):
+            fast[k] = o = decide_pair(p.shape_a, p.R_a, p.times_a, p.origins_a, p.shape_b, p.R_b, p.times_b,
+                                      p.origins_b, (t0, t1), margin, ext_margin, tol, p.name)
+            if o is not None:
+                n_fast += o.tests
+        if n_fast:
+            bud.charge(n_fast)
+        if all(o is not None for o in fast):
+            return fast  # type: ignore[return-value]
+    rest = [k for k, o in enumerate(fast) if o is None]
+    if len(rest) < len(eps_pairs):
+        outs_rest = _run_extrusion_python([eps_pairs[k] for k in rest], margin, ext_margin, tol, bud, t0, t1)
+        for k, o in zip(rest, outs_rest):
+            fast[k] = o
+        return fast  # type: ignore[return-value]
+    return _run_extrusion_python(eps_pairs, margin, ext_margin, tol, bud, t0, t1)
+
+
+_SWEPT_FIRST = True
+"""Run :func:`monitor.certify.extrusion_swept.decide_pair` before the Python extrusion checker
+(tests switch it off to compare with the Python checker alone)."""
+
+
+def _run_extrusion_python(eps_pairs: list, margin: float, ext_margin: float, tol: Tolerances, bud: Budget,
+                          t0: float, t1: float) -> list[PairOutcome]:
+    """The Python extrusion checker (one n-ary search, Cameron §6) on ``eps_pairs``, re-run for witnesses."""
+    from monitor.certify import extrusion
     # The extrusion checker is exact up to Tolerances.extrusion_slack with Cameron's
     # regularised semantics (touching is not a collision). The engine's contract is
     # stricter (certified => clearance > margin, rounding included), so it asks the
@@ -1325,7 +1359,6 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     # Pairs that fail the stronger question (only those) are re-run at the true margin
     # for a witness deep enough to confirm (with margin > 0 the checker caps its depth
     # at the margin it is given); "certified" there means the sub-slack band: unresolved.
-    ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
     outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud, nary=True)
     redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
     if redo and not bud.exhausted:
