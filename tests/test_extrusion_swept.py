@@ -357,3 +357,31 @@ def test_exhausted_budget_skips_the_pass():
     scene, motion = case.scene(), case.body_motion()
     cert = certify(scene, motion, margin=case.margin, method="extrusion", budget=Budget(tests=0))
     assert cert.verdict != "certified"
+
+
+def test_engine_entry_box_calls_same_public_answers():
+    """The recorded box-scene calls of tests/test_engine_entry.py (first pass on vs off): same verdict,
+    earliest time, witness pair and per-pair verdicts; clearances within 1e-12 m."""
+    import sys
+    from pathlib import Path
+
+    pytest.importorskip("mujoco")
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from _engine_entry_cases import box_calls
+
+    n_fast = 0
+    for name, run in box_calls():
+        a, b = _both(run)
+        assert a.verdict == b.verdict, name
+        assert (a.earliest_time is None) == (b.earliest_time is None), name
+        if a.earliest_time is not None:
+            assert a.earliest_time == pytest.approx(b.earliest_time, abs=1e-12), name
+        assert (a.witness is None) == (b.witness is None), name
+        assert a.witness is None or a.witness.geoms == b.witness.geoms, name
+        assert [p.verdict for p in a.pairs] == [p.verdict for p in b.pairs], name
+        assert [p.method for p in a.pairs] == [p.method for p in b.pairs], name
+        for p, q in zip(a.pairs, b.pairs):
+            if p.verdict == "certified":
+                assert p.clearance == pytest.approx(q.clearance, abs=1e-12), name
+        n_fast += a.stats.get("extrusion", {}).get("swept_kernel", 0)
+    assert n_fast > 10
