@@ -1300,7 +1300,14 @@ def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: floa
 
 def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, bud: Budget,
                    t0: float, t1: float) -> list[PairOutcome]:
-    """Extrusion checker on the translating pairs, in one n-ary search (Cameron §6).
+    """Extrusion checker on the translating pairs: a compiled first pass, then one n-ary search (Cameron §6).
+
+    First pass (issue 12; ``_SWEPT_FIRST``): :func:`monitor.certify.extrusion_swept.decide_pair`,
+    the checker's exact swept test per span in one compiled call per pair (certified at the
+    stronger margin below, violation at the true margin with the exact first contact);
+    ``info["test"] == "swept_kernel"``, stage ``"exact_swept"``. The pairs it leaves (the
+    exactness band, half-spaces, penetrations of sharp polytopes at margin 0, bad input) go
+    to the Python checker exactly as before:
 
     Per pair the checker runs S-bounds (§4.3, App. B; shared per body, §6.3), divide
     and conquer (§4.1) and the null-set LP on the half-spaces offset by the pair's
@@ -1309,36 +1316,53 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     :func:`extrusion_stats` summarises a list of outcomes for ``cert.stats``.
     """
     from monitor.certify import extrusion
-    posr, rotr = plan.body_poses(np.array([t0]))
-    eps_pairs = []
-    for _i, ga, gb, ((ta, oa), (tb, ob)) in ext_items:
-        eps_pairs.append(extrusion.TranslatingPair(
-            ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
-            gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
-            name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
     ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
-    # issue 12: the compiled exact swept test first (one call per pair, extrusion_swept);
-    # the pairs it cannot settle go to the Python checker below, unchanged
-    fast: list[PairOutcome | None] = [None] * len(eps_pairs)
+    rot = _rotations(plan, t0)
+    outs: list[PairOutcome | None] = [None] * len(ext_items)
     if _SWEPT_FIRST and not bud.exhausted:
+        # issue 12: the compiled exact swept test first, one call per pair
+        # (monitor.certify.extrusion_swept); what it cannot settle goes to the Python checker
         from monitor.certify.extrusion_swept import decide_pair
         n_fast = 0
-        for k, p in enumerate(eps_pairs):
-            fast[k] = o = decide_pair(p.shape_a, p.R_a, p.times_a, p.origins_a, p.shape_b, p.R_b, p.times_b,
-                                      p.origins_b, (t0, t1), margin, ext_margin, tol, p.name)
+        for k, (_i, ga, gb, ((ta, oa), (tb, ob))) in enumerate(ext_items):
+            outs[k] = o = decide_pair(ga.shape, rot(ga.body_id), ta, oa, gb.shape, rot(gb.body_id), tb, ob,
+                                      (t0, t1), margin, ext_margin, tol, (ga.name, gb.name))
             if o is not None:
                 n_fast += o.tests
         if n_fast:
             bud.charge(n_fast)
-        if all(o is not None for o in fast):
-            return fast  # type: ignore[return-value]
-    rest = [k for k, o in enumerate(fast) if o is None]
-    if len(rest) < len(eps_pairs):
-        outs_rest = _run_extrusion_python([eps_pairs[k] for k in rest], margin, ext_margin, tol, bud, t0, t1)
-        for k, o in zip(rest, outs_rest):
-            fast[k] = o
-        return fast  # type: ignore[return-value]
-    return _run_extrusion_python(eps_pairs, margin, ext_margin, tol, bud, t0, t1)
+    rest = [k for k, o in enumerate(outs) if o is None]
+    if rest:
+        eps_pairs = []
+        for k in rest:
+            _i, ga, gb, ((ta, oa), (tb, ob)) = ext_items[k]
+            eps_pairs.append(extrusion.TranslatingPair(
+                ga.shape, rot(ga.body_id), np.asarray(ta, float), np.asarray(oa, float),
+                gb.shape, rot(gb.body_id), np.asarray(tb, float), np.asarray(ob, float),
+                name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
+        for k, o in zip(rest, _run_extrusion_python(eps_pairs, margin, ext_margin, tol, bud, t0, t1)):
+            outs[k] = o
+    return outs  # type: ignore[return-value]
+
+
+def _rotations(plan: Any, t0: float) -> Any:
+    """``body -> R_WB`` (3, 3) at ``t0`` for the bodies of translating pairs (constant over the window).
+
+    A :class:`~monitor.motion.plan.Plan` has them already: its waypoint FK rotations
+    (``_wp_mat[0]``; the rotation of a body that only translates is the same at every
+    waypoint). Other trajectories: one ``body_poses`` call at ``t0``, made on first use.
+    """
+    cls = _plan_class()
+    if cls is not None and type(plan) is cls:
+        wm = plan._wp_mat
+        return lambda b: wm[0, b]
+    memo: list = []
+
+    def rot(b: int) -> np.ndarray:
+        if not memo:
+            memo.append(plan.body_poses(np.array([t0]))[1])
+        return memo[0][0, b]
+    return rot
 
 
 _SWEPT_FIRST = True
