@@ -1350,12 +1350,26 @@ def _rotations(plan: Any, t0: float) -> Any:
 
     A :class:`~monitor.motion.plan.Plan` has them already: its waypoint FK rotations
     (``_wp_mat[0]``; the rotation of a body that only translates is the same at every
-    waypoint). Other trajectories: one ``body_poses`` call at ``t0``, made on first use.
+    waypoint); a :class:`~monitor.motion.bodymotion.BodyMotion` its first waypoint
+    quaternion (``quat[0]``, normalised; constant for such a body). Other trajectories: one
+    ``body_poses`` call at ``t0``, made on first use.
     """
     cls = _plan_class()
     if cls is not None and type(plan) is cls:
         wm = plan._wp_mat
         return lambda b: wm[0, b]
+    bm = sys.modules.get("monitor.motion.bodymotion")
+    if bm is not None and type(plan) is getattr(bm, "BodyMotion", None):
+        # a BodyMotion: the waypoint quaternions (normalised); a translating body's is constant
+        q0 = plan.quat[0]
+        mats: dict[int, np.ndarray] = {}
+
+        def rot_bm(b: int) -> np.ndarray:
+            R = mats.get(b)
+            if R is None:
+                R = mats[b] = bm.K.quat_to_mat(q0[b])
+            return R
+        return rot_bm
     memo: list = []
 
     def rot(b: int) -> np.ndarray:
