@@ -1008,7 +1008,22 @@ def _translates(plan: Any, mp: Any, b: int) -> bool:
         return True
     if mp.body_rotating[b] != 0:
         return False
+    if type(plan) in _known_trajectories():
+        # Plan and BodyMotion: translation_segments(b) is None exactly when the body moves and
+        # its own _rotating flag is set (a Plan's equals the pack's, checked above)
+        return not plan._rotating[b]
     return plan.translation_segments(b) is not None
+
+
+def _known_trajectories() -> tuple:
+    """Loaded trajectory classes whose ``translation_segments`` is None iff moving and ``_rotating``."""
+    out = []
+    for mod, name in (("monitor.motion.plan", "Plan"), ("monitor.motion.bodymotion", "BodyMotion")):
+        m = sys.modules.get(mod)
+        c = None if m is None else getattr(m, name, None)
+        if c is not None:
+            out.append(c)
+    return tuple(out)
 
 
 _FULL_SEARCH_TESTS = 1024
@@ -1361,14 +1376,12 @@ def _rotations(plan: Any, t0: float) -> Any:
     bm = sys.modules.get("monitor.motion.bodymotion")
     if bm is not None and type(plan) is getattr(bm, "BodyMotion", None):
         # a BodyMotion: the waypoint quaternions (normalised); a translating body's is constant
-        q0 = plan.quat[0]
-        mats: dict[int, np.ndarray] = {}
+        mats: list = []
 
         def rot_bm(b: int) -> np.ndarray:
-            R = mats.get(b)
-            if R is None:
-                R = mats[b] = bm.K.quat_to_mat(q0[b])
-            return R
+            if not mats:   # one vectorised conversion per call (the same arithmetic per body)
+                mats.append(bm.K.quat_to_mat(plan.quat[0]))
+            return mats[0][b]
         return rot_bm
     memo: list = []
 
