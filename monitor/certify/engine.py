@@ -1340,8 +1340,9 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
         from monitor.certify.extrusion_swept import decide_pair
         n_fast = 0
         for k, (_i, ga, gb, ((ta, oa), (tb, ob))) in enumerate(ext_items):
-            outs[k] = o = decide_pair(ga.shape, rot(ga.body_id), ta, oa, gb.shape, rot(gb.body_id), tb, ob,
-                                      (t0, t1), margin, ext_margin, tol, (ga.name, gb.name))
+            Ra, Rb = rot(ga.body_id, True), rot(gb.body_id, True)
+            outs[k] = o = decide_pair(ga.shape, Ra, ta, oa, gb.shape, Rb, tb, ob, (t0, t1), margin,
+                                      ext_margin, tol, (ga.name, gb.name))
             if o is not None:
                 n_fast += o.tests
         if n_fast:
@@ -1361,31 +1362,38 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
 
 
 def _rotations(plan: Any, t0: float) -> Any:
-    """``body -> R_WB`` (3, 3) at ``t0`` for the bodies of translating pairs (constant over the window).
+    """``rot(body, fast=False) -> R_WB`` (3, 3) at ``t0`` for the bodies of translating pairs.
 
-    A :class:`~monitor.motion.plan.Plan` has them already: its waypoint FK rotations
-    (``_wp_mat[0]``; the rotation of a body that only translates is the same at every
-    waypoint); a :class:`~monitor.motion.bodymotion.BodyMotion` its first waypoint
-    quaternion (``quat[0]``, normalised; constant for such a body). Other trajectories: one
-    ``body_poses`` call at ``t0``, made on first use.
+    The rotation of such a body is constant over the window. A
+    :class:`~monitor.motion.plan.Plan` has it already: its waypoint FK rotations
+    (``_wp_mat[0]``; the same at every waypoint). A
+    :class:`~monitor.motion.bodymotion.BodyMotion`: its first waypoint quaternion
+    (``quat[0]``, normalised; a translating body's quaternions are equal bit for bit), by
+    ``quat_to_mat`` (one vectorised call) or, with ``fast=True`` (the compiled first pass,
+    whose pads cover a few ulp in R), the same formula on Python floats without the
+    re-normalisation. Other trajectories: one ``body_poses`` call at ``t0``, made on first use.
     """
     cls = _plan_class()
     if cls is not None and type(plan) is cls:
         wm = plan._wp_mat
-        return lambda b: wm[0, b]
+        return lambda b, fast=False: wm[0, b]
     bm = sys.modules.get("monitor.motion.bodymotion")
     if bm is not None and type(plan) is getattr(bm, "BodyMotion", None):
-        # a BodyMotion: the waypoint quaternions (normalised); a translating body's is constant
         mats: list = []
 
-        def rot_bm(b: int) -> np.ndarray:
+        def rot_bm(b: int, fast: bool = False) -> np.ndarray:
+            if fast:
+                w, x, y, z = plan.quat[0, b].tolist()
+                return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                                 [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                                 [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
             if not mats:   # one vectorised conversion per call (the same arithmetic per body)
                 mats.append(bm.K.quat_to_mat(plan.quat[0]))
             return mats[0][b]
         return rot_bm
     memo: list = []
 
-    def rot(b: int) -> np.ndarray:
+    def rot(b: int, fast: bool = False) -> np.ndarray:
         if not memo:
             memo.append(plan.body_poses(np.array([t0]))[1])
         return memo[0][0, b]
