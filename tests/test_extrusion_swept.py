@@ -106,6 +106,59 @@ def test_sphere_head_on_at_box_face_closed_form(seed):
         assert o.info["stage"] == "exact_swept" and o.info["test"] == "swept_kernel"
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_box_onto_tilted_moving_plane_closed_form(seed):
+    """A rotated box moving onto a rotated, translating half-space over 2 segments (closed form).
+
+    Signed distance of the box to the plane: ``min_i n.(x_i(t)) - h(t)``; its first crossing of
+    the level is the smallest per-vertex root on the first segment where one exists.
+    """
+    rng = np.random.default_rng(50 + seed)
+    Rp = Rotation.random(random_state=100 + seed).as_matrix()
+    Rb = Rotation.random(random_state=200 + seed).as_matrix()
+    half = rng.uniform(0.05, 0.2, 3)
+    box = box_polytope(half)
+    n = Rp[:, 2]                                    # the plane's world normal (body z)
+    margin = float(rng.choice([0.0, 0.01]))
+    times = np.array([0.0, 0.4, 1.0])
+    p_plane = np.array([rng.normal(size=3) * 0.1, rng.normal(size=3) * 0.1, rng.normal(size=3) * 0.1])
+    start = p_plane[0] + n * rng.uniform(0.5, 0.9)
+    # the box moves towards the plane (along -n plus a sideways drift); the plane drifts too
+    drift = rng.normal(size=3) * 0.1
+    speeds = rng.uniform(0.3, 1.2, 2)
+    ob = np.array([start, start - n * speeds[0] * 0.4 + drift * 0.4,
+                   start - n * (speeds[0] * 0.4 + speeds[1] * 0.6) + drift])
+    V = box.points @ Rb.T
+
+    def signed(t):
+        x = V + np.array([np.interp(t, times, ob[:, c]) for c in range(3)])
+        p = np.array([np.interp(t, times, p_plane[:, c]) for c in range(3)])
+        return float(np.min((x - p) @ n))
+
+    # closed form per segment: each vertex's distance is linear on a segment
+    t_star = None
+    for k in range(2):
+        a, b = times[k], times[k + 1]
+        da = (V + ob[k] - p_plane[k]) @ n
+        db = (V + ob[k + 1] - p_plane[k + 1]) @ n
+        hit = [a + (b - a) * (da[i] - margin) / (da[i] - db[i]) for i in range(8)
+               if da[i] >= margin > db[i]]
+        if hit:
+            t_star = min(hit)
+            break
+    o = _decide(halfspace_shape(), Rp, times, p_plane, box, Rb, times, ob, (0.0, 1.0), margin)
+    assert o is not None and o.info.get("closed_form") == "halfspace"
+    if t_star is None:
+        assert o.verdict == "certified"
+        true_min = min(signed(t) for t in times)       # concave piecewise linear: a breakpoint
+        assert true_min - 1e-9 <= o.clearance <= true_min
+    else:
+        assert o.verdict == "violation"
+        assert o.info["earliest_time"] == pytest.approx(t_star, abs=1e-9)
+        assert signed(o.witness_time) < margin
+        assert o.info["stage"] == "null_set"
+
+
 # ----------------------------------------------------------------------------- random pairs, sampling
 
 def _random_shape(rng, kind):
@@ -223,9 +276,9 @@ def test_undecided_cases_are_left_to_the_python_checker():
     box = box_polytope(np.array([0.1, 0.1, 0.1]))
     t = np.array([0.0, 1.0])
     still = np.zeros((2, 3))
-    # a half-space: the checker's closed form decides it
+    # two half-spaces: the checker raises UnsupportedGeometryError
     up = still + [0, 0, 1.0]
-    assert _decide(halfspace_shape(), EYE, t, still, box, EYE, t, up, (0.0, 1.0), 0.0) is None
+    assert _decide(halfspace_shape(), EYE, t, still, halfspace_shape(), EYE, t, up, (0.0, 1.0), 0.0) is None
     # touching exactly at the margin at t = 1 (the exactness band): neither proved
     far = np.array([[0.5, 0, 0], [0.2 + 0.01, 0, 0]])
     assert _decide(box, EYE, t, still, box, EYE, t, far, (0.0, 1.0), 0.01) is None

@@ -245,7 +245,166 @@ def swept_pair_kernel(Pa, Ra, ta, oa, Pb, Rb, tb, ob, w0, w1, thr_cert, level, r
 
 
 _KINDS = ("polytope", "sphere", "capsule")
-"""Core kinds the compiled pass takes (a half-space goes to the checker's closed form)."""
+"""Core kinds of :func:`swept_pair_kernel`; a half-space against one of them takes
+:func:`halfspace_pair_kernel`."""
+
+
+@njit(cache=True)
+def halfspace_pair_kernel(n_p, h_p, Pp, Rp, tp, op, Po, Ro, to, oo, w0, w1, thr_cert, level, rr, rel_pad,
+                          abs_pad, out):
+    """A convex core against a (translating) half-space: the checker's closed form per span.
+
+    The half-space is ``{x : n . x <= h}`` in its body frame (``n_p`` (3,) unit, ``h_p``), on a
+    body with rotation ``Rp``, motion ``tp, op``; the core has vertices ``Po`` (body frame),
+    rotation ``Ro``, motion ``to, oo``. On a span the signed distance of the core to the plane
+    is ``d(tau) = min_i n.(p_i + w tau) - h``, concave and piecewise linear: its minimum over
+    the span is at an end, and its first crossing of a level is the smallest per-vertex
+    crossing time (the closed form of ``extrusion_null.halfspace_null_test``, counted as the
+    null-set stage §4.2: a half-space offset by r is exact). Same rules, levels, pads,
+    first-contact and witness times as the Python checker (``_round_pair``).
+
+    Args and returns: as :func:`swept_pair_kernel` (``Pp``: the plane's points, only for the
+    coordinate scale).
+    """
+    for k in range(OUT_SIZE):
+        out[k] = 0.0
+    no = Po.shape[0]
+    if no < 1 or not (level >= 0.0) or not (thr_cert >= level):
+        return CODE_UNDECIDED
+    if not (np.isfinite(w0) and np.isfinite(w1) and w0 < w1):
+        return CODE_UNDECIDED
+    if not (_valid_motion(tp, op, w0, w1) and _valid_motion(to, oo, w0, w1)):
+        return CODE_UNDECIDED
+    nw0 = np.empty(3)
+    for r in range(3):
+        nw0[r] = Rp[r, 0] * n_p[0] + Rp[r, 1] * n_p[1] + Rp[r, 2] * n_p[2]
+    V0 = np.empty((no, 3))
+    mo = 0.0
+    for i in range(no):
+        for r in range(3):
+            V0[i, r] = Ro[r, 0] * Po[i, 0] + Ro[r, 1] * Po[i, 1] + Ro[r, 2] * Po[i, 2]
+            mo = max(mo, abs(V0[i, r]), abs(Po[i, r]))
+    mp = abs(h_p)
+    for i in range(Pp.shape[0]):
+        for r in range(3):
+            mp = max(mp, abs(Pp[i, r]))
+    if not (np.isfinite(mo) and np.isfinite(mp) and np.isfinite(nw0[0] + nw0[1] + nw0[2])):
+        return CODE_UNDECIDED
+    moa = 0.0
+    for i in range(op.shape[0]):
+        for c in range(3):
+            moa = max(moa, abs(op[i, c]))
+    mob = 0.0
+    for i in range(oo.shape[0]):
+        for c in range(3):
+            mob = max(mob, abs(oo[i, c]))
+    scale = max(moa + 2.0 * mp, mob + 2.0 * mo)
+    data_pad = rel_pad * scale + abs_pad
+    bps = np.empty(tp.shape[0] + to.shape[0] + 2)
+    nbp = 0
+    bps[nbp] = w0
+    nbp += 1
+    for t in tp:
+        if w0 < t < w1:
+            bps[nbp] = t
+            nbp += 1
+    for t in to:
+        if w0 < t < w1:
+            bps[nbp] = t
+            nbp += 1
+    bps[nbp] = w1
+    nbp += 1
+    bps = np.sort(bps[:nbp])
+    o_p = np.empty(3)
+    v_p = np.empty(3)
+    o_o = np.empty(3)
+    v_o = np.empty(3)
+    cc = np.empty(3)
+    V = np.empty((no, 3))
+    d0 = np.empty(no)
+    clear = np.inf
+    spans = 0
+    for j in range(nbp - 1):
+        s0 = bps[j]
+        s1 = bps[j + 1]
+        if not (s1 > s0):
+            continue
+        T = s1 - s0
+        _body_state(tp, op, s0, s1, o_p, v_p)
+        _body_state(to, oo, s0, s1, o_o, v_o)
+        for c in range(3):
+            cc[c] = 0.5 * (o_p[c] + o_o[c])
+        # the plane centred at cc: n . x <= h + n . (o_p - cc); the core V + v_o tau
+        h = h_p + (nw0[0] * (o_p[0] - cc[0]) + nw0[1] * (o_p[1] - cc[1]) + nw0[2] * (o_p[2] - cc[2]))
+        nw = 0.0
+        for c in range(3):
+            nw += nw0[c] * (v_o[c] - v_p[c])
+        mag = 0.0
+        for i in range(no):
+            s = 0.0
+            m = 0.0
+            for c in range(3):
+                V[i, c] = V0[i, c] + (o_o[c] - cc[c])
+                s += V[i, c] * nw0[c]
+                m += abs(V[i, c]) * abs(nw0[c])
+            d0[i] = s - h
+            mag = max(mag, m + abs(h) + abs(nw) * T)
+        # the minimum over both ends, the span start first on ties (the checker's argmin order)
+        dmin = np.inf
+        tmin = 0.0
+        for i in range(no):
+            if d0[i] < dmin:
+                dmin = d0[i]
+        for i in range(no):
+            e1 = d0[i] + nw * T
+            if e1 < dmin:
+                dmin, tmin = e1, T
+        pad_w = 8 * rel_pad * mag + abs_pad   # the checker's witness-level call has no data pad
+        pad = pad_w + data_pad
+        spans += 1
+        if dmin - pad >= thr_cert:
+            clear = min(clear, dmin - pad - rr)
+            continue
+        if not (dmin + pad < level):
+            return CODE_UNDECIDED
+        # first crossing of the level, and of the witness level half way to the minimum
+        first = np.inf
+        lw = 0.5 * (level + dmin)
+        wt = np.inf
+        for i in range(no):
+            if d0[i] < level:
+                first = 0.0
+            elif nw < 0:
+                first = min(first, min(max((level - d0[i]) / nw, 0.0), T))
+            if d0[i] < lw:
+                wt = 0.0
+            elif nw < 0:
+                wt = min(wt, min(max((lw - d0[i]) / nw, 0.0), T))
+        if not (dmin + pad_w < lw) or not np.isfinite(wt):
+            wt = tmin   # the checker: no proved crossing of the witness level -> the minimum's end
+        if not np.isfinite(first):
+            return CODE_UNDECIDED
+        kw = 0
+        dw = np.inf
+        for i in range(no):
+            dv = d0[i] + nw * wt
+            if dv < dw:
+                dw, kw = dv, i
+        for c in range(3):
+            out[O_WP + c] = V[kw, c] + v_o[c] * wt - 0.5 * dw * nw0[c] + cc[c]
+            out[O_FP + c] = V[kw, c] + v_o[c] * first + cc[c]
+        out[O_FIRST] = s0 + first
+        out[O_WTIME] = s0 + wt
+        out[O_S0] = s0
+        out[O_S1] = s1
+        out[O_DEPTH] = level - (dmin + pad)
+        out[O_CLEAR] = -np.inf
+        out[O_SPANS] = spans
+        out[O_SOLVES] = 0
+        return CODE_VIOLATION
+    out[O_CLEAR] = clear
+    out[O_SPANS] = spans
+    return CODE_CERTIFIED
 
 
 def _f(x: Any) -> np.ndarray:
@@ -280,7 +439,11 @@ def decide_pair(shape_a: Any, R_a: np.ndarray, times_a: np.ndarray, origins_a: n
         ``witness_point``, ``info["earliest_time"]`` the exact first contact at ``margin``,
         ``intervals == [(earliest, witness)]``), or None when the pass cannot decide.
     """
-    if shape_a.kind not in _KINDS or shape_b.kind not in _KINDS:
+    ka, kb = shape_a.kind, shape_b.kind
+    plane = ka == "halfspace" or kb == "halfspace"
+    if plane and (ka == kb or (ka if kb == "halfspace" else kb) not in _KINDS):
+        return None   # two planes (the checker raises) or an unknown kind
+    if not plane and (ka not in _KINDS or kb not in _KINDS):
         return None
     ra, rb = float(shape_a.radius), float(shape_b.radius)
     rr = ra + rb
@@ -288,15 +451,31 @@ def decide_pair(shape_a: Any, R_a: np.ndarray, times_a: np.ndarray, origins_a: n
     thr_cert = ra + rb + margin_ext - tol.extrusion_slack
     level = ra + rb + margin
     out = np.empty(OUT_SIZE)
-    code = swept_pair_kernel(_f(shape_a.points), _f(R_a), _f(times_a), _f(origins_a),
-                             _f(shape_b.points), _f(R_b), _f(times_b), _f(origins_b),
-                             float(window[0]), float(window[1]), float(thr_cert), float(level), float(rr),
-                             float(tol.rel_pad), float(tol.abs_pad), out)
+    if plane:
+        sides = [(shape_a, R_a, times_a, origins_a), (shape_b, R_b, times_b, origins_b)]
+        if ka != "halfspace":
+            sides.reverse()
+        (sp, Rp, tp, op), (so, Ro, to, oo) = sides
+        if len(sp.normals) != 1:
+            return None
+        code = halfspace_pair_kernel(_f(sp.normals[0]), float(sp.offsets[0]), _f(sp.points), _f(Rp), _f(tp),
+                                     _f(op), _f(so.points), _f(Ro), _f(to), _f(oo), float(window[0]),
+                                     float(window[1]), float(thr_cert), float(level), float(rr),
+                                     float(tol.rel_pad), float(tol.abs_pad), out)
+    else:
+        code = swept_pair_kernel(_f(shape_a.points), _f(R_a), _f(times_a), _f(origins_a),
+                                 _f(shape_b.points), _f(R_b), _f(times_b), _f(origins_b),
+                                 float(window[0]), float(window[1]), float(thr_cert), float(level), float(rr),
+                                 float(tol.rel_pad), float(tol.abs_pad), out)
     if code == CODE_UNDECIDED:
         return None
     o = out.tolist()
-    info: dict[str, Any] = {"geoms": [names[0], names[1]], "test": "swept_kernel", "stage": "exact_swept",
+    # the stage names follow the checker's: the half-space closed form is its null-set stage
+    info: dict[str, Any] = {"geoms": [names[0], names[1]], "test": "swept_kernel",
+                            "stage": "null_set" if plane else "exact_swept",
                             "spans": int(o[O_SPANS]), "solves": int(o[O_SOLVES])}
+    if plane:
+        info["closed_form"] = "halfspace"
     if code == CODE_CERTIFIED:
         clr = o[O_CLEAR]
         return PairOutcome(Outcome.CERTIFIED, int(o[O_SPANS]), 0, [], clr if clr < np.inf else float("inf"),
@@ -317,6 +496,8 @@ def warm() -> None:
     ob = np.array([[3.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
     out = np.empty(OUT_SIZE)
     swept_pair_kernel(P, eye, t, oa, P, eye, t, ob, 0.0, 1.0, 0.5, 0.5, 0.5, 64 * 2.0**-52, 1e-12, out)
+    halfspace_pair_kernel(np.array([0.0, 0.0, 1.0]), 0.0, P, eye, t, oa, P, eye, t, ob, 0.0, 1.0, 0.5, 0.5,
+                          0.5, 64 * 2.0**-52, 1e-12, out)
 
 
-__all__ = ["swept_pair_kernel", "decide_pair", "warm", "SWEPT_MAX_POINTS"]
+__all__ = ["swept_pair_kernel", "halfspace_pair_kernel", "decide_pair", "warm", "SWEPT_MAX_POINTS"]
