@@ -1320,9 +1320,10 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     First pass (issue 12; ``_SWEPT_FIRST``): :func:`monitor.certify.extrusion_swept.decide_pair`,
     the checker's exact swept test per span in one compiled call per pair (certified at the
     stronger margin below, violation at the true margin with the exact first contact);
-    ``info["test"] == "swept_kernel"``, stage ``"exact_swept"``. The pairs it leaves (the
-    exactness band, half-spaces, penetrations of sharp polytopes at margin 0, bad input) go
-    to the Python checker exactly as before:
+    ``info["test"] == "swept_kernel"``, stage ``"exact_swept"`` (``"null_set"`` for the
+    half-space closed form). The pairs it leaves (the exactness band, two half-spaces,
+    penetrations of sharp polytopes at margin 0, bad input) go to the Python checker exactly
+    as before:
 
     Per pair the checker runs S-bounds (§4.3, App. B; shared per body, §6.3), divide
     and conquer (§4.1) and the null-set LP on the half-spaces offset by the pair's
