@@ -31,8 +31,10 @@ Decision per span, spans in time order (the §6 earliest-first order):
       from the level to the span's minimum) come from
       :func:`~monitor.certify.extrusion_kernels.first_time_kernel` (conservative advancement
       with proved steps, then the bisection rule), as in the Python checker;
-    * anything else (the exactness band, zero level, a half-space, bad input, too many
-      vertices): **undecided**, and the whole pair goes to the Python checker, which then
+    * a half-space against a core: the checker's closed form per span
+      (:func:`halfspace_pair_kernel`, the null-set stage of §4.2 for a plane), same rules;
+    * anything else (the exactness band, a penetration at zero level, two half-spaces, bad
+      input, too many vertices): **undecided**, and the whole pair goes to the Python checker, which then
       decides it exactly as before. So completeness is never below the Python checker's, and
       every pair this pass decides gets the verdict the Python checker's exact test would.
 
