@@ -192,10 +192,17 @@ def test_null_set_path_issues_most_certificates_on_seeded_set():
 
 
 @pytest.mark.xdist_group(QUICK_CASES_GROUP)
-def test_null_set_path_issues_most_certificates_on_bench_cases():
-    """The translating group of monitor.bench.cases (quick set) through monitor.certify."""
+def test_null_set_path_issues_most_certificates_on_bench_cases(monkeypatch):
+    """The translating group of monitor.bench.cases (quick set) through monitor.certify.
+
+    About the Python checker's own pipeline: the engine's compiled first pass
+    (:mod:`monitor.certify.extrusion_swept`, the exact swept test per span) is switched off.
+    """
     pytest.importorskip("mujoco")
     import monitor
+    from monitor.certify import engine
+
+    monkeypatch.setattr(engine, "_SWEPT_FIRST", False)
 
     stages: dict[tuple[str, str], int] = {}
     for c in quick_cases():
@@ -213,10 +220,13 @@ def test_null_set_path_issues_most_certificates_on_bench_cases():
 
 
 @pytest.mark.slow
-def test_null_set_path_issues_most_certificates_on_full_bench_cases():
+def test_null_set_path_issues_most_certificates_on_full_bench_cases(monkeypatch):
     pytest.importorskip("mujoco")
     import monitor
     from monitor.bench.cases import make_cases
+    from monitor.certify import engine
+
+    monkeypatch.setattr(engine, "_SWEPT_FIRST", False)  # the Python checker's pipeline (see above)
 
     paper = exact = null = 0
     for c in make_cases(seed=7):
@@ -234,17 +244,30 @@ def test_null_set_path_issues_most_certificates_on_full_bench_cases():
 
 # ----------------------------------------------------------------------------- AGV and trays (§5)
 
-def _agv(skewed: bool, name: str):
+def _agv(skewed: bool, name: str, swept_first: bool = False):
+    """The AGV scene certified through the public API.
+
+    ``swept_first=False`` (these tests are about the paper's pipeline and its stage counts):
+    the engine's compiled first pass (:mod:`monitor.certify.extrusion_swept`) is off, so
+    every translating pair goes through the Python checker. tests/test_extrusion_swept.py
+    runs the same scenes with it on (same verdicts, earliest time and clearance).
+    """
     mujoco = pytest.importorskip("mujoco")
     import monitor
     from monitor._paths import models_dir
     from monitor.bench.extrusion_scenes import schedule
+    from monitor.certify import engine
 
     m = mujoco.MjModel.from_xml_path(str(models_dir() / "agv_trays" / ("scene_skewed.xml" if skewed
                                                                          else "scene.xml")))
     scene = monitor.Scene.from_model(m, pairs="all")
     s = schedule(name)
-    return scene, monitor.certify(scene, monitor.Plan(s["times"], s["qpos"], model=m), method="auto")
+    old = engine._SWEPT_FIRST
+    engine._SWEPT_FIRST = swept_first
+    try:
+        return scene, monitor.certify(scene, monitor.Plan(s["times"], s["qpos"], model=m), method="auto")
+    finally:
+        engine._SWEPT_FIRST = old
 
 
 def _agv_trays_sbounds(cert):

@@ -1008,7 +1008,22 @@ def _translates(plan: Any, mp: Any, b: int) -> bool:
         return True
     if mp.body_rotating[b] != 0:
         return False
+    if type(plan) in _known_trajectories():
+        # Plan and BodyMotion: translation_segments(b) is None exactly when the body moves and
+        # its own _rotating flag is set (a Plan's equals the pack's, checked above)
+        return not plan._rotating[b]
     return plan.translation_segments(b) is not None
+
+
+def _known_trajectories() -> tuple:
+    """Loaded trajectory classes whose ``translation_segments`` is None iff moving and ``_rotating``."""
+    out = []
+    for mod, name in (("monitor.motion.plan", "Plan"), ("monitor.motion.bodymotion", "BodyMotion")):
+        m = sys.modules.get(mod)
+        c = None if m is None else getattr(m, name, None)
+        if c is not None:
+            out.append(c)
+    return tuple(out)
 
 
 _FULL_SEARCH_TESTS = 1024
@@ -1300,7 +1315,15 @@ def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: floa
 
 def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, bud: Budget,
                    t0: float, t1: float) -> list[PairOutcome]:
-    """Extrusion checker on the translating pairs, in one n-ary search (Cameron §6).
+    """Extrusion checker on the translating pairs: a compiled first pass, then one n-ary search (Cameron §6).
+
+    First pass (issue 12; ``_SWEPT_FIRST``): :func:`monitor.certify.extrusion_swept.decide_pair`,
+    the checker's exact swept test per span in one compiled call per pair (certified at the
+    stronger margin below, violation at the true margin with the exact first contact);
+    ``info["test"] == "swept_kernel"``, stage ``"exact_swept"`` (``"null_set"`` for the
+    half-space closed form). The pairs it leaves (the exactness band, two half-spaces,
+    penetrations of sharp polytopes at margin 0, bad input) go to the Python checker exactly
+    as before:
 
     Per pair the checker runs S-bounds (§4.3, App. B; shared per body, §6.3), divide
     and conquer (§4.1) and the null-set LP on the half-spaces offset by the pair's
@@ -1309,13 +1332,84 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     :func:`extrusion_stats` summarises a list of outcomes for ``cert.stats``.
     """
     from monitor.certify import extrusion
-    posr, rotr = plan.body_poses(np.array([t0]))
-    eps_pairs = []
-    for _i, ga, gb, ((ta, oa), (tb, ob)) in ext_items:
-        eps_pairs.append(extrusion.TranslatingPair(
-            ga.shape, rotr[0, ga.body_id], np.asarray(ta, float), np.asarray(oa, float),
-            gb.shape, rotr[0, gb.body_id], np.asarray(tb, float), np.asarray(ob, float),
-            name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
+    ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
+    rot = _rotations(plan, t0)
+    outs: list[PairOutcome | None] = [None] * len(ext_items)
+    if _SWEPT_FIRST and not bud.exhausted:
+        # issue 12: the compiled exact swept test first, one call per pair
+        # (monitor.certify.extrusion_swept); what it cannot settle goes to the Python checker
+        from monitor.certify.extrusion_swept import decide_pair
+        n_fast = 0
+        for k, (_i, ga, gb, ((ta, oa), (tb, ob))) in enumerate(ext_items):
+            Ra, Rb = rot(ga.body_id, True), rot(gb.body_id, True)
+            outs[k] = o = decide_pair(ga.shape, Ra, ta, oa, gb.shape, Rb, tb, ob, (t0, t1), margin,
+                                      ext_margin, tol, (ga.name, gb.name))
+            if o is not None:
+                n_fast += o.tests
+        if n_fast:
+            bud.charge(n_fast)
+    rest = [k for k, o in enumerate(outs) if o is None]
+    if rest:
+        eps_pairs = []
+        for k in rest:
+            _i, ga, gb, ((ta, oa), (tb, ob)) = ext_items[k]
+            eps_pairs.append(extrusion.TranslatingPair(
+                ga.shape, rot(ga.body_id), np.asarray(ta, float), np.asarray(oa, float),
+                gb.shape, rot(gb.body_id), np.asarray(tb, float), np.asarray(ob, float),
+                name=(ga.name, gb.name), bodies=(ga.body, gb.body)))
+        for k, o in zip(rest, _run_extrusion_python(eps_pairs, margin, ext_margin, tol, bud, t0, t1)):
+            outs[k] = o
+    return outs  # type: ignore[return-value]
+
+
+def _rotations(plan: Any, t0: float) -> Any:
+    """``rot(body, fast=False) -> R_WB`` (3, 3) at ``t0`` for the bodies of translating pairs.
+
+    The rotation of such a body is constant over the window. A
+    :class:`~monitor.motion.plan.Plan` has it already: its waypoint FK rotations
+    (``_wp_mat[0]``; the same at every waypoint). A
+    :class:`~monitor.motion.bodymotion.BodyMotion`: its first waypoint quaternion
+    (``quat[0]``, normalised; a translating body's quaternions are equal bit for bit), by
+    ``quat_to_mat`` (one vectorised call) or, with ``fast=True`` (the compiled first pass,
+    whose pads cover a few ulp in R), the same formula on Python floats without the
+    re-normalisation. Other trajectories: one ``body_poses`` call at ``t0``, made on first use.
+    """
+    cls = _plan_class()
+    if cls is not None and type(plan) is cls:
+        wm = plan._wp_mat
+        return lambda b, fast=False: wm[0, b]
+    bm = sys.modules.get("monitor.motion.bodymotion")
+    if bm is not None and type(plan) is getattr(bm, "BodyMotion", None):
+        mats: list = []
+
+        def rot_bm(b: int, fast: bool = False) -> np.ndarray:
+            if fast:
+                w, x, y, z = plan.quat[0, b].tolist()
+                return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                                 [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                                 [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+            if not mats:   # one vectorised conversion per call (the same arithmetic per body)
+                mats.append(bm.K.quat_to_mat(plan.quat[0]))
+            return mats[0][b]
+        return rot_bm
+    memo: list = []
+
+    def rot(b: int, fast: bool = False) -> np.ndarray:
+        if not memo:
+            memo.append(plan.body_poses(np.array([t0]))[1])
+        return memo[0][0, b]
+    return rot
+
+
+_SWEPT_FIRST = True
+"""Run :func:`monitor.certify.extrusion_swept.decide_pair` before the Python extrusion checker
+(tests switch it off to compare with the Python checker alone)."""
+
+
+def _run_extrusion_python(eps_pairs: list, margin: float, ext_margin: float, tol: Tolerances, bud: Budget,
+                          t0: float, t1: float) -> list[PairOutcome]:
+    """The Python extrusion checker (one n-ary search, Cameron §6) on ``eps_pairs``, re-run for witnesses."""
+    from monitor.certify import extrusion
     # The extrusion checker is exact up to Tolerances.extrusion_slack with Cameron's
     # regularised semantics (touching is not a collision). The engine's contract is
     # stricter (certified => clearance > margin, rounding included), so it asks the
@@ -1325,7 +1419,6 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     # Pairs that fail the stronger question (only those) are re-run at the true margin
     # for a witness deep enough to confirm (with margin > 0 the checker caps its depth
     # at the margin it is given); "certified" there means the sub-slack band: unresolved.
-    ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
     outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud, nary=True)
     redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
     if redo and not bud.exhausted:

@@ -1149,14 +1149,21 @@ def search_summary(outcomes: Sequence[PairOutcome]) -> dict[str, Any]:
         :data:`STAGES`), ``lps``, ``offset_lps``, ``offset_certified``, ``offset_open``
         (offset LPs that left the region to the exact swept test), ``exact_swept``,
         ``regions``, ``searches`` and ``sbounds``: per span and body pair the primitives
-        in, the survivors and the time bounds (§4.3).
+        in, the survivors and the time bounds (§4.3); ``swept_kernel`` (only when > 0):
+        outcomes decided by the compiled first pass
+        (:mod:`monitor.certify.extrusion_swept`, stage ``exact_swept``).
     """
     stages: dict[str, int] = {}
+    compiled = 0
     for o in outcomes:
         st = o.info.get("stage")
         if st is not None:
             stages[st] = stages.get(st, 0) + 1
+        if o.info.get("test") == "swept_kernel":
+            compiled += 1
     out: dict[str, Any] = {"stages": stages, "searches": 0, "sbounds": []}
+    if compiled:
+        out["swept_kernel"] = compiled
     keys = ("lps", "dual_shortcut", "nnls", "offset_lps", "offset_certified", "offset_open", "exact_swept",
             "regions")
     for k in keys:

@@ -301,11 +301,15 @@ def warm_small_lp() -> None:
     """Compile (or load from the numba cache) the null-set stage's kernels: for ``monitor.warmup``.
 
     :func:`small_slack_lp`'s simplex and the exact swept stage's min-norm and
-    first-contact kernels (:mod:`monitor.certify.extrusion_kernels`).
+    first-contact kernels (:mod:`monitor.certify.extrusion_kernels`), and the engine's
+    compiled first pass over translating pairs (:mod:`monitor.certify.extrusion_swept`).
     """
     G = np.array([[1.0, 0, 0, 0], [-1.0, 0, 0, 0], [0, 1.0, 0, 0]])
     _dual_simplex_kernel(G, np.ones(3), -np.ones(4), np.ones(4), 10)
     _warm_kernels()
+    from monitor.certify.extrusion_swept import warm as _warm_swept
+
+    _warm_swept()
 
 
 def slack_lower(G: np.ndarray, h: np.ndarray, z: np.ndarray, tol: Tolerances) -> float:
