@@ -764,6 +764,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
                            margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
                            allowed=allowed, sc=sc, sr=sr, KS=KS)
+    if route_all and done_to == S:
+        # every survivor went through the whole-shape stage in this one call: when the kernel
+        # decided them all, the certificate is the general tail's (see _kernel_decided)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, geoms=scene.geoms, t0=t0, t1=t1,
+                               margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
+                               allowed=allowed, sc=sc, sr=sr, KS=KS)
+        if cert is not None:
+            return cert
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -924,6 +932,85 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": {"culled": P} if P else {},
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
     return Certificate._trusted(Verdict.CERTIFIED, (t0, t1), margin, epsilon, _METHOD_OF[method], None, None,
+                                clearance, lazy, stats, allowed)
+
+
+def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
+                    res: np.ndarray, info: np.ndarray, S: int, *, geoms: tuple, t0: float, t1: float,
+                    margin: float, epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
+                    sc: np.ndarray, sr: np.ndarray, KS: Any) -> Certificate | None:
+    """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
+
+    None when a survivor is left to the stages after the kernel (``WK_PYTHON``, ``WK_OPEN``,
+    ``WK_UNRES``: the general tail runs). Called only when one ``window_kernel`` call ran stage 1
+    on all S survivors (``method="toleranced"``, S <= the chunk), so nothing is unfinished, no
+    Python stage and no full search runs, and the general tail's values reduce to these (same
+    order of survivors, same float values read from ``res``, same dict insertion order):
+    violation if any survivor is ``WK_STATIC_VIOL`` / ``WK_VIOL``, else certified; the witness
+    of the smallest (time, pair index); the earliest time the smallest of the witness times and
+    first unresolved times (t0 for a start-pose violation); the clearance the smallest of the
+    certified survivors' clearances, -inf with a violation, and the best culled gap.
+    Issue 12 (pair-window floor): the general tail's survivor lists cost ~20 us per call.
+    """
+    if S == 1:      # the bench's and a lone pair's case, without the lists below
+        k = int(surv[0])
+        c = int(code[k])
+        if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
+            return None
+        ks, cs = (k,), (c,)
+    else:
+        ks = surv[:S].tolist()
+        cs = code.take(surv[:S]).tolist()
+        if KS.WK_PYTHON in cs or KS.WK_OPEN in cs or KS.WK_UNRES in cs:
+            return None
+    P = len(sel)
+    rows = res[:S].tolist()
+    mix: dict[str, int] = {}
+    if P - S:
+        mix["culled"] = P - S
+    tests, depth = 0, 0
+    n_static = 0
+    clears: list[float] = []
+    best_v = None                     # (witness time, pair index, k, slot) of the earliest witness
+    starts: list[float] = []          # the witness times, then the first unresolved times (the tail's order)
+    firsts: list[float] = []
+    for s, (k, c) in enumerate(zip(ks, cs)):
+        row = rows[s]
+        static = c == KS.WK_STATIC_VIOL or c == KS.WK_STATIC_CERT
+        if static:
+            n_static += 1
+        else:
+            tests += int(row[KS.R_TESTS])
+            if int(row[KS.R_DEPTH]) > depth:
+                depth = int(row[KS.R_DEPTH])
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
+            key = (row[KS.R_WTIME], int(sel[k]))
+            if best_v is None or key < best_v[:2]:
+                best_v = (key[0], key[1], k, s)
+            starts.append(row[KS.R_WTIME])
+            firsts.append(t0 if static else row[KS.R_FIRST_UNRES])
+        else:
+            clears.append(row[KS.R_CLEAR])
+    if n_static:
+        mix["static"] = n_static
+    if S - n_static:
+        mix["toleranced/whole-shape"] = S - n_static
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], np.zeros(P, bool), {}, geoms, (t0, t1),
+                        sc, sr, info.item(KS.WI_PAD))
+    witness = earliest = None
+    if best_v is not None:
+        witness = lazy.kernel_witness(best_v[2], best_v[3])
+        earliest = float(min(starts + firsts))
+        clears.append(float("-inf"))
+    best_cull = info.item(KS.WI_BEST)
+    if best_cull < float("inf"):
+        clears.append(best_cull)
+    clearance = float(min(clears)) if clears else float("inf")
+    stats = {"pairs": P, "pairs_culled": P - S, "tests": tests, "max_depth": depth,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
+    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+    return Certificate._trusted(verdict, (t0, t1), margin, epsilon, _METHOD_OF[method], witness, earliest,
                                 clearance, lazy, stats, allowed)
 
 
