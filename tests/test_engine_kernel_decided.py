@@ -1,4 +1,4 @@
-"""engine._kernel_decided: the certificate of a window whose survivors the kernel decided (issue 12).
+"""engine._kernel_decided and engine._window_kernel (issue 12, the pair-window floor).
 
 When one ``window_kernel`` call decided every surviving pair (``method="toleranced"``, at most
 ``_FAST_CHUNK`` survivors), ``_certify_fast`` builds the certificate from the result rows
@@ -88,3 +88,47 @@ def test_the_cases_cover_every_kernel_decision():
             seen.add((str(p.verdict), str(p.method)))
     assert {("violation", "static"), ("certified", "static"), ("violation", "toleranced"),
             ("certified", "toleranced"), ("certified", "culled")} <= seen, seen
+
+
+# -- engine._window_kernel: the entry point called directly for known argument objects ---------------
+
+
+def test_direct_calls_give_the_dispatchers_certificates():
+    for name in sorted(CASES):
+        scene, plan = _scene_plan(*CASES[name])
+        engine._WK_DIRECT[0] = None
+        ref = monitor.certify(scene, plan, method="toleranced", epsilon=1e-3)      # the dispatcher
+        assert engine._WK_DIRECT[0] is not None and engine._WK_DIRECT[0][4] is not None
+        again = monitor.certify(scene, plan, method="toleranced", epsilon=1e-3)    # the entry point
+        assert _key(again) == _key(ref), name
+
+
+def test_only_the_last_typed_objects_take_the_direct_call(monkeypatch):
+    from monitor.certify import kernels as KS
+
+    scene, plan = _scene_plan(*CASES["near+static-clear"])
+    monitor.certify(scene, plan, method="toleranced")
+    d = engine._WK_DIRECT[0]
+    used = []
+    poisoned = d[:2] + (lambda *a: used.append("direct") or 0,) + d[3:]
+    monkeypatch.setattr(engine, "_WK_DIRECT", [poisoned])
+    monitor.certify(scene, plan, method="toleranced")       # the recorded objects: the entry point runs
+    assert used == ["direct"]
+    used.clear()
+    # another plan object (a new motion pack): the dispatcher, never the recorded entry point
+    engine._WK_DIRECT[0] = poisoned
+    scene2, plan2 = _scene_plan(*CASES["near+static-clear"])
+    cert = monitor.certify(scene2, plan2, method="toleranced")
+    assert used == [] and cert.stats["checker_mix"].get("toleranced/whole-shape") == 1
+    # a replaced window_kernel is what runs, not the recorded entry point
+    calls = []
+    real = KS.window_kernel
+
+    def wrapper(*a):
+        calls.append(1)
+        return real(*a)
+
+    monkeypatch.setattr(KS, "window_kernel", wrapper)
+    engine._WK_DIRECT[0] = poisoned
+    monitor.certify(scene, plan, method="toleranced")
+    assert used == [] and calls

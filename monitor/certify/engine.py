@@ -714,6 +714,48 @@ class _WindowPairs:
                               self.bnames)
 
 
+_WK_DIRECT: list = [None]
+"""(dispatcher, number of its overloads, entry point, gp, mp, pairs, fixed, moving) of the last
+:func:`_window_kernel` call that went through numba's dispatcher (see there)."""
+
+
+def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarray, moving: np.ndarray,
+                   *rest: Any) -> Any:
+    """``KS.window_kernel(gp, mp, pairs, fixed, moving, *rest)``, skipping numba's argument typing if known.
+
+    numba's dispatcher types every argument on every call; for the two packs (47 arrays) that
+    costs ~9 us per call (issue 12, pair-window floor: a trivial njit function taking them
+    costs 12-15 us, its compiled entry point 3-6 us). The caller builds every other argument
+    afresh with fixed types (int64 / float64 C-contiguous writable arrays, Python ints), so the
+    argument types are decided by these five objects: when they are the very objects of the
+    last call that went through the dispatcher, and that dispatcher still has exactly one
+    compiled overload (the one it ran: a different argument type would have compiled a
+    second), the overload's entry point is called directly -- what the dispatcher itself calls
+    after typing. Anything else (another pack or flag array, a monkeypatched or non-numba
+    ``window_kernel``, several overloads) goes through the dispatcher. The packs and flag arrays
+    are never modified in place (the kernels only read them).
+    """
+    wk = KS.window_kernel
+    d = _WK_DIRECT[0]
+    if (d is not None and d[0] is wk and d[3] is gp and d[4] is mp and d[5] is pairs and d[6] is fixed
+            and d[7] is moving and len(wk.overloads) == d[1]):
+        return d[2](gp, mp, pairs, fixed, moving, *rest)
+    out = wk(gp, mp, pairs, fixed, moving, *rest)
+    if type(wk).__name__ == "CPUDispatcher":
+        ovl = wk.overloads
+        if len(ovl) == 1:
+            ep = _ENTRY_POINTS.get(id(wk))
+            if ep is None or ep[0] is not wk:
+                # (reading the overload costs ~50-100 us: once per dispatcher and process)
+                ep = _ENTRY_POINTS[id(wk)] = (wk, next(iter(ovl.values())).entry_point)
+            _WK_DIRECT[0] = (wk, 1, ep[1], gp, mp, pairs, fixed, moving)
+    return out
+
+
+_ENTRY_POINTS: dict[int, tuple] = {}
+"""id(dispatcher) -> (the dispatcher, the entry point of its single overload), read once per process."""
+
+
 def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
                   bud: Budget, tol: Tolerances, sel: np.ndarray, wall0: float, allowed: tuple,
                   fast: tuple) -> Certificate:
@@ -754,8 +796,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
-    S = int(KS.window_kernel(sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
-                             sc, sr, info))
+    S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
+                           sc, sr, info))
     done_to = min(first, S)
     charged = info[KS.WI_TESTS]
     if charged:
@@ -797,8 +839,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             stopped = True
             break
         k1 = min(S, done_to + chunk)
-        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
-                         sc, sr, info)
+        _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
+                       sc, sr, info)
         bud.charge(int(info[KS.WI_TESTS] - charged))
         charged = info[KS.WI_TESTS]
         done_to = k1
@@ -806,8 +848,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         # budget spent: the rest get their start-pose test only (the Python pipeline tests every
         # start pose before any checker runs; start tests are not charged), then go on to the
         # checkers, which leave them undecided on the exhausted budget
-        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code, gap,
-                         surv, res, sc, sr, info)
+        _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code,
+                       gap, surv, res, sc, sr, info)
         done_to = S
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
