@@ -1,6 +1,6 @@
 """A/B of the bench's pair-window calls: per case median us (run_ours' call), verdict, earliest, witness.
 
-Usage: python pwab.py OUT.json TREE_A TREE_B [rounds]
+Usage: python pwab.py OUT.json TREE_A[::patch] TREE_B[::patch] [rounds]
 Each round runs every case in a fresh subprocess per tree (A, B alternated); per case the median CPU time
 (time.process_time, robust to time-sharing) of 31 calls (3 for the slow screw / bezier / 1e-4 cases).
 The answers (verdict, earliest time, witness time/point/distance, tests) are compared bit for bit.
@@ -17,6 +17,8 @@ import monitor  # noqa: F401
 from monitor.bench.cases import make_cases
 from monitor.certify.common import Budget
 from monitor.certify.engine import certify
+import os
+exec(os.environ.get("PWAB_PATCH", ""))   # e.g. switch one engine feature off (same tree, A/B by process)
 out = {}
 for c in make_cases(seed=7, quick=True):
     s, m = c.scene(16), c.body_motion()
@@ -40,7 +42,8 @@ print(json.dumps(out))
 
 
 def run(tree):
-    env = dict(os.environ, PYTHONPATH=tree)
+    tree, _, patch = tree.partition("::")      # TREE::python-snippet run in the child before the cases
+    env = dict(os.environ, PYTHONPATH=tree, PWAB_PATCH=patch)
     r = subprocess.run([sys.executable, "-c", CHILD], env=env, capture_output=True, text=True, check=True)
     return json.loads(r.stdout.strip().splitlines()[-1])
 
