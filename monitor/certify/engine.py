@@ -714,6 +714,48 @@ class _WindowPairs:
                               self.bnames)
 
 
+_WK_DIRECT: list = [None]
+"""(dispatcher, number of its overloads, entry point, gp, mp, pairs, fixed, moving) of the last
+:func:`_window_kernel` call that went through numba's dispatcher (see there)."""
+
+
+def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarray, moving: np.ndarray,
+                   *rest: Any) -> Any:
+    """``KS.window_kernel(gp, mp, pairs, fixed, moving, *rest)``, skipping numba's argument typing if known.
+
+    numba's dispatcher types every argument on every call; for the two packs (47 arrays) that
+    costs ~9 us per call (issue 12, pair-window floor: a trivial njit function taking them
+    costs 12-15 us, its compiled entry point 3-6 us). The caller builds every other argument
+    afresh with fixed types (int64 / float64 C-contiguous writable arrays, Python ints), so the
+    argument types are decided by these five objects: when they are the very objects of the
+    last call that went through the dispatcher, and that dispatcher still has exactly one
+    compiled overload (the one it ran: a different argument type would have compiled a
+    second), the overload's entry point is called directly -- what the dispatcher itself calls
+    after typing. Anything else (another pack or flag array, a monkeypatched or non-numba
+    ``window_kernel``, several overloads) goes through the dispatcher. The packs and flag arrays
+    are never modified in place (the kernels only read them).
+    """
+    wk = KS.window_kernel
+    d = _WK_DIRECT[0]
+    if (d is not None and d[0] is wk and d[3] is gp and d[4] is mp and d[5] is pairs and d[6] is fixed
+            and d[7] is moving and len(wk.overloads) == d[1]):
+        return d[2](gp, mp, pairs, fixed, moving, *rest)
+    out = wk(gp, mp, pairs, fixed, moving, *rest)
+    if type(wk).__name__ == "CPUDispatcher":
+        ovl = wk.overloads
+        if len(ovl) == 1:
+            ep = _ENTRY_POINTS.get(id(wk))
+            if ep is None or ep[0] is not wk:
+                # (reading the overload costs ~50-100 us: once per dispatcher and process)
+                ep = _ENTRY_POINTS[id(wk)] = (wk, next(iter(ovl.values())).entry_point)
+            _WK_DIRECT[0] = (wk, 1, ep[1], gp, mp, pairs, fixed, moving)
+    return out
+
+
+_ENTRY_POINTS: dict[int, tuple] = {}
+"""id(dispatcher) -> (the dispatcher, the entry point of its single overload), read once per process."""
+
+
 def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
                   bud: Budget, tol: Tolerances, sel: np.ndarray, wall0: float, allowed: tuple,
                   fast: tuple) -> Certificate:
@@ -754,8 +796,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
-    S = int(KS.window_kernel(sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
-                             sc, sr, info))
+    S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
+                           sc, sr, info))
     done_to = min(first, S)
     charged = info[KS.WI_TESTS]
     if charged:
@@ -764,6 +806,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
                            margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
                            allowed=allowed, sc=sc, sr=sr, KS=KS)
+    if route_all and done_to == S:
+        # every survivor went through the whole-shape stage in this one call: when the kernel
+        # decided them all, the certificate is the general tail's (see _kernel_decided)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, geoms=scene.geoms, t0=t0, t1=t1,
+                               margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
+                               allowed=allowed, sc=sc, sr=sr, KS=KS)
+        if cert is not None:
+            return cert
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -789,8 +839,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             stopped = True
             break
         k1 = min(S, done_to + chunk)
-        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
-                         sc, sr, info)
+        _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
+                       sc, sr, info)
         bud.charge(int(info[KS.WI_TESTS] - charged))
         charged = info[KS.WI_TESTS]
         done_to = k1
@@ -798,8 +848,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         # budget spent: the rest get their start-pose test only (the Python pipeline tests every
         # start pose before any checker runs; start tests are not charged), then go on to the
         # checkers, which leave them undecided on the exhausted budget
-        KS.window_kernel(sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code, gap,
-                         surv, res, sc, sr, info)
+        _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code,
+                       gap, surv, res, sc, sr, info)
         done_to = S
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
@@ -924,6 +974,85 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": {"culled": P} if P else {},
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
     return Certificate._trusted(Verdict.CERTIFIED, (t0, t1), margin, epsilon, _METHOD_OF[method], None, None,
+                                clearance, lazy, stats, allowed)
+
+
+def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
+                    res: np.ndarray, info: np.ndarray, S: int, *, geoms: tuple, t0: float, t1: float,
+                    margin: float, epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
+                    sc: np.ndarray, sr: np.ndarray, KS: Any) -> Certificate | None:
+    """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
+
+    None when a survivor is left to the stages after the kernel (``WK_PYTHON``, ``WK_OPEN``,
+    ``WK_UNRES``: the general tail runs). Called only when one ``window_kernel`` call ran stage 1
+    on all S survivors (``method="toleranced"``, S <= the chunk), so nothing is unfinished, no
+    Python stage and no full search runs, and the general tail's values reduce to these (same
+    order of survivors, same float values read from ``res``, same dict insertion order):
+    violation if any survivor is ``WK_STATIC_VIOL`` / ``WK_VIOL``, else certified; the witness
+    of the smallest (time, pair index); the earliest time the smallest of the witness times and
+    first unresolved times (t0 for a start-pose violation); the clearance the smallest of the
+    certified survivors' clearances, -inf with a violation, and the best culled gap.
+    Issue 12 (pair-window floor): the general tail's survivor lists cost ~20 us per call.
+    """
+    if S == 1:      # the bench's and a lone pair's case, without the lists below
+        k = int(surv[0])
+        c = int(code[k])
+        if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
+            return None
+        ks, cs = (k,), (c,)
+    else:
+        ks = surv[:S].tolist()
+        cs = code.take(surv[:S]).tolist()
+        if KS.WK_PYTHON in cs or KS.WK_OPEN in cs or KS.WK_UNRES in cs:
+            return None
+    P = len(sel)
+    rows = res[:S].tolist()
+    mix: dict[str, int] = {}
+    if P - S:
+        mix["culled"] = P - S
+    tests, depth = 0, 0
+    n_static = 0
+    clears: list[float] = []
+    best_v = None                     # (witness time, pair index, k, slot) of the earliest witness
+    starts: list[float] = []          # the witness times, then the first unresolved times (the tail's order)
+    firsts: list[float] = []
+    for s, (k, c) in enumerate(zip(ks, cs)):
+        row = rows[s]
+        static = c == KS.WK_STATIC_VIOL or c == KS.WK_STATIC_CERT
+        if static:
+            n_static += 1
+        else:
+            tests += int(row[KS.R_TESTS])
+            if int(row[KS.R_DEPTH]) > depth:
+                depth = int(row[KS.R_DEPTH])
+        if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
+            key = (row[KS.R_WTIME], int(sel[k]))
+            if best_v is None or key < best_v[:2]:
+                best_v = (key[0], key[1], k, s)
+            starts.append(row[KS.R_WTIME])
+            firsts.append(t0 if static else row[KS.R_FIRST_UNRES])
+        else:
+            clears.append(row[KS.R_CLEAR])
+    if n_static:
+        mix["static"] = n_static
+    if S - n_static:
+        mix["toleranced/whole-shape"] = S - n_static
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], np.zeros(P, bool), {}, geoms, (t0, t1),
+                        sc, sr, info.item(KS.WI_PAD))
+    witness = earliest = None
+    if best_v is not None:
+        witness = lazy.kernel_witness(best_v[2], best_v[3])
+        earliest = float(min(starts + firsts))
+        clears.append(float("-inf"))
+    best_cull = info.item(KS.WI_BEST)
+    if best_cull < float("inf"):
+        clears.append(best_cull)
+    clearance = float(min(clears)) if clears else float("inf")
+    stats = {"pairs": P, "pairs_culled": P - S, "tests": tests, "max_depth": depth,
+             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
+    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+    return Certificate._trusted(verdict, (t0, t1), margin, epsilon, _METHOD_OF[method], witness, earliest,
                                 clearance, lazy, stats, allowed)
 
 
