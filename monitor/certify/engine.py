@@ -742,13 +742,15 @@ def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarr
         return d[2](gp, mp, pairs, fixed, moving, *rest)
     out = wk(gp, mp, pairs, fixed, moving, *rest)
     if type(wk).__name__ == "CPUDispatcher":
-        ovl = wk.overloads
-        if len(ovl) == 1:
+        ovl = getattr(wk, "overloads", None)
+        if ovl is not None and len(ovl) == 1:
             ep = _ENTRY_POINTS.get(id(wk))
             if ep is None or ep[0] is not wk:
-                # (reading the overload costs ~50-100 us: once per dispatcher and process)
-                ep = _ENTRY_POINTS[id(wk)] = (wk, next(iter(ovl.values())).entry_point)
-            _WK_DIRECT[0] = (wk, 1, ep[1], gp, mp, pairs, fixed, moving)
+                # (reading the overload costs ~50-100 us: once per dispatcher and process; a numba
+                # without this attribute keeps the dispatcher path)
+                ep = _ENTRY_POINTS[id(wk)] = (wk, getattr(next(iter(ovl.values())), "entry_point", None))
+            if ep[1] is not None:
+                _WK_DIRECT[0] = (wk, 1, ep[1], gp, mp, pairs, fixed, moving)
     return out
 
 
