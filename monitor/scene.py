@@ -109,9 +109,10 @@ SYNC_FIELDS: tuple[str, ...] = (
     # geometry of the shapes (body frame)
     "geom_type", "geom_size", "geom_pos", "geom_quat", "geom_dataid", "geom_bodyid", "geom_margin",
     "mesh_vertadr", "mesh_vertnum", "mesh_vert",
-    # pair policy ("mujoco": masks, exclusions, <pair>; "all": weld groups and the anchor test)
-    "geom_contype", "geom_conaffinity", "body_weldid", "body_parentid", "body_dofnum", "body_mocapid",
-    "exclude_signature", "pair_geom1", "pair_geom2",
+    # pair policy ("mujoco": masks, exclusions, <pair>; "all": weld groups and the anchor test;
+    # geom_group: hazards= / allow= "group:N" patterns)
+    "geom_contype", "geom_conaffinity", "geom_group", "body_weldid", "body_parentid", "body_dofnum",
+    "body_mocapid", "exclude_signature", "pair_geom1", "pair_geom2",
     # kinematics: the world-children anchor test of pairs="all" and the motion bounds of a Plan
     "jnt_type", "jnt_qposadr", "jnt_bodyid", "jnt_pos", "jnt_axis", "qpos0", "body_pos", "body_quat",
     "body_jntadr", "body_jntnum", "body_ipos", "geom_rbound",

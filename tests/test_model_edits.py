@@ -155,6 +155,25 @@ def test_contype_edit_under_mujoco_pairs():
     assert cert.stats["nothing_checked"] is False
 
 
+def test_geom_group_edit_under_group_hazards():
+    """hazards=["group:N"]: moving a geom into the hazard group in place adds its pairs.
+
+    On the old code ``geom_group`` was not watched by ``Scene.sync``: the wall moved into group 3
+    stayed unmonitored and the slide through it was ``certified``.
+    """
+    xml = (WALL_XML.replace('pos="0.5 0 0"/>', 'pos="0.5 0 0" group="0"/>\n'
+                            ' <geom name="post" type="box" size="0.01 0.01 0.01" pos="0 0 2" group="3"/>')
+           .replace('size="0.1" pos="0.3 0 0"/>', 'size="0.2" pos="0.3 0 0" group="1"/>'))
+    m = mujoco.MjModel.from_xml_string(xml)
+    scene = monitor.Scene.from_model(m, hazards=["group:3"])
+    assert scene.candidate_pairs == (("post", "ball"),)
+    assert monitor.certify(scene, _slide_plan(m)).verdict == "certified"
+    m.geom_group[m.geom("wall").id] = 3
+    cert = monitor.certify(scene, _slide_plan(m))
+    assert set(scene.candidate_pairs) == {("post", "ball"), ("wall", "ball")}
+    assert cert.verdict == "violation"
+
+
 def test_mesh_vertex_edit_is_seen():
     xml = """<mujoco><asset><mesh name="m" vertex="-.1 -.1 -.1  .1 -.1 -.1  -.1 .1 -.1  .1 .1 -.1
       -.1 -.1 .1  .1 -.1 .1  -.1 .1 .1  .1 .1 .1"/></asset><worldbody>
