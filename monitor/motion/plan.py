@@ -752,18 +752,23 @@ class Plan(WindowTimes):
         m = self._model
         d = self._scratch
         T = Q.shape[0]
-        pos = np.empty((T, m.nbody, 3))
-        mat = np.empty((T, m.nbody, 3, 3))
+        nbody = m.nbody
+        pos = np.empty((T, nbody, 3))
+        mat = np.empty((T, nbody, 3, 3))
         if m.nmocap:
             d.mocap_pos[:] = self._mocap_pos
             d.mocap_quat[:] = self._mocap_quat
+        # the scratch's arrays once (each attribute read makes a new view of the same buffer)
+        qpos, xpos, xmat = d.qpos, d.xpos, d.xmat
+        mat9 = mat.reshape(T, nbody, 9)
+        kin = mujoco.mj_kinematics
         for k in range(T):
             if not k % 16:
                 check_active_budget()
-            d.qpos[:] = Q[k]
-            mujoco.mj_kinematics(m, d)
-            pos[k] = d.xpos
-            mat[k] = d.xmat.reshape(m.nbody, 3, 3)
+            qpos[:] = Q[k]
+            kin(m, d)
+            pos[k] = xpos
+            mat9[k] = xmat
         return pos, mat
 
     def body_poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
