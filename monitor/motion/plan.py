@@ -1079,7 +1079,8 @@ class Plan(WindowTimes):
             raise InvalidInputError(f"body index {body} out of range [0, {self.nbody})")
         if not self._moving[b]:
             p = self._wp_pos[0, b]
-            return np.array([self.t0, self.t1]), np.stack([p, p])
+            # = np.array([t0, t1]), np.stack([p, p]) (fresh float64 arrays), in fewer numpy calls
+            return self._times[[0, -1]], p[None].repeat(2, 0)
         if self._rotating[b]:
             return None
         return self._times.copy(), self._wp_pos[:, b].copy()
