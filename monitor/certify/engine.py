@@ -825,15 +825,22 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         # poll it: a budget spent by now stops here, as before (see _translates)
         stopped = bud.exhausted
         try:
-            for s, k in enumerate([] if stopped else surv[:S].tolist()):
-                if code[k] != KS.WK_OPEN:
-                    continue
-                for gi in (int(pid[k, 0]), int(pid[k, 1])):
-                    b = int(sp.geoms.body[gi])
-                    if b not in trans:
-                        trans[b] = _translates(plan, mp, b)
-                if trans[int(sp.geoms.body[pid[k, 0]])] and trans[int(sp.geoms.body[pid[k, 1]])]:
-                    route[s] = 0
+            if not stopped:
+                # Python ints of the survivors' codes and bodies (one gather each: per-element
+                # numpy indexing costs more than the loop on a few survivors)
+                sv_all = surv[:S]
+                gbody = sp.geoms.body
+                ba = gbody.take(pid[sv_all, 0]).tolist()
+                bb = gbody.take(pid[sv_all, 1]).tolist()
+                wk_open = KS.WK_OPEN
+                for s, c in enumerate(code.take(sv_all).tolist()):
+                    if c != wk_open:
+                        continue
+                    for b in (ba[s], bb[s]):
+                        if b not in trans:
+                            trans[b] = _translates(plan, mp, b)
+                    if trans[ba[s]] and trans[bb[s]]:
+                        route[s] = 0
         except BudgetExhausted:
             stopped = True
     while done_to < S and not stopped:
@@ -1148,13 +1155,22 @@ def _translates(plan: Any, mp: Any, b: int) -> bool:
 
 def _known_trajectories() -> tuple:
     """Loaded trajectory classes whose ``translation_segments`` is None iff moving and ``_rotating``."""
+    hit = _KNOWN[0]
+    if hit is not None:
+        return hit
     out = []
     for mod, name in (("monitor.motion.plan", "Plan"), ("monitor.motion.bodymotion", "BodyMotion")):
         m = sys.modules.get(mod)
         c = None if m is None else getattr(m, name, None)
         if c is not None:
             out.append(c)
+    if len(out) == 2:   # both loaded: the answer is final (a module is not unloaded)
+        _KNOWN[0] = tuple(out)
     return tuple(out)
+
+
+_KNOWN: list = [None]
+"""(Plan, BodyMotion) once both are loaded (:func:`_known_trajectories`)."""
 
 
 _FULL_SEARCH_TESTS = 1024
@@ -1677,8 +1693,26 @@ def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
     """
     from monitor.geometry.distance import shape_distance
 
-    pos, rot = plan.body_poses(times)
     slack = _approx(ga, gb)
+    first = 0
+    cls = _plan_class()
+    if (budget is not None and len(times) > 1 and cls is not None and type(plan) is cls
+            and not plan._quat_tracks):
+        # issue 12 (tunnel gate): the first candidate usually confirms; its pose alone first.
+        # A Plan without quaternion tracks poses each time on its own (Python-float location,
+        # elementwise lerp, one mj_kinematics per row), so these are the values of the batch.
+        pos, rot = plan.body_poses(times[:1])
+        w = _confirm(shape_distance, ga, gb, times[:1], pos, rot, margin, slack, tol, budget)
+        if w is not None or (budget is not None and budget.exhausted):
+            return w
+        first = 1
+    pos, rot = plan.body_poses(times[first:])
+    return _confirm(shape_distance, ga, gb, times[first:], pos, rot, margin, slack, tol, budget)
+
+
+def _confirm(shape_distance: Any, ga: Any, gb: Any, times: np.ndarray, pos: np.ndarray, rot: np.ndarray,
+             margin: float, slack: float, tol: Tolerances, budget: Budget | None) -> Witness | None:
+    """:func:`_find_witness`'s loop over candidate ``times`` (T,) posed at ``pos`` (T, nbody, 3), ``rot``."""
     for k, t in enumerate(times):
         if budget is not None and budget.exhausted:
             return None

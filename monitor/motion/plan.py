@@ -112,6 +112,7 @@ from __future__ import annotations
 
 import math
 import threading
+from bisect import bisect_right
 
 import mujoco
 import numpy as np
@@ -562,6 +563,7 @@ class Plan(WindowTimes):
         self._mocap_pos = mp
         self._mocap_quat = mq
         self._seg = K.Segments(t)
+        self._tlist = t.tolist()   # the waypoint times as Python floats (_times_ok, _locate)
         self._lin = st.lin
         self._ref = st.ref
         self._jnt_of_body = st.jnt_of_body
@@ -687,9 +689,52 @@ class Plan(WindowTimes):
         return self._mocap_quat.copy()
 
     # ----------------------------------------------------------- interpolation
+    def _times_ok(self, times: object) -> np.ndarray:
+        """``K.check_times_in_window(times, self.window)``: the same (T,) values, or its error.
+
+        A small float64 (T,) array whose every entry lies in the window (NaN and inf do
+        not) is checked on Python floats and copied (what the full check returns: a float64
+        copy); anything else takes the full check, which raises the error naming the entry.
+        Issue 12 (tunnel gate): the full check is ~10 numpy calls per ``body_poses`` query.
+        """
+        if (type(times) is np.ndarray and times.dtype == np.float64 and times.ndim == 1
+                and 0 < times.shape[0] <= 64):
+            tl = self._tlist
+            w0, w1 = tl[0], tl[-1]
+            for x in times.tolist():
+                if not (w0 <= x <= w1):
+                    break
+            else:
+                return times.copy()
+        return K.check_times_in_window(times, self.window)
+
+    def _locate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``self._seg.locate(t)`` (segment index, local parameter, at_end) for validated times (T,).
+
+        Up to 16 times on Python floats with the same arithmetic as
+        :meth:`monitor.motion._kinematics.Segments.locate` (``bisect_right`` is
+        ``searchsorted(side="right")``; the same clips, the same IEEE division; NaN stays NaN
+        as in ``np.clip``), so the values are bit-identical; more times: ``Segments.locate``.
+        """
+        if t.shape[0] > 16:
+            return self._seg.locate(t)
+        tl = self._tlist
+        last = len(tl) - 2
+        t_end = tl[-1]
+        ii, ss, ee = [], [], []
+        for x in t.tolist():
+            i = bisect_right(tl, x) - 1
+            i = 0 if i < 0 else last if i > last else i
+            lo = tl[i]
+            s = (x - lo) / (tl[i + 1] - lo)
+            ii.append(i)
+            ss.append(0.0 if s < 0.0 else 1.0 if s > 1.0 else s)
+            ee.append(x >= t_end)
+        return np.array(ii, np.int64), np.array(ss, np.float64), np.array(ee, bool)
+
     def _qpos_many(self, t: np.ndarray, loc: tuple | None = None) -> np.ndarray:
         """Interpolated qpos (T, nq) at validated times (T,)."""
-        i, s, at_end = self._seg.locate(t) if loc is None else loc
+        i, s, at_end = self._locate(t) if loc is None else loc
         out = K.lerp_values(self._qpos, i, s, at_end)
         for j, a, _ in self._st.quat_joints:
             out[:, a:a + 4] = self._quat_tracks[j].interp(i, s, at_end)
@@ -707,18 +752,23 @@ class Plan(WindowTimes):
         m = self._model
         d = self._scratch
         T = Q.shape[0]
-        pos = np.empty((T, m.nbody, 3))
-        mat = np.empty((T, m.nbody, 3, 3))
+        nbody = m.nbody
+        pos = np.empty((T, nbody, 3))
+        mat = np.empty((T, nbody, 3, 3))
         if m.nmocap:
             d.mocap_pos[:] = self._mocap_pos
             d.mocap_quat[:] = self._mocap_quat
+        # the scratch's arrays once (each attribute read makes a new view of the same buffer)
+        qpos, xpos, xmat = d.qpos, d.xpos, d.xmat
+        mat9 = mat.reshape(T, nbody, 9)
+        kin = mujoco.mj_kinematics
         for k in range(T):
             if not k % 16:
                 check_active_budget()
-            d.qpos[:] = Q[k]
-            mujoco.mj_kinematics(m, d)
-            pos[k] = d.xpos
-            mat[k] = d.xmat.reshape(m.nbody, 3, 3)
+            qpos[:] = Q[k]
+            kin(m, d)
+            pos[k] = xpos
+            mat9[k] = xmat
         return pos, mat
 
     def body_poses(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -727,7 +777,7 @@ class Plan(WindowTimes):
         Returns:
             positions (T, nbody, 3) m and rotations R_WB (T, nbody, 3, 3).
         """
-        t = K.check_times_in_window(times, self.window)
+        t = self._times_ok(times)
         # Small queries are memoised (several broad-phase stages ask for the same
         # sub-interval midpoints); the poses are a pure function of the times.
         key = t.tobytes() if t.shape[0] <= 64 else None
@@ -1029,7 +1079,8 @@ class Plan(WindowTimes):
             raise InvalidInputError(f"body index {body} out of range [0, {self.nbody})")
         if not self._moving[b]:
             p = self._wp_pos[0, b]
-            return np.array([self.t0, self.t1]), np.stack([p, p])
+            # = np.array([t0, t1]), np.stack([p, p]) (fresh float64 arrays), in fewer numpy calls
+            return self._times[[0, -1]], p[None].repeat(2, 0)
         if self._rotating[b]:
             return None
         return self._times.copy(), self._wp_pos[:, b].copy()
