@@ -233,9 +233,14 @@ def project(g: GeomPose, z: np.ndarray) -> np.ndarray:
         v[2] = np.clip(u[2], -s[1], s[1])
     elif g.type == ELLIPSOID:
         a = s[:3]
+        # sum((a u / (a^2 + lam))^2) - 1 on Python floats, in numpy's order for 3 terms
+        # ((q0^2 + q1^2) + q2^2): the same value bit for bit, ~10x cheaper per call (the
+        # 80-step bisection below was most of the ellipsoid red-team tests' time)
+        (au0, au1, au2), (aa0, aa1, aa2) = (a * u).tolist(), (a * a).tolist()
 
         def obj(lam: float) -> float:
-            return float(np.sum((a * u / (a * a + lam)) ** 2) - 1.0)
+            q0, q1, q2 = au0 / (aa0 + lam), au1 / (aa1 + lam), au2 / (aa2 + lam)
+            return (q0 * q0 + q1 * q1) + q2 * q2 - 1.0
 
         if np.sum((u / a) ** 2) <= 1.0:
             v = u

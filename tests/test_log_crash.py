@@ -84,8 +84,16 @@ def _official_count(data: bytes) -> int:
     return n
 
 
-def test_killed_between_windows_loses_nothing(tmp_path):
-    path, rc, lines = _run_writer(tmp_path, "between", 40)
+@pytest.fixture(scope="module")
+def between_run(tmp_path_factory):
+    """One writer killed between windows after 40 complete ones (no finish(), no close()): its file,
+    exit code and per-window (windows, messages) lines. Read only; shared by the tests below (the
+    message count after each window is the same in every mode that writes an index)."""
+    return _run_writer(tmp_path_factory.mktemp("between"), "between", 40)
+
+
+def test_killed_between_windows_loses_nothing(between_run):
+    path, rc, lines = between_run
     assert rc == 1 and lines[-1][0] == 40
     written = lines[-1][1]
     c = read_log(path)
@@ -97,9 +105,10 @@ def test_killed_between_windows_loses_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("window", [0, 7, 23])
-def test_killed_inside_a_window_loses_at_most_one_window(tmp_path, window):
+def test_killed_inside_a_window_loses_at_most_one_window(tmp_path, window, between_run):
     # find the message count at the end of window `window - 1` from a clean run, crash 2 messages later
-    _, _, lines = _run_writer(tmp_path, "probe", window + 1)
+    # (the shared 40-window run: its first windows are the same as a separate run's of window + 1)
+    _, _, lines = between_run
     before = lines[window - 1][1] if window else 0
     crash_at = before + 2
     path, rc, lines = _run_writer(tmp_path, "mid", 40, crash_at)

@@ -95,8 +95,11 @@ def _trace(gp, mp, ga, gb, window, margin, eps=1e-3, max_depth=40):
 def _mj_distances(m, plan, ga, gb, ts):
     d = mujoco.MjData(m)
     out = np.empty(len(ts))
-    for i, t in enumerate(ts):
-        d.qpos[:] = plan.qpos_at(float(t))
+    # one vectorised interpolation for all samples (row i equals qpos_at(ts[i]) bit for bit; a
+    # call per sample was ~85 % of these tests' time)
+    Q = plan.qpos_at(np.asarray(ts, dtype=float))
+    for i in range(len(ts)):
+        d.qpos[:] = Q[i]
         mujoco.mj_kinematics(m, d)
         out[i] = mujoco.mj_geomDistance(m, d, ga, gb, 1.0, None)
     return out
