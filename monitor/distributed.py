@@ -202,9 +202,12 @@ def expand_logs(paths: Sequence[str | os.PathLike[str]]) -> list[str]:
     return out
 
 
-def _verify_task(job: tuple[str, str, int | None]) -> dict[str, Any]:
-    """Re-verify one log (runs in a worker); errors come back as ``{"error": ...}``."""
-    path, model_source, limit = job
+def _verify_task(job: tuple[str, str, int | None, dict[str, Any]]) -> dict[str, Any]:
+    """Re-verify one log (runs in a worker); errors come back as ``{"error": ...}``.
+
+    ``job`` = (path, model_source, limit, the auditor's options for :func:`monitor.review.verify`).
+    """
+    path, model_source, limit, options = job
     from monitor.errors import LogFormatError, MonitorError
     from monitor.log.reader import read_log
     from monitor.review import verify
@@ -214,7 +217,7 @@ def _verify_task(job: tuple[str, str, int | None]) -> dict[str, Any]:
     except (LogFormatError, OSError) as exc:
         return {"error": str(exc)}
     try:
-        return verify(contents, model_source=model_source, progress=False, limit=limit)
+        return verify(contents, model_source=model_source, progress=False, limit=limit, **options)
     except ImportError as exc:
         return {"error": f"verification needs the certification engine: {exc}"}
     except (MonitorError, ValueError) as exc:
@@ -225,7 +228,9 @@ def _verify_task(job: tuple[str, str, int | None]) -> dict[str, Any]:
 
 def verify_logs(paths: Sequence[str | os.PathLike[str]], *, backend: str = "ray", workers: int | None = None,
                 model_source: str = "auto", limit: int | None = None,
-                progress: bool | None = None) -> list[dict[str, Any]]:
+                progress: bool | None = None, tolerances: dict[str, Any] | None = None,
+                expect_pairs: str | None = None, max_penetration: float | None = None,
+                trust_model_edits: bool = False) -> list[dict[str, Any]]:
     """Re-verify many logs in parallel, one task per log.
 
     Each task reads its log and runs :func:`monitor.review.verify` on it, so every
@@ -242,14 +247,18 @@ def verify_logs(paths: Sequence[str | os.PathLike[str]], *, backend: str = "ray"
         model_source: ``"auto" | "xml" | "mjb"`` (see :func:`monitor.log.reader.load_model`).
         limit: verify only the first ``limit`` windows of each log.
         progress: progress bar over logs (None: on a terminal).
+        tolerances, expect_pairs, max_penetration, trust_model_edits: the auditor's options,
+            passed to :func:`monitor.review.verify` in every task unchanged (see there).
 
     Returns:
         one verification dict per log, in the order of :func:`expand_logs`.
     """
     files = expand_logs(paths)
+    options = {"tolerances": tolerances, "expect_pairs": expect_pairs, "max_penetration": max_penetration,
+               "trust_model_edits": bool(trust_model_edits)}
     if backend == "local" and workers is None:
         workers = os.cpu_count() or 1
-    return run_tasks(_verify_task, [(f, model_source, limit) for f in files], backend=backend,
+    return run_tasks(_verify_task, [(f, model_source, limit, options) for f in files], backend=backend,
                      workers=workers, desc="verifying logs", progress=progress)
 
 

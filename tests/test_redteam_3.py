@@ -482,14 +482,32 @@ def test_gate_still_pickles_after_a_step():
     assert again.step(d, np.zeros(1)).verdict == "certified"
 
 
-def test_review_cli_trust_model_edits_flag(tmp_path, capsys):
+def test_review_cli_trust_model_edits_flag(tmp_path):
     """``python -m monitor review --verify`` on the edited run: exit 2 by default (the edit record is
-    unverifiable), exit 0 with ``--trust-model-edits``; the flag is refused with ``--ray`` (not wired)."""
+    unverifiable), exit 0 with ``--trust-model-edits``."""
     from monitor.cli import main
 
     _edited_run(tmp_path / "edit.mcap")
     log = str(tmp_path / "edit.mcap")
     assert main(["review", log, "--verify", "--no-progress"]) == 2
     assert main(["review", log, "--verify", "--no-progress", "--trust-model-edits"]) == 0
-    assert main(["review", log, "--ray", "--trust-model-edits"]) == 2
-    assert "--trust-model-edits" in capsys.readouterr().err
+
+
+def test_parallel_verify_takes_the_auditor_options(tmp_path):
+    """``verify_logs`` (the ``review --ray`` path; local workers here) passes the auditor's options to
+    every task: the same dicts as the serial ``verify`` with them. Before, ``--ray`` refused
+    ``--trust-model-edits``, ``--expect-pairs``, ``--max-penetration`` and ``--tolerances``."""
+    from monitor.distributed import verify_logs
+    from monitor.log.reader import read_log
+    from monitor.review import verify, verify_exit_code
+
+    _edited_run(tmp_path / "edit.mcap")
+    log = str(tmp_path / "edit.mcap")
+    for opts in ({}, {"trust_model_edits": True}, {"expect_pairs": "all", "max_penetration": 0.0}):
+        got = verify_logs([log], backend="local", workers=1, progress=False, **opts)[0]
+        want = verify(read_log(log), progress=False, **opts)
+        assert verify_exit_code(got) == verify_exit_code(want)
+        assert {k: got[k] for k in ("checked", "critical", "unverifiable")} == \
+            {k: want[k] for k in ("checked", "critical", "unverifiable")}
+    assert verify_exit_code(verify_logs([log], backend="local", workers=1, progress=False,
+                                        trust_model_edits=True)[0]) == 0

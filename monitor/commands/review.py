@@ -182,12 +182,6 @@ def run(args: argparse.Namespace) -> int:
     if mp is not None and not (math.isfinite(mp) and mp >= 0):
         print(f"error: --max-penetration must be a finite number >= 0 (m), got {mp}", file=sys.stderr)
         return 2
-    if (args.tolerance_values or getattr(args, "expect_pairs", None) or mp is not None
-            or getattr(args, "trust_model_edits", False)) and getattr(args, "ray", False):
-        print("error: --tolerances, --expect-pairs, --max-penetration and --trust-model-edits are not "
-              "supported with --ray yet",
-              file=sys.stderr)
-        return 2
     paths = expand_logs(args.logs)
     if not paths:
         print(f"error: no .mcap logs in {' '.join(map(str, args.logs))}", file=sys.stderr)
@@ -200,8 +194,11 @@ def run(args: argparse.Namespace) -> int:
 
         args.verify = True
         try:
-            verified = dict(zip(paths, verify_logs(paths, backend="ray", model_source=args.model_source,
-                                                   limit=args.limit, progress=args.progress)))
+            verified = dict(zip(paths, verify_logs(
+                paths, backend="ray", model_source=args.model_source, limit=args.limit,
+                progress=args.progress,
+                tolerances=args.tolerance_values, expect_pairs=getattr(args, "expect_pairs", None),
+                max_penetration=mp, trust_model_edits=bool(getattr(args, "trust_model_edits", False)))))
         except DependencyNotInstalled as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
