@@ -100,6 +100,36 @@ def _valid_motion(times, origins, w0, w1):
 
 
 @njit(cache=True)
+def _max_abs(rows):
+    """Largest |entry| of an (n, 3) array (0.0 when empty): the data scale of the rounding pad."""
+    m = 0.0
+    for i in range(rows.shape[0]):
+        for c in range(3):
+            m = max(m, abs(rows[i, c]))
+    return m
+
+
+@njit(cache=True)
+def _spans(ta, tb, w0, w1):
+    """Sorted breakpoints of the window: w0, every waypoint time of either body inside (w0, w1), w1 (§3)."""
+    bps = np.empty(ta.shape[0] + tb.shape[0] + 2)
+    nbp = 0
+    bps[nbp] = w0
+    nbp += 1
+    for t in ta:
+        if w0 < t < w1:
+            bps[nbp] = t
+            nbp += 1
+    for t in tb:
+        if w0 < t < w1:
+            bps[nbp] = t
+            nbp += 1
+    bps[nbp] = w1
+    nbp += 1
+    return np.sort(bps[:nbp])
+
+
+@njit(cache=True)
 def swept_pair_kernel(Pa, Ra, ta, oa, Pb, Rb, tb, ob, w0, w1, thr_cert, level, rr, rel_pad, abs_pad, out):
     """Decide one translating pair over ``[w0, w1]`` with the exact swept test per span, or leave it.
 
@@ -149,32 +179,10 @@ def swept_pair_kernel(Pa, Ra, ta, oa, Pb, Rb, tb, ob, w0, w1, thr_cert, level, r
             mb = max(mb, abs(B0[i, r]), abs(Pb[i, r]))
     if not (np.isfinite(ma) and np.isfinite(mb)):
         return CODE_UNDECIDED
-    moa = 0.0
-    for i in range(oa.shape[0]):
-        for c in range(3):
-            moa = max(moa, abs(oa[i, c]))
-    mob = 0.0
-    for i in range(ob.shape[0]):
-        for c in range(3):
-            mob = max(mob, abs(ob[i, c]))
-    scale = max(moa + 2.0 * ma, mob + 2.0 * mb)
+    scale = max(_max_abs(oa) + 2.0 * ma, _max_abs(ob) + 2.0 * mb)
     data_pad = rel_pad * scale + abs_pad
-    # spans: merged breakpoints inside the window (§3)
-    bps = np.empty(ta.shape[0] + tb.shape[0] + 2)
-    nbp = 0
-    bps[nbp] = w0
-    nbp += 1
-    for t in ta:
-        if w0 < t < w1:
-            bps[nbp] = t
-            nbp += 1
-    for t in tb:
-        if w0 < t < w1:
-            bps[nbp] = t
-            nbp += 1
-    bps[nbp] = w1
-    nbp += 1
-    bps = np.sort(bps[:nbp])
+    bps = _spans(ta, tb, w0, w1)  # spans: merged breakpoints inside the window (§3)
+    nbp = bps.shape[0]
     m = na * nb
     P = np.empty((2 * m, 3))
     lam = np.empty(2 * m)
@@ -292,31 +300,10 @@ def halfspace_pair_kernel(n_p, h_p, Pp, Rp, tp, op, Po, Ro, to, oo, w0, w1, thr_
             mp = max(mp, abs(Pp[i, r]))
     if not (np.isfinite(mo) and np.isfinite(mp) and np.isfinite(nw0[0] + nw0[1] + nw0[2])):
         return CODE_UNDECIDED
-    moa = 0.0
-    for i in range(op.shape[0]):
-        for c in range(3):
-            moa = max(moa, abs(op[i, c]))
-    mob = 0.0
-    for i in range(oo.shape[0]):
-        for c in range(3):
-            mob = max(mob, abs(oo[i, c]))
-    scale = max(moa + 2.0 * mp, mob + 2.0 * mo)
+    scale = max(_max_abs(op) + 2.0 * mp, _max_abs(oo) + 2.0 * mo)
     data_pad = rel_pad * scale + abs_pad
-    bps = np.empty(tp.shape[0] + to.shape[0] + 2)
-    nbp = 0
-    bps[nbp] = w0
-    nbp += 1
-    for t in tp:
-        if w0 < t < w1:
-            bps[nbp] = t
-            nbp += 1
-    for t in to:
-        if w0 < t < w1:
-            bps[nbp] = t
-            nbp += 1
-    bps[nbp] = w1
-    nbp += 1
-    bps = np.sort(bps[:nbp])
+    bps = _spans(tp, to, w0, w1)
+    nbp = bps.shape[0]
     o_p = np.empty(3)
     v_p = np.empty(3)
     o_o = np.empty(3)
