@@ -137,6 +137,10 @@ class Rollout:
         self._roll: Any = None  # mujoco._rollout.Rollout, created on the first C tail
         self._tail_bufs: tuple[np.ndarray, ...] | None = None  # buffers of the C tail (see _tail_by_rollout)
         self._n_full = self._n_user = 0
+        self.tails = 0
+        """Braking tails simulated by :meth:`brake_rows` (a measure of the gate's physics cost)."""
+        self.tail_substeps = 0
+        """Substeps simulated in those tails (each ends at rest, ``vel_tol``, or at ``max_steps``)."""
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle / deepcopy state: without the C rollout object and views into the scratches.
@@ -322,6 +326,8 @@ class Rollout:
         if self.c_tail and _rollout_is_exact(m):
             rows = self._tail_by_rollout(n, vel_tol)
             if rows is not None:
+                self.tails += 1
+                self.tail_substeps += len(rows) - 1
                 return rows, brake
             # a MuJoCo warning in the tail: redo it in the loop (the rollout stops stepping there)
             mujoco.mj_setState(m, s, self._end_state, _INTEGRATION)
@@ -331,6 +337,8 @@ class Rollout:
         rows = self._tail_by_loop(n, vel_tol)
         if warn.any() and not (np.isfinite(rows).all() and (np.diff(rows[:, 0]) > 0).all()):
             self.tail_unstable = True  # rows as MuJoCo gives them (reset included); the gate refuses them
+        self.tails += 1
+        self.tail_substeps += len(rows) - 1
         return rows, brake
 
     tail_unstable = False

@@ -256,6 +256,18 @@ def test_target_status_rules():
     assert target_row(SPECS["sparse_seconds"], 0.01)["floor_status"] is None  # the issue sets no floor
 
 
+def test_physics_floor_counts_the_tails_that_ran():
+    """The floor is 1 + (tail substeps actually simulated per step) x (one loop substep) / ungated step."""
+    from monitor.bench.targets import _floor
+
+    tail = {"tail_substeps": 25, "tail_loop_s": 250e-6}  # 10 us per substep
+    f = _floor(tail, 20e-6, 3.5)  # tails of 3.5 substeps per gated step on average
+    assert f["physics_floor_ratio"] == pytest.approx(1 + 3.5 * 10e-6 / 20e-6)
+    assert f["physics_floor_horizon_ratio"] == pytest.approx(1 + 250e-6 / 20e-6)
+    assert "physics_floor_ratio" not in _floor(tail, 20e-6)  # no count: only the horizon bound
+    assert _floor(None, 20e-6) == {}
+
+
 def test_cli_lists_the_targets_suite():
     from monitor.commands.bench import SUITES
 

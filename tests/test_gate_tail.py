@@ -71,6 +71,8 @@ def test_c_tail_equals_the_loop_and_a_hand_oracle(scene, vel_tol):
             assert np.array_equal(brake, brake_want)
             rows2, _ = ro.brake_rows(d, ctrl, 3, gate._brake_ctrl, 30, vel_tol)  # again: same scratch
             assert np.array_equal(rows2, want)
+            # the rollout's counters (the bench's physics floor) count the substeps the oracle stepped
+            assert (ro.tails, ro.tail_substeps) == (2, 2 * (len(want) - 1))
         lengths.add(len(want))
         d.ctrl[:] = ctrl
         mujoco.mj_step(m, d, nstep=3)

@@ -393,11 +393,14 @@ def gym_gate(
     envs = {"ungated": gym.make(env_id), "gated": SafetyGate(gym.make(env_id), pairs=pairs, brake=brake)}
     verdicts: Counter = Counter()
 
+    tails = _TailCount(envs["gated"].gate)
+
     def block(name: str, n: int, rep: int, count: bool = True) -> float:
         env = envs[name]
         env.reset(seed=rep)
         env.action_space.seed(rep)
         acts = [env.action_space.sample() for _ in range(n)]
+        t0_tails = tails.start()
         t = time.perf_counter()
         for a in acts:
             _, _, term, trunc, info = env.step(a)
@@ -405,7 +408,10 @@ def gym_gate(
                 verdicts[str(info.get("safety", {}).get("verdict", "?"))] += 1
             if term or trunc:
                 env.reset()
-        return (time.perf_counter() - t) / n
+        dt = (time.perf_counter() - t) / n
+        if name == "gated" and count:
+            tails.add(t0_tails, n)
+        return dt
 
     try:
         block("ungated", 5, 1000, False)
@@ -440,15 +446,47 @@ def gym_gate(
         "steps_gated": steps_gated,
         "steps_ungated": steps_ungated,
         "reps": reps,
-        **_floor(tail, u),
+        **_floor(tail, u, tails.per_step()),
     }
 
 
-def _floor(tail: dict[str, Any] | None, ungated_s: float | None) -> dict[str, Any]:
-    """``tail_physics`` figures plus ``physics_floor_ratio`` = 1 + tail loop / ungated step."""
+def _floor(tail: dict[str, Any] | None, ungated_s: float | None,
+           substeps_per_step: float | None = None) -> dict[str, Any]:
+    """``tail_physics`` figures plus the physics floors of the gated step.
+
+    ``physics_floor_ratio`` = 1 + (the braking-tail substeps the gate actually simulated per timed
+    gated step, ``substeps_per_step``) x (one substep of the plain loop) / ungated step: a tail ends
+    at rest (every ``|qvel| <= brake_vel_tol``) or at the horizon, so it is often shorter than
+    ``brake_steps``. ``physics_floor_horizon_ratio`` = 1 + a full-horizon tail / ungated step, the
+    floor if every tail ran to the horizon (the only floor the bench reported before 2026-11-28;
+    on the tunnel the tails average ~3.5 of 25 substeps, so that one overstated it ~4x).
+    """
     if not tail or not ungated_s:
         return {}
-    return dict(tail, physics_floor_ratio=1.0 + tail["tail_loop_s"] / ungated_s)
+    out = dict(tail, physics_floor_horizon_ratio=1.0 + tail["tail_loop_s"] / ungated_s)
+    if substeps_per_step is not None and tail["tail_substeps"]:
+        per_substep = tail["tail_loop_s"] / tail["tail_substeps"]
+        out["tail_substeps_per_step"] = substeps_per_step
+        out["physics_floor_ratio"] = 1.0 + substeps_per_step * per_substep / ungated_s
+    return out
+
+
+class _TailCount:
+    """Braking-tail substeps a gate's rollout simulates between :meth:`start` and :meth:`per_step`."""
+
+    def __init__(self, gate: Any) -> None:
+        self.rollout = getattr(gate, "_rollout", None)
+        self.substeps = self.steps = 0
+
+    def start(self) -> int:
+        return int(getattr(self.rollout, "tail_substeps", 0))
+
+    def add(self, since: int, steps: int) -> None:
+        self.substeps += self.start() - since
+        self.steps += steps
+
+    def per_step(self) -> float | None:
+        return self.substeps / self.steps if (self.rollout is not None and self.steps) else None
 
 
 def tail_physics(model: Any, data: Any, gate: Any, *, reps: int = 5) -> dict[str, Any] | None:
@@ -509,11 +547,14 @@ def plain_gate(
     verdicts: Counter = Counter()
     replaced = 0
 
+    tails = _TailCount(gate)
+
     def gated(n: int, count: bool = True) -> float:
         nonlocal replaced
         reset(dg)
         gate.reset()
         total = 0.0
+        t0_tails = tails.start()
         for k in range(n):
             ctrl = controller(dg, k)
             t = time.perf_counter()
@@ -522,6 +563,8 @@ def plain_gate(
             if count:
                 verdicts[str(rep.verdict)] += 1
                 replaced += int(bool(rep.replaced))
+        if count:
+            tails.add(t0_tails, n)
         return total / n
 
     def ungated(n: int) -> float:
@@ -554,7 +597,7 @@ def plain_gate(
         "steps_gated": steps_gated,
         "steps_ungated": steps_ungated,
         "reps": reps,
-        **_floor(tail, u),
+        **_floor(tail, u, tails.per_step()),
     }
     gate.close()
     return out
@@ -754,8 +797,10 @@ def _gate_note(r: dict[str, Any], what: str) -> str:
         f"{r['monitored_pairs']} monitored pairs"
         + (f" ({', '.join(r['pair_names'])})" if r.get("pair_names") else "")
         + f"; verdicts {r['verdicts']}"
-        + (f"; braking tail {r['tail_substeps']} substeps = {_f(1e6 * r['tail_loop_s'])} µs of mj_step "
-           f"alone: physics floor {_f(r['physics_floor_ratio'])}x" if r.get("physics_floor_ratio") else "")
+        + (f"; braking tails simulated {_f(r['tail_substeps_per_step'])} substeps per gated step (horizon "
+           f"{r['tail_substeps']} = {_f(1e6 * r['tail_loop_s'])} µs of mj_step alone): physics floor "
+           f"{_f(r['physics_floor_ratio'])}x ({_f(r['physics_floor_horizon_ratio'])}x if every tail ran to "
+           f"the horizon)" if r.get("physics_floor_ratio") else "")
     )
 
 
