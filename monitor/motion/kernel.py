@@ -917,9 +917,25 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
         r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
         if r > ref_norm:
             ref_norm = r
+    # tree_poses at every waypoint, its scratch allocated once for the K calls (the same
+    # calls of _locate / _qpos_at / _fk, so the same numbers; issue 12, Arm tail: the per-call
+    # allocations were ~85 % of this loop, ~180 us of a 131-waypoint pack)
+    njnt = mp.jnt_type.shape[0]
+    need = np.ones(nbody, dtype=np.int64)
+    q = np.empty(mp.qpos.shape[1])
+    xquat = np.empty((nbody, 4))
+    ja = np.empty((njnt, 3))
+    jx = np.empty((njnt, 3))
+    jf = np.empty((njnt, 4))
+    tmp3 = np.empty(4)
+    qloc = np.empty(4)
     big = 0.0
     for k in range(K):
-        tree_poses(mp, mp.times[k], pos[0], rot[0])
+        i, s, at_end = _locate(mp.times, mp.times[k])
+        _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
+        _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum,
+            mp.jnt_type, mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
+            q, need, pos[0], xquat, rot[0], ja, jx, jf, tmp3, qloc)
         for b in range(nbody):
             r = _norm3(pos[0, b, 0], pos[0, b, 1], pos[0, b, 2])
             if r > big:
