@@ -273,3 +273,20 @@ def test_arm_tails_refuted_by_the_joint_witness_are_unsafe_by_their_own_call():
     env.close()
     assert seen and gate.stats["tail_refuted"] == len(seen)
     assert all(s == ("violation", True) for s in seen), seen
+
+
+def test_the_joint_call_skips_the_ongoing_rule_and_its_certificates_carry_the_gates_request():
+    # The joint call runs under ongoing="violation" (a certificate the rule changed is never
+    # used); a certified joint call is what the gate's own request gives, and carries that request.
+    m, plan, tail = _slider_plans([0.03, 0.1], [0.1, 0.04])
+    gate = Gate(m, pairs="all", allowed=None, margin=0.02, ongoing="deepen")
+    assert gate._plain_request().ongoing == "violation" and gate._plain_request() is gate._plain_request()
+    assert gate._plain_request().replace(ongoing="deepen") == gate.request
+    w, b, _ = _joint(gate, plan, tail)
+    assert w.request is gate.request and b.request is gate.request
+    joint = type(plan)(np.r_[plan.times, tail.times[1:]], np.r_[plan.qpos, tail.qpos[1:]], m)
+    own = gate._certify(joint)[0]       # the oracle: one call under the gate's request
+    assert own.certified and own.clearance == w.clearance == b.clearance
+    assert own.stats["tests"] == w.stats["tests"] and own.pairs == w.pairs
+    plain = Gate(m, pairs="all", allowed=None, margin=0.02, ongoing="violation")
+    assert plain._plain_request() is plain.request
