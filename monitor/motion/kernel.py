@@ -189,6 +189,26 @@ def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _quat_unit(w: float, x: float, y: float, z: float) -> tuple[float, float, float, float]:
+    """(w, x, y, z) / its norm, identity for a zero quaternion: :func:`_quat_normalize` on scalars."""
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if n > 0.0:
+        return w / n, x / n, y / n, z / n
+    return 1.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _quat_mat9(w: float, x: float, y: float, z: float) -> tuple:
+    """The 9 entries (row-major) of R for a unit quaternion (w, x, y, z).
+
+    :func:`_quat_to_mat`'s expressions, on scalars (the FK's: no array views).
+    """
+    return (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+            2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Set out = R(q) v for a unit quaternion q (v and out (3,), may not alias)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -337,15 +357,7 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
                 jframe[j, 2] = y
                 jframe[j, 3] = z
                 # _rot_vec(quaternion, v) = R v, R's entries as _rot_vec / _quat_to_mat write them
-                r00 = 1.0 - 2.0 * (y * y + z * z)
-                r01 = 2.0 * (x * y - w * z)
-                r02 = 2.0 * (x * z + w * y)
-                r10 = 2.0 * (x * y + w * z)
-                r11 = 1.0 - 2.0 * (x * x + z * z)
-                r12 = 2.0 * (y * z - w * x)
-                r20 = 2.0 * (x * z - w * y)
-                r21 = 2.0 * (y * z + w * x)
-                r22 = 1.0 - 2.0 * (x * x + y * y)
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _quat_mat9(w, x, y, z)
                 v0, v1, v2 = jnt_pos[j, 0], jnt_pos[j, 1], jnt_pos[j, 2]
                 ax = px + (r00 * v0 + r01 * v1 + r02 * v2)
                 ay = py + (r10 * v0 + r11 * v1 + r12 * v2)
@@ -367,15 +379,7 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
                     pz += jx2 * d
                     continue
                 if typ == _BALL:
-                    l0, l1, l2, l3 = q[adr], q[adr + 1], q[adr + 2], q[adr + 3]
-                    n = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2 + l3 * l3)
-                    if n > 0.0:
-                        l0 /= n
-                        l1 /= n
-                        l2 /= n
-                        l3 /= n
-                    else:
-                        l0, l1, l2, l3 = 1.0, 0.0, 0.0, 0.0
+                    l0, l1, l2, l3 = _quat_unit(q[adr], q[adr + 1], q[adr + 2], q[adr + 3])
                 else:  # hinge
                     ang = q[adr] - qpos0[adr]
                     n = jnt_axis_norm[j]
@@ -393,26 +397,11 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
                 nz = w * l3 + x * l2 - y * l1 + z * l0
                 w, x, y, z = nw, nx, ny, nz
                 v0, v1, v2 = jnt_pos[j, 0], jnt_pos[j, 1], jnt_pos[j, 2]
-                r00 = 1.0 - 2.0 * (y * y + z * z)
-                r01 = 2.0 * (x * y - w * z)
-                r02 = 2.0 * (x * z + w * y)
-                r10 = 2.0 * (x * y + w * z)
-                r11 = 1.0 - 2.0 * (x * x + z * z)
-                r12 = 2.0 * (y * z - w * x)
-                r20 = 2.0 * (x * z - w * y)
-                r21 = 2.0 * (y * z + w * x)
-                r22 = 1.0 - 2.0 * (x * x + y * y)
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _quat_mat9(w, x, y, z)
                 px = ax - (r00 * v0 + r01 * v1 + r02 * v2)
                 py = ay - (r10 * v0 + r11 * v1 + r12 * v2)
                 pz = az - (r20 * v0 + r21 * v1 + r22 * v2)
-        n = math.sqrt(w * w + x * x + y * y + z * z)
-        if n > 0.0:
-            w /= n
-            x /= n
-            y /= n
-            z /= n
-        else:
-            w, x, y, z = 1.0, 0.0, 0.0, 0.0
+        w, x, y, z = _quat_unit(w, x, y, z)
         xpos[b, 0] = px
         xpos[b, 1] = py
         xpos[b, 2] = pz
@@ -420,15 +409,8 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         xquat[b, 1] = x
         xquat[b, 2] = y
         xquat[b, 3] = z
-        xmat[b, 0, 0] = 1.0 - 2.0 * (y * y + z * z)
-        xmat[b, 0, 1] = 2.0 * (x * y - w * z)
-        xmat[b, 0, 2] = 2.0 * (x * z + w * y)
-        xmat[b, 1, 0] = 2.0 * (x * y + w * z)
-        xmat[b, 1, 1] = 1.0 - 2.0 * (x * x + z * z)
-        xmat[b, 1, 2] = 2.0 * (y * z - w * x)
-        xmat[b, 2, 0] = 2.0 * (x * z - w * y)
-        xmat[b, 2, 1] = 2.0 * (y * z + w * x)
-        xmat[b, 2, 2] = 1.0 - 2.0 * (x * x + y * y)
+        (xmat[b, 0, 0], xmat[b, 0, 1], xmat[b, 0, 2], xmat[b, 1, 0], xmat[b, 1, 1], xmat[b, 1, 2],
+         xmat[b, 2, 0], xmat[b, 2, 1], xmat[b, 2, 2]) = _quat_mat9(w, x, y, z)
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
