@@ -1149,6 +1149,9 @@ class Gate:
         self._committed: np.ndarray | None = None
         self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
         self._joint_hint = True  # try the joint window + tail call (see decide)
+        self._joint_witness: Any = None  # the last failed joint call's witness inside the tail, or None
+        self._plain: tuple[CertifyRequest, CertifyRequest] | None = None  # (request, its plain copy)
+        self._call_request: CertifyRequest | None = None  # set during the joint call (see _certify)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
         self._tail_record: tuple[Certificate, int] | None = None  # (tail certificate, its log record index)
@@ -1169,7 +1172,7 @@ class Gate:
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
                       "tail_replay_differs": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0,
-                      "committed": 0, "joint": 0}
+                      "committed": 0, "joint": 0, "tail_refuted": 0}
         self._warned = False
         if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -1320,16 +1323,20 @@ class Gate:
         return self._certify(plan)[0]
 
     def _certify(self, plan: Any) -> tuple[Certificate, float]:
-        """Certificate of ``plan`` and the wall time in µs."""
+        """Certificate of ``plan`` and the wall time in µs.
+
+        Under the gate's request, or ``self._call_request`` while that is set (the joint call's).
+        """
         from monitor.certify.engine import certify
 
         t_start = time.perf_counter()
         scene = self.scene
+        req = self._call_request or self._request or self.request
         todo, reused, keys = self._split_reuse(scene, plan)
         if todo is None:  # nothing reusable: one plain call
-            cert = certify(scene, plan, request=self._request or self.request)
+            cert = certify(scene, plan, request=req)
         else:
-            cert = self._certify_subset(certify, scene, plan, todo, reused)
+            cert = self._certify_subset(certify, scene, plan, todo, reused, req)
         if keys:  # fixed pairs (only with reuse on)
             self._remember(cert, keys)
         us = (time.perf_counter() - t_start) * 1e6
@@ -1371,8 +1378,11 @@ class Gate:
         the same for the window, the tail and the joint plan.
 
         Anything else (uncertain, violation, an ongoing contact, a plan that does not join)
-        returns None and the caller runs today's two calls, so verdicts, witnesses and the
-        brake verdict of those windows are exactly today's.
+        returns None and the caller runs today's two calls, so verdicts and witnesses of
+        those windows are exactly today's. One exception, for the tail only: a joint
+        ``violation`` whose witness lies in the tail's span [t1, t_end] (and no ongoing pair)
+        is kept in ``self._joint_witness``; :meth:`_tail_refuted` may then reject the tail
+        without certifying it again (the brake decision is the one the tail's own call gives).
 
         Returns:
             (window certificate, tail certificate, µs) or None. The two certificates are the
@@ -1381,6 +1391,7 @@ class Gate:
         """
         from monitor.motion.plan import Plan
 
+        self._joint_witness = None
         # Bit-for-bit checks (bytes: stricter than ==, e.g. -0.0 != 0.0); both hold by
         # construction on the gate's own path, a failure only means two calls.
         if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
@@ -1391,13 +1402,91 @@ class Gate:
         rows = np.concatenate((window_rows, tail_rows[1:]))
         joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
                               mocap_pos=mocap_pos.copy(), mocap_quat=mocap_quat.copy())
-        cert, us = self._certify(joint)
+        self._call_request = self._plain_request()
+        try:
+            cert, us = self._certify(joint)
+        finally:
+            self._call_request = None
         if not cert.certified or cert.stats.get("ongoing", 0):
+            w = cert.witness
+            if (cert.verdict == "violation" and not cert.stats.get("ongoing", 0) and w is not None
+                    and float(tail_rows[0, 0]) <= w.time <= float(rows[-1, 0])):
+                self._joint_witness = w  # a confirmed violation inside the tail (see _tail_refuted)
             return None
+        cert.__dict__["request"] = self.request  # (not a compared field) what a call under it returns
         self.stats["joint"] += 1
         t0, t1, t_end = float(rows[0, 0]), float(tail_rows[0, 0]), float(rows[-1, 0])
         span = [t0, t_end]
         return _part(cert, (t0, t1), span), _part(cert, (t1, t_end), span), us
+
+    def _plain_request(self) -> CertifyRequest:
+        """The gate's request under ``ongoing="violation"`` (the joint call's; cached per request).
+
+        The joint call's certificate is used only when it is ``certified`` with no ongoing
+        pair (:meth:`_certify_joint`). Under ``"deepen"``, ``certify`` returns a certified
+        plain certificate unchanged, and re-judges the pairs of any other one: the result is
+        then either not certified or certified through the ongoing rule (``stats["ongoing"]``),
+        and the gate uses neither. So the joint call skips the rule (issue 12: on the Arm
+        it cost ~40 % of the failing joint calls): the same windows are settled by it, with the
+        same certificates (the gate's request is set on them), and the rest fall back as before.
+        A witness of the plain call is still a confirmed violation (:meth:`_tail_refuted`
+        checks the ongoing rule at the TAIL's start, the only one the tail's call applies).
+        """
+        req = self.request
+        if req.ongoing == "violation":
+            return req
+        hit = self._plain
+        if hit is None or hit[0] is not req:
+            hit = self._plain = (req, req.replace(ongoing="violation"))
+        return hit[1]
+
+    def _tail_refuted(self, witness: Any, tail: _Tail) -> bool:
+        """Whether the joint call's ``witness`` decides the tail as its own certify call would.
+
+        Args:
+            witness: the :class:`Witness` of a ``violation`` of the joint plan (window + tail,
+                no ongoing pair) at a time in the tail's span [t1, t_end]
+                (:meth:`_certify_joint` keeps it in ``self._joint_witness``).
+            tail: the braking tail whose certificate the caller is about to compute.
+
+        The witness is a confirmed violation of the continuous motion: the exact static
+        distance of its pair at ``witness.time`` is below the margin (rounding padded up).
+        On [t1, t_end] the joint plan's motion is the tail plan's, exactly (same rows,
+        same interpolation: :meth:`_certify_joint`), so the tail's motion has that
+        configuration too, and a sound certificate of the tail can only say ``violation``
+        or ``uncertain`` for that pair, hence for the tail, unless the tail's call re-judges
+        the pair by the ongoing-contact rule. Under ``ongoing="deepen"`` it does that only
+        for a pair whose static lower bound at the tail's start is <= margin
+        (:func:`monitor.certify.ongoing.deepen`): the same ``shape_distance`` on the same
+        poses (the tail plan's at t1) is computed here, and the pair must be clear. Then
+        every verdict the tail's call could give is unsafe under ``unsafe="uncertain"``
+        (the default: anything not certified), which is the only policy this answers for:
+        under ``unsafe="violation"`` an ``uncertain`` tail is accepted, so the tail is
+        certified as before. The brake is rejected exactly when the tail's own call would
+        reject it; the reported ``brake_verdict`` is ``"violation"`` (the tail's call could
+        only differ by saying ``"uncertain"``).
+
+        Returns:
+            True when the tail can be rejected without its own certify call.
+        """
+        if self.unsafe != "uncertain":
+            return False
+        if self.ongoing != "violation":   # "deepen": the pair must not be ongoing at the tail's start
+            from monitor.geometry.distance import shape_distance
+
+            scene = self.scene
+            try:
+                ga, gb = scene.geom(witness.geoms[0]), scene.geom(witness.geoms[1])
+            except InvalidInputError:   # not a geom of the scene (cannot happen on the gate's path)
+                return False
+            plan = tail.plan
+            pos, rot = plan.body_poses(np.array([float(plan.times[0])]))
+            dist = shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
+                                  gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]),
+                                  tolerances=self.tolerances)
+            if not dist.lower > self.margin:
+                return False
+        return True
 
     def _split_reuse(self, scene: Any, plan: Any) -> tuple[list[int] | None, dict[int, PairResult],
                                                              dict[int, bytes]]:
@@ -1449,12 +1538,17 @@ class Gate:
         return body_a, body_b
 
     def _certify_subset(self, certify: Callable[..., Certificate], scene: Any, plan: Any,
-                        todo: list[int], reused: dict[int, PairResult]) -> Certificate:
-        """Certify only ``todo`` and merge in the reused pair results (scene order)."""
+                        todo: list[int], reused: dict[int, PairResult],
+                        request: CertifyRequest | None = None) -> Certificate:
+        """Certify only ``todo`` and merge in the reused pair results (scene order).
+
+        ``request``: the request of the fresh pairs (default the gate's); the merged
+        certificate carries the gate's.
+        """
         t0, t1 = float(plan.t0), float(plan.t1)
         if todo:
             names = tuple(tuple(scene.candidate_pairs[i]) for i in todo)
-            fresh = certify(scene, plan, request=self.request._with_pairs(names))
+            fresh = certify(scene, plan, request=(request or self.request)._with_pairs(names))
             by_geoms = {p.geoms: p for p in fresh.pairs}
             fresh_pairs = [by_geoms[tuple(scene.candidate_pairs[i])] for i in todo]
         else:
@@ -1604,7 +1698,7 @@ class Gate:
         else:
             plan = predict(ctrl)
         brake_on = self._brake_active(fallback)
-        tail = joint = None
+        tail = joint = joint_witness = None
         if (brake_on and self._joint_tail and self._joint_hint and own_predictor
                 and self.scene.candidate_pairs):
             # Common path: window + braking tail certified by ONE call (see _certify_joint).
@@ -1616,6 +1710,7 @@ class Gate:
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
                                         tail.mocap_quat)
+            joint_witness = self._joint_witness
         if joint is not None:
             cert, tail_cert, us = joint
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
@@ -1637,9 +1732,15 @@ class Gate:
                     self._rollout.check_tail()
                     tail = _Tail(rows, self.model, data)
                     tail_qvel = tail.qvel
-                tail_cert, tail_us = self._certify(tail.plan)
-                us += tail_us
-                brake_verdict = tail_cert.verdict
+                if joint_witness is not None and self._tail_refuted(joint_witness, tail):
+                    # the joint call confirmed a violation inside the tail (see _tail_refuted)
+                    tail_cert = None
+                    brake_verdict = "violation"
+                    self.stats["tail_refuted"] += 1
+                else:
+                    tail_cert, tail_us = self._certify(tail.plan)
+                    us += tail_us
+                    brake_verdict = tail_cert.verdict
                 if self.is_unsafe(brake_verdict):
                     unsafe = True
                     self.stats["brake_rejected"] += 1

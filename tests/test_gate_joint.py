@@ -199,3 +199,94 @@ def test_a_custom_predictor_is_used_and_never_joined():
         r = gate.decide(d, np.array([2.0]))
         assert calls and r.verdict == "certified" and r.brake_verdict == "certified"
         assert gate.stats["joint"] == 0  # its window may not be the rollout's: two calls
+
+
+def _tail_of(m, tail):
+    """A gate ``_Tail`` from a tail Plan (its rows: time, qpos, zero qvel)."""
+    from monitor.gate import _Tail
+
+    return _Tail(np.c_[tail.times, tail.qpos, np.zeros((len(tail.times), m.nv))], m, mujoco.MjData(m))
+
+
+def test_a_joint_witness_in_the_tail_rejects_the_brake_as_the_tails_own_call_does():
+    # Clear window, then the tail drives the ball 2 cm into the wall: the joint call is a
+    # violation with its witness in the tail, and the gate may reject the brake without a
+    # second certify of the tail. Oracle: the tail's own certificate (a separate call).
+    m, plan, tail = _slider_plans([0.1, 0.1], [0.1, -0.02])
+    for ongoing in ("deepen", "violation"):
+        gate = Gate(m, pairs="all", allowed=None, margin=0.01, ongoing=ongoing)
+        assert _joint(gate, plan, tail) is None
+        w = gate._joint_witness
+        assert w is not None and tail.t0 <= w.time <= tail.t1 and w.distance < 0.01
+        own = gate._certify(tail)[0]
+        assert own.verdict == "violation" and gate.is_unsafe(own.verdict)
+        assert gate._tail_refuted(w, _tail_of(m, tail))
+    # under unsafe="violation" an uncertain tail would be accepted: the tail is certified again
+    gate = Gate(m, pairs="all", allowed=None, margin=0.01, unsafe="violation")
+    assert _joint(gate, plan, tail) is None and gate._joint_witness is not None
+    assert not gate._tail_refuted(gate._joint_witness, _tail_of(m, tail))
+    # a witness in the window (or none) is not kept
+    m, plan, tail = _slider_plans([0.1, 0.1, -0.02, 0.1], [0.1, 0.1])
+    gate = Gate(m, pairs="all", allowed=None, margin=0.01)
+    assert _joint(gate, plan, tail) is None and gate._joint_witness is None
+
+
+def test_a_joint_witness_does_not_refute_a_tail_that_starts_in_an_ongoing_contact():
+    # The tail starts 5 mm from the wall (inside the 1 cm margin) and ends at 2 mm: a plain
+    # violation of the margin, but under ongoing="deepen" the tail's own call judges the pair
+    # as an ongoing contact at ITS start and certifies it (it never penetrates). The joint
+    # witness must then not reject the brake; under ongoing="violation" it must.
+    from monitor.certify.certificate import Witness
+
+    m, plan, tail = _slider_plans([0.1, 0.005], [0.005, 0.002])
+    w = Witness(float(tail.times[-1]), ("ball", "wall"), np.zeros(3), 0.002)
+    deepen = Gate(m, pairs="all", allowed=None, margin=0.01, ongoing="deepen")
+    own = deepen._certify(tail)[0]
+    assert own.verdict == "certified" and own.stats.get("ongoing", 0) == 1   # the oracle
+    assert not deepen._tail_refuted(w, _tail_of(m, tail))
+    plain = Gate(m, pairs="all", allowed=None, margin=0.01, ongoing="violation")
+    assert plain._certify(tail)[0].verdict == "violation"
+    assert plain._tail_refuted(w, _tail_of(m, tail))
+
+
+def test_arm_tails_refuted_by_the_joint_witness_are_unsafe_by_their_own_call():
+    # Every tail the gate rejects from the joint call's witness is certified again here by its
+    # own call (the oracle): it must be unsafe, with the same verdict label.
+    env = SafetyGate(gym.make("monitor/Arm-v0"))
+    gate = env.gate
+    seen = []
+    refuted = gate._tail_refuted
+
+    def check(witness, tail):
+        out = refuted(witness, tail)
+        if out:
+            own = gate._certify(tail.plan)[0]
+            seen.append((str(own.verdict), gate.is_unsafe(own.verdict)))
+        return out
+
+    gate._tail_refuted = check
+    env.action_space.seed(0)
+    acts = [env.action_space.sample() for _ in range(40)]
+    env.reset(seed=0)
+    for a in acts:
+        env.step(a)
+    env.close()
+    assert seen and gate.stats["tail_refuted"] == len(seen)
+    assert all(s == ("violation", True) for s in seen), seen
+
+
+def test_the_joint_call_skips_the_ongoing_rule_and_its_certificates_carry_the_gates_request():
+    # The joint call runs under ongoing="violation" (a certificate the rule changed is never
+    # used); a certified joint call is what the gate's own request gives, and carries that request.
+    m, plan, tail = _slider_plans([0.03, 0.1], [0.1, 0.04])
+    gate = Gate(m, pairs="all", allowed=None, margin=0.02, ongoing="deepen")
+    assert gate._plain_request().ongoing == "violation" and gate._plain_request() is gate._plain_request()
+    assert gate._plain_request().replace(ongoing="deepen") == gate.request
+    w, b, _ = _joint(gate, plan, tail)
+    assert w.request is gate.request and b.request is gate.request
+    joint = type(plan)(np.r_[plan.times, tail.times[1:]], np.r_[plan.qpos, tail.qpos[1:]], m)
+    own = gate._certify(joint)[0]       # the oracle: one call under the gate's request
+    assert own.certified and own.clearance == w.clearance == b.clearance
+    assert own.stats["tests"] == w.stats["tests"] and own.pairs == w.pairs
+    plain = Gate(m, pairs="all", allowed=None, margin=0.02, ongoing="violation")
+    assert plain._plain_request() is plain.request

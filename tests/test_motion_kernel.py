@@ -406,3 +406,130 @@ def test_pair_bound_equals_two_body_bounds():
             assert got[:2] == (0.0, 0.0) and (keep == 7.0).all()
             assert got[2:] == KN.body_bound(mp, ba, ta[i], tb[i], p1, R1)
     assert n > 500
+
+
+def test_rounding_scale_equals_its_definition_with_static_bodies():
+    """The pack's rounding scale (``tol[TOL_SCALE]``, ``batch(BATCH_SCALE)``) is exactly its
+    definition: max over waypoints and bodies of |origin| (every body's FK at every waypoint,
+    ``tree_poses``) + reference points + the whole-window bound at scale 0. The kernel
+    recomputes only the moving bodies after the first waypoint; here random trees get some
+    coordinates frozen (static bodies between moving ones), some frozen at +-0 alternately
+    (equal, so not moving, but not the same bits)."""
+    rng = np.random.default_rng(20261128)
+    n_static = 0
+    for _ in range(40):
+        m = mujoco.MjModel.from_xml_string(_random_chain_xml(rng))
+        K = int(rng.integers(2, 7))
+        times = np.cumsum(rng.uniform(0.05, 1.0, K))
+        qpos = _random_qpos(rng, m, K)
+        for j in range(m.njnt):
+            if rng.random() < 0.5:
+                a = m.jnt_qposadr[j]
+                w = {0: 7, 1: 4}.get(int(m.jnt_type[j]), 1)
+                qpos[:, a:a + w] = qpos[0, a:a + w]
+                if w == 1 and rng.random() < 0.5:
+                    qpos[:, a] = np.where(np.arange(K) % 2 == 0, 0.0, -0.0)
+        mocap_pos = rng.uniform(-1, 1, (m.nmocap, 3)) if m.nmocap else None
+        mocap_quat = np.array([_rand_quat(rng) for _ in range(m.nmocap)]) if m.nmocap else None
+        mp = pack_trajectory(Plan(times, qpos, model=m, mocap_pos=mocap_pos, mocap_quat=mocap_quat))
+        nbody = m.nbody
+        n_static += int(np.count_nonzero(mp.body_moving[1:] == 0))
+        if not mp.body_moving.any():
+            assert mp.tol[KN.TOL_SCALE] == 0.0
+            continue
+        pos, _ = body_poses(mp, mp.times)                  # tree_poses at every waypoint
+        big = float(np.linalg.norm(pos, axis=-1).max())
+        ref_norm = float(np.linalg.norm(mp.ref_points, axis=-1).max())
+        mp0 = mp._replace(tol=mp.tol.copy())
+        mp0.tol[KN.TOL_SCALE] = 0.0
+        tr = np.empty((1, nbody))
+        KN.batch(mp0, KN.BATCH_BOUNDS, mp.times[:1].copy(), mp.times[-1:].copy(), np.empty((1, nbody, 3)),
+                 np.empty((1, nbody, 3, 3)), tr, np.empty((1, nbody)))
+        whole = max(float(tr.max()), 0.0)
+        assert mp.tol[KN.TOL_SCALE] == big + ref_norm + whole + 2.0 * ref_norm
+    assert n_static > 20
+
+
+def _former_fk(mp, q):
+    """The former view-based ``_fk`` (before it was written on scalars), in plain Python on float64.
+
+    The same operations in the same order as the helpers it called (their ``py_func``): the
+    oracle of the compiled FK's bits. Returns xpos (nbody, 3), xmat (nbody, 3, 3).
+    """
+    qm, qn, q2m, rv = (KN._quat_mul.py_func, KN._quat_normalize.py_func, KN._quat_to_mat.py_func,
+                       KN._rot_vec.py_func)
+    nb, nj = mp.body_parent.shape[0], mp.jnt_type.shape[0]
+    xpos, xquat, xmat = np.zeros((nb, 3)), np.zeros((nb, 4)), np.zeros((nb, 3, 3))
+    janchor, jaxis, tmp3, qloc = np.zeros((nj, 3)), np.zeros((nj, 3)), np.zeros(3), np.zeros(4)
+    for b in range(nb):
+        if b == 0 or mp.body_mocap[b] != 0:
+            xpos[b], xquat[b] = mp.body_pos[b], mp.body_quat[b]
+            qn(xquat[b])
+            q2m(xquat[b], xmat[b])
+            continue
+        ja, jn = mp.body_jntadr[b], mp.body_jntnum[b]
+        if jn >= 1 and mp.jnt_type[ja] == 0:
+            adr = mp.jnt_qposadr[ja]
+            xpos[b], xquat[b] = q[adr:adr + 3], q[adr + 3:adr + 7]
+            qn(xquat[b])
+            q2m(xquat[b], xmat[b])
+            continue
+        p = mp.body_parent[b]
+        for r in range(3):
+            xpos[b, r] = xpos[p, r] + (xmat[p, r, 0] * mp.body_pos[b, 0] + xmat[p, r, 1] * mp.body_pos[b, 1]
+                                       + xmat[p, r, 2] * mp.body_pos[b, 2])
+        qm(xquat[p], mp.body_quat[b], xquat[b])
+        for j in range(ja, ja + jn):
+            typ, adr = mp.jnt_type[j], mp.jnt_qposadr[j]
+            rv(xquat[b], mp.jnt_pos[j], tmp3)
+            for c in range(3):
+                janchor[j, c] = tmp3[c] + xpos[b, c]
+            rv(xquat[b], mp.jnt_axis[j], tmp3)
+            jaxis[j] = tmp3
+            if typ == 2:
+                d = q[adr] - mp.qpos0[adr]
+                for c in range(3):
+                    xpos[b, c] += jaxis[j, c] * d
+                continue
+            if typ == 1:
+                qloc[:] = q[adr:adr + 4]
+                qn(qloc)
+            else:
+                ang = q[adr] - mp.qpos0[adr]
+                if ang == 0.0:
+                    qloc[:] = (1.0, 0.0, 0.0, 0.0)
+                else:
+                    sh = np.sin(0.5 * ang)
+                    qloc[0] = np.cos(0.5 * ang)
+                    for c in range(3):
+                        qloc[1 + c] = sh * mp.jnt_axis[j, c] / mp.jnt_axis_norm[j]
+            qm(xquat[b], qloc, xquat[b])
+            rv(xquat[b], mp.jnt_pos[j], tmp3)
+            for c in range(3):
+                xpos[b, c] = janchor[j, c] - tmp3[c]
+        qn(xquat[b])
+        q2m(xquat[b], xmat[b])
+    return xpos, xmat
+
+
+def test_fk_on_scalars_gives_the_former_fks_bits():
+    """The compiled FK (written on scalars) == the former view-based FK, bit for bit, on random
+    trees (hinge, slide, ball, free joints, mocap bodies) at every waypoint."""
+    rng = np.random.default_rng(7)
+    n = 0
+    for _ in range(25):
+        m, times, plan = _random_plan(rng)
+        mp = pack_trajectory(plan)
+        pos, mat = body_poses(mp, mp.times)
+        K = mp.times.shape[0]
+        scalar = np.ones(mp.qpos.shape[1], bool)     # columns body_poses lerps (quaternions: slerp)
+        for a in mp.qt_adr:
+            scalar[a:a + 4] = False
+        for k in range(K):
+            q = mp.qpos[k].copy()     # the interpolation at waypoint k: a + 0 (b - a), or the last row
+            if k < K - 1:
+                q[scalar] = q[scalar] + 0.0 * (mp.qpos[k + 1, scalar] - q[scalar])
+            p_ref, R_ref = _former_fk(mp, q)
+            assert pos[k].tobytes() == p_ref.tobytes() and mat[k].tobytes() == R_ref.tobytes(), (k, m.nbody)
+            n += 1
+    assert n > 50

@@ -189,6 +189,26 @@ def _quat_to_mat(q: np.ndarray, R: np.ndarray) -> None:
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _quat_unit(w: float, x: float, y: float, z: float) -> tuple[float, float, float, float]:
+    """(w, x, y, z) / its norm, identity for a zero quaternion: :func:`_quat_normalize` on scalars."""
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if n > 0.0:
+        return w / n, x / n, y / n, z / n
+    return 1.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _quat_mat9(w: float, x: float, y: float, z: float) -> tuple:
+    """The 9 entries (row-major) of R for a unit quaternion (w, x, y, z).
+
+    :func:`_quat_to_mat`'s expressions, on scalars (the FK's: no array views).
+    """
+    return (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+            2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rot_vec(q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Set out = R(q) v for a unit quaternion q (v and out (3,), may not alias)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -252,6 +272,8 @@ def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half:
     nq = qpos.shape[1]
     for c in range(nq):
         out[c] = _lerp_col(qpos, c, i, s, at_end)
+    if qt_adr.shape[0] == 0:   # no quaternion track: no scratch (an allocation is ~0.1 us per call)
+        return
     tmp = np.empty(4)
     for k in range(qt_adr.shape[0]):
         _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, tmp)
@@ -281,82 +303,114 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
         xpos, xquat, xmat: (nbody, 3), (nbody, 4), (nbody, 3, 3) outputs (world).
         janchor, jaxis: (njnt, 3) world joint anchors and (unnormalised) axes, before each joint acts.
         jframe: (njnt, 4) world orientation of the frame each joint acts in (before the joint).
-        tmp3, qloc: (>= 3,), (4,) scratch (contents on entry do not matter; passed in so that
-            the bound kernels' per-sub-interval FK allocates nothing: issue 12, kernel cost).
+        tmp3, qloc: (>= 3,), (4,) scratch (no longer written: kept in the signature, which
+            every caller passes).
+
+    Written on scalars (issue 12, Arm tail: the former version passed row views such as
+    ``xquat[b]`` to ``_quat_mul`` / ``_rot_vec`` / ``_quat_normalize`` / ``_quat_to_mat`` and
+    took ~2x as long): each pose is carried in locals and stored once. The expressions are
+    those helpers' own, term for term in their order (no fastmath, so no reassociation or
+    contraction): the same floats in every output, bit for bit (checked on random trees
+    with every joint type and mocap bodies against the former version,
+    tests/test_motion_kernel.py).
     """
     nbody = xpos.shape[0]
     for b in range(nbody):
         if need[b] == 0:
             continue
-        if b == 0 or body_mocap[b] != 0:
-            for c in range(3):
-                xpos[b, c] = body_pos[b, c]
-            for c in range(4):
-                xquat[b, c] = body_quat[b, c]
-            _quat_normalize(xquat[b])
-            _quat_to_mat(xquat[b], xmat[b])
-            continue
         ja = body_jntadr[b]
         jn = body_jntnum[b]
-        if jn >= 1 and jnt_type[ja] == _FREE:
+        if b == 0 or body_mocap[b] != 0:
+            px, py, pz = body_pos[b, 0], body_pos[b, 1], body_pos[b, 2]
+            w, x, y, z = body_quat[b, 0], body_quat[b, 1], body_quat[b, 2], body_quat[b, 3]
+        elif jn >= 1 and jnt_type[ja] == _FREE:
             adr = jnt_qposadr[ja]
-            for c in range(3):
-                xpos[b, c] = q[adr + c]
-                janchor[ja, c] = q[adr + c]
-                jaxis[ja, c] = jnt_axis[ja, c]
-            for c in range(4):
-                xquat[b, c] = q[adr + 3 + c]
-            _quat_normalize(xquat[b])
+            px, py, pz = q[adr], q[adr + 1], q[adr + 2]
+            janchor[ja, 0] = px
+            janchor[ja, 1] = py
+            janchor[ja, 2] = pz
+            jaxis[ja, 0] = jnt_axis[ja, 0]
+            jaxis[ja, 1] = jnt_axis[ja, 1]
+            jaxis[ja, 2] = jnt_axis[ja, 2]
+            w, x, y, z = q[adr + 3], q[adr + 4], q[adr + 5], q[adr + 6]
             jframe[ja, 0] = 1.0
             jframe[ja, 1] = 0.0
             jframe[ja, 2] = 0.0
             jframe[ja, 3] = 0.0
-            _quat_to_mat(xquat[b], xmat[b])
-            continue
-        p = body_parent[b]
-        for r in range(3):
-            xpos[b, r] = xpos[p, r] + (xmat[p, r, 0] * body_pos[b, 0] + xmat[p, r, 1] * body_pos[b, 1]
-                                       + xmat[p, r, 2] * body_pos[b, 2])
-        _quat_mul(xquat[p], body_quat[b], xquat[b])
-        for j in range(ja, ja + jn):
-            typ = jnt_type[j]
-            adr = jnt_qposadr[j]
-            for c in range(4):
-                jframe[j, c] = xquat[b, c]
-            _rot_vec(xquat[b], jnt_pos[j], tmp3)
-            for c in range(3):
-                janchor[j, c] = tmp3[c] + xpos[b, c]
-            _rot_vec(xquat[b], jnt_axis[j], tmp3)
-            for c in range(3):
-                jaxis[j, c] = tmp3[c]
-            if typ == _SLIDE:
-                d = q[adr] - qpos0[adr]
-                for c in range(3):
-                    xpos[b, c] += jaxis[j, c] * d
-                continue
-            if typ == _BALL:
-                for c in range(4):
-                    qloc[c] = q[adr + c]
-                _quat_normalize(qloc)
-            else:  # hinge
-                ang = q[adr] - qpos0[adr]
-                n = jnt_axis_norm[j]
-                if ang == 0.0:
-                    qloc[0] = 1.0
-                    qloc[1] = 0.0
-                    qloc[2] = 0.0
-                    qloc[3] = 0.0
-                else:
-                    sh = math.sin(0.5 * ang)
-                    qloc[0] = math.cos(0.5 * ang)
-                    for c in range(3):
-                        qloc[1 + c] = sh * jnt_axis[j, c] / n
-            _quat_mul(xquat[b], qloc, xquat[b])
-            _rot_vec(xquat[b], jnt_pos[j], tmp3)
-            for c in range(3):
-                xpos[b, c] = janchor[j, c] - tmp3[c]
-        _quat_normalize(xquat[b])
-        _quat_to_mat(xquat[b], xmat[b])
+        else:
+            p = body_parent[b]
+            bp0, bp1, bp2 = body_pos[b, 0], body_pos[b, 1], body_pos[b, 2]
+            px = xpos[p, 0] + (xmat[p, 0, 0] * bp0 + xmat[p, 0, 1] * bp1 + xmat[p, 0, 2] * bp2)
+            py = xpos[p, 1] + (xmat[p, 1, 0] * bp0 + xmat[p, 1, 1] * bp1 + xmat[p, 1, 2] * bp2)
+            pz = xpos[p, 2] + (xmat[p, 2, 0] * bp0 + xmat[p, 2, 1] * bp1 + xmat[p, 2, 2] * bp2)
+            a0, a1, a2, a3 = xquat[p, 0], xquat[p, 1], xquat[p, 2], xquat[p, 3]
+            c0, c1, c2, c3 = body_quat[b, 0], body_quat[b, 1], body_quat[b, 2], body_quat[b, 3]
+            w = a0 * c0 - a1 * c1 - a2 * c2 - a3 * c3
+            x = a0 * c1 + a1 * c0 + a2 * c3 - a3 * c2
+            y = a0 * c2 - a1 * c3 + a2 * c0 + a3 * c1
+            z = a0 * c3 + a1 * c2 - a2 * c1 + a3 * c0
+            for j in range(ja, ja + jn):
+                typ = jnt_type[j]
+                adr = jnt_qposadr[j]
+                jframe[j, 0] = w
+                jframe[j, 1] = x
+                jframe[j, 2] = y
+                jframe[j, 3] = z
+                # _rot_vec(quaternion, v) = R v, R's entries as _rot_vec / _quat_to_mat write them
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _quat_mat9(w, x, y, z)
+                v0, v1, v2 = jnt_pos[j, 0], jnt_pos[j, 1], jnt_pos[j, 2]
+                ax = px + (r00 * v0 + r01 * v1 + r02 * v2)
+                ay = py + (r10 * v0 + r11 * v1 + r12 * v2)
+                az = pz + (r20 * v0 + r21 * v1 + r22 * v2)
+                janchor[j, 0] = ax
+                janchor[j, 1] = ay
+                janchor[j, 2] = az
+                v0, v1, v2 = jnt_axis[j, 0], jnt_axis[j, 1], jnt_axis[j, 2]
+                jx0 = r00 * v0 + r01 * v1 + r02 * v2
+                jx1 = r10 * v0 + r11 * v1 + r12 * v2
+                jx2 = r20 * v0 + r21 * v1 + r22 * v2
+                jaxis[j, 0] = jx0
+                jaxis[j, 1] = jx1
+                jaxis[j, 2] = jx2
+                if typ == _SLIDE:
+                    d = q[adr] - qpos0[adr]
+                    px += jx0 * d
+                    py += jx1 * d
+                    pz += jx2 * d
+                    continue
+                if typ == _BALL:
+                    l0, l1, l2, l3 = _quat_unit(q[adr], q[adr + 1], q[adr + 2], q[adr + 3])
+                else:  # hinge
+                    ang = q[adr] - qpos0[adr]
+                    n = jnt_axis_norm[j]
+                    if ang == 0.0:
+                        l0, l1, l2, l3 = 1.0, 0.0, 0.0, 0.0
+                    else:
+                        sh = math.sin(0.5 * ang)
+                        l0 = math.cos(0.5 * ang)
+                        l1 = sh * jnt_axis[j, 0] / n
+                        l2 = sh * jnt_axis[j, 1] / n
+                        l3 = sh * jnt_axis[j, 2] / n
+                nw = w * l0 - x * l1 - y * l2 - z * l3
+                nx = w * l1 + x * l0 + y * l3 - z * l2
+                ny = w * l2 - x * l3 + y * l0 + z * l1
+                nz = w * l3 + x * l2 - y * l1 + z * l0
+                w, x, y, z = nw, nx, ny, nz
+                v0, v1, v2 = jnt_pos[j, 0], jnt_pos[j, 1], jnt_pos[j, 2]
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _quat_mat9(w, x, y, z)
+                px = ax - (r00 * v0 + r01 * v1 + r02 * v2)
+                py = ay - (r10 * v0 + r11 * v1 + r12 * v2)
+                pz = az - (r20 * v0 + r21 * v1 + r22 * v2)
+        w, x, y, z = _quat_unit(w, x, y, z)
+        xpos[b, 0] = px
+        xpos[b, 1] = py
+        xpos[b, 2] = pz
+        xquat[b, 0] = w
+        xquat[b, 1] = x
+        xquat[b, 2] = y
+        xquat[b, 3] = z
+        (xmat[b, 0, 0], xmat[b, 0, 1], xmat[b, 0, 2], xmat[b, 1, 0], xmat[b, 1, 1], xmat[b, 1, 2],
+         xmat[b, 2, 0], xmat[b, 2, 1], xmat[b, 2, 2]) = _quat_mat9(w, x, y, z)
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -917,9 +971,33 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
         r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
         if r > ref_norm:
             ref_norm = r
+    # tree_poses at every waypoint, its scratch allocated once for the K calls (the same
+    # calls of _locate / _qpos_at / _fk). After the first waypoint only the moving bodies
+    # are recomputed (issue 12, Arm tail: ~130 us of FK for a 131-waypoint pack): a body
+    # with body_moving == 0 is the world, a mocap body or a body whose chain coordinates
+    # compare equal at every waypoint (``derive``), so its pose is the first waypoint's
+    # (equal inputs to the same arithmetic; +-0 inputs can only flip the sign of a zero
+    # coordinate), and _fk leaves the rows of bodies it skips as they are, so a moving
+    # body reads its static parent's pose from the first pass. Same norms, same maximum.
+    njnt = mp.jnt_type.shape[0]
+    need = np.ones(nbody, dtype=np.int64)
+    moving_need = np.empty(nbody, dtype=np.int64)
+    for b in range(nbody):
+        moving_need[b] = 1 if mp.body_moving[b] != 0 else 0
+    q = np.empty(mp.qpos.shape[1])
+    xquat = np.empty((nbody, 4))
+    ja = np.empty((njnt, 3))
+    jx = np.empty((njnt, 3))
+    jf = np.empty((njnt, 4))
+    tmp3 = np.empty(4)
+    qloc = np.empty(4)
     big = 0.0
     for k in range(K):
-        tree_poses(mp, mp.times[k], pos[0], rot[0])
+        i, s, at_end = _locate(mp.times, mp.times[k])
+        _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
+        _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum,
+            mp.jnt_type, mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
+            q, need if k == 0 else moving_need, pos[0], xquat, rot[0], ja, jx, jf, tmp3, qloc)
         for b in range(nbody):
             r = _norm3(pos[0, b, 0], pos[0, b, 1], pos[0, b, 2])
             if r > big:
