@@ -1556,7 +1556,7 @@ def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unpr
             intervals = [(float(o.witness_time), float(o.witness_time))]
     for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
         k = 1 if b <= a else max(2, tol.witness_candidates)
-        cands += list(np.linspace(a, b, k))
+        cands += np.linspace(a, b, k).tolist()   # Python floats: the same values, cheaper set/sort
     w = None
     if cands:
         try:  # a budget that runs out here leaves the pair "uncertain" (no witness)
