@@ -12,6 +12,9 @@ tunnel gate's steps.
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -19,16 +22,15 @@ from monitor.certify import engine
 from monitor.certify.common import Budget
 from monitor.certify.engine import certify
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-def _key(cert) -> str:
-    d = cert.to_dict()
-    d["stats"].pop("wall_seconds")
-    return repr(d)
+from _switch_cases import cert_key as _key  # noqa: E402
+from _switch_cases import on_and_off, tunnel_gate_keys  # noqa: E402
 
 
 def _both(run):
     """(direct path on, off) results of ``run()``, and how often the direct builder returned a certificate."""
-    old, real = engine._EXTRUSION_DIRECT, engine._extrusion_decided
+    real = engine._extrusion_decided
     used = [0]
 
     def counted(*a, **k):
@@ -36,14 +38,11 @@ def _both(run):
         used[0] += c is not None
         return c
 
+    engine._extrusion_decided = counted
     try:
-        engine._extrusion_decided = counted
-        engine._EXTRUSION_DIRECT = True
-        a = run()
-        engine._EXTRUSION_DIRECT = False
-        b = run()
+        a, b = on_and_off(engine, "_EXTRUSION_DIRECT", run)
     finally:
-        engine._EXTRUSION_DIRECT, engine._extrusion_decided = old, real
+        engine._extrusion_decided = real
     return a, b, used[0]
 
 
@@ -108,27 +107,11 @@ def test_rotating_pair_and_extrusion_method_fall_back():
 
 def test_tunnel_gate_same_certificates():
     """models/tunnel, plain Gate.step (the bench's workload): the same certificate at every step."""
-    mujoco = pytest.importorskip("mujoco")
-    from monitor._paths import scene_path
-    from monitor.gate import Gate
-
-    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
-
-    def run():
-        gate = Gate(m, margin=0.001)
-        d = mujoco.MjData(m)
-        mujoco.mj_resetDataKeyframe(m, d, 0)
-        out = []
-        for k in range(60):
-            target = 0.3 if (k // 15) % 2 == 0 else -0.3
-            r = gate.step(d, np.clip([12.0 * (target - d.qpos[0])], -6, 6), nstep=1)
-            out.append(_key(r.certificate))
-        return out, d.qpos.tobytes()
-
-    a, b, used = _both(run)
+    pytest.importorskip("mujoco")
+    a, b, used = _both(tunnel_gate_keys)
     assert a == b
     assert used > 20
-    assert any("'violation'" in k for k in a[0]) and any("'certified'" in k for k in a[0])
+    assert any("'violation'" in k for k in a) and any("'certified'" in k for k in a)
 
 
 @pytest.mark.parametrize(("name", "skewed"), [("straight", False), ("weaving", False), ("weaving", True)])

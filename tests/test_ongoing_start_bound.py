@@ -8,29 +8,23 @@ the same inputs: the same certificates (``to_dict()`` without ``wall_seconds``).
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from monitor.certify import ongoing
 from monitor.certify.engine import certify
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-def _key(cert) -> str:
-    d = cert.to_dict()
-    d["stats"].pop("wall_seconds")
-    return repr(d)
+from _switch_cases import cert_key as _key  # noqa: E402
+from _switch_cases import on_and_off, tunnel_gate_keys  # noqa: E402
 
 
 def _both(run):
-    old = ongoing._START_BOUND
-    try:
-        ongoing._START_BOUND = True
-        a = run()
-        ongoing._START_BOUND = False
-        b = run()
-    finally:
-        ongoing._START_BOUND = old
-    return a, b
+    return on_and_off(ongoing, "_START_BOUND", run)
 
 
 def _bounds(cert) -> dict | None:
@@ -81,12 +75,9 @@ def test_same_certificates_on_translating_cases():
 def test_tunnel_gate_same_certificates_and_closed_form_bound():
     """models/tunnel, plain Gate.step (ongoing "deepen"): the same certificate at every step; every
     start bound within 1e-9 m below the closed-form start distance |x0| - 0.005 - 0.01."""
-    mujoco = pytest.importorskip("mujoco")
-    from monitor._paths import scene_path
+    pytest.importorskip("mujoco")
     from monitor.certify import engine
-    from monitor.gate import Gate
 
-    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
     seen: list = []
     real = engine.deepen
 
@@ -97,20 +88,9 @@ def test_tunnel_gate_same_certificates_and_closed_form_bound():
             seen.append((x0, list(known.values())))
         return real(certify_fn, scene, plan, cert, **kw)
 
-    def run():
-        gate = Gate(m, margin=0.001)
-        d = mujoco.MjData(m)
-        mujoco.mj_resetDataKeyframe(m, d, 0)
-        out = []
-        for k in range(60):
-            target = 0.3 if (k // 15) % 2 == 0 else -0.3
-            r = gate.step(d, np.clip([12.0 * (target - d.qpos[0])], -6, 6), nstep=1)
-            out.append(_key(r.certificate))
-        return out
-
     engine.deepen = spy
     try:
-        a, b = _both(run)
+        a, b = _both(tunnel_gate_keys)
     finally:
         engine.deepen = real
     assert a == b

@@ -1079,14 +1079,30 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         witness = lazy.kernel_witness(best_v[2], best_v[3])
         earliest = float(min(starts + firsts))
         clears.append(float("-inf"))
+    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+    return _window_certificate(verdict, witness, earliest, clears, lazy, info, P, S, tests, depth, mix, {},
+                               t0=t0, t1=t1, margin=margin, epsilon=epsilon, method=method, bud=bud,
+                               wall0=wall0, allowed=allowed, KS=KS)
+
+
+def _window_certificate(verdict: Verdict, witness: Witness | None, earliest: float | None,
+                        clears: list[float], lazy: _WindowPairs, info: np.ndarray, P: int, S: int, tests: int,
+                        depth: int, mix: dict, extra: dict, *, t0: float, t1: float, margin: float,
+                        epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
+                        KS: Any) -> Certificate:
+    """The certificate of a window whose S survivors were all decided, the general tail's values.
+
+    For :func:`_kernel_decided` and :func:`_extrusion_decided`: clearance the smallest of
+    ``clears`` (the pairs') and the best culled gap (``info[WI_BEST]``, when finite), inf if
+    none; the general tail's stats (``extra``: the extrusion stats) with ``P - S`` pairs culled.
+    """
     best_cull = info.item(KS.WI_BEST)
     if best_cull < float("inf"):
         clears.append(best_cull)
     clearance = float(min(clears)) if clears else float("inf")
     stats = {"pairs": P, "pairs_culled": P - S, "tests": tests, "max_depth": depth,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
-    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **extra}
     return Certificate._trusted(verdict, (t0, t1), margin, epsilon, _METHOD_OF[method], witness, earliest,
                                 clearance, lazy, stats, allowed)
 
@@ -1183,15 +1199,9 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         starts += [c[0] for c in cand]
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
-    best_cull = info.item(KS.WI_BEST)
-    if best_cull < float("inf"):
-        clears.append(best_cull)
-    clearance = float(min(clears)) if clears else float("inf")
-    stats = {"pairs": P, "pairs_culled": P - S, "tests": tests, "max_depth": depth,
-             "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
-    return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
-                                earliest, clearance, lazy, stats, allowed)
+    return _window_certificate(_VERDICT_OF[verdict], witness, earliest, clears, lazy, info, P, S, tests,
+                               depth, mix, ext_stats, t0=t0, t1=t1, margin=margin, epsilon=epsilon,
+                               method=method, bud=bud, wall0=wall0, allowed=allowed, KS=KS)
 
 _VERDICT_OF = {v.value: v for v in Verdict}
 _METHOD_OF = {m.value: m for m in Method}
