@@ -1,13 +1,14 @@
 """In-process A/B of this branch's tunnel shortcuts, interleaved rounds; certificates compared in full.
 
 PYTHONPATH=<this tree> python docs/notes/issue-12-tunnel-3/ab_inproc.py [rounds] [steps] [switch...]
-switch: "direct" (engine._EXTRUSION_DIRECT) and/or "start" (ongoing._START_BOUND); default both.
-"old" = the switches off (the general stages / shape_distance at t0), "new" = on. Workload: the
+switch: "direct" (engine._EXTRUSION_DIRECT), "start" (ongoing._START_BOUND), "pose" (distance._check_pose:
+old = the numpy checks alone, as on main); default all three. "old" = the switches off, "new" = on. Workload: the
 bench's tunnel_gate (models/tunnel, Gate(margin=0.001), target +-0.3 m switching every 100 windows,
 one 10 ms step per window). Every step's certificate (to_dict without wall_seconds, pairs
 included) and the final state must be identical between the two; medians of per-round means.
 """
 import hashlib
+import math
 import sys
 import time
 
@@ -15,11 +16,28 @@ import mujoco
 import numpy as np
 
 from monitor.certify import engine, ongoing
+from monitor.errors import InvalidInputError
 from monitor.gate import Gate
+from monitor.geometry import distance
 
 rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 4
 steps = int(sys.argv[2]) if len(sys.argv) > 2 else 600
-switches = sys.argv[3:] or ["direct", "start"]
+switches = sys.argv[3:] or ["direct", "start", "pose"]
+NEW_POSE = distance._check_pose
+
+
+def old_check_pose(X, name):
+    """main's _check_pose (numpy reductions only)."""
+    R, p = X
+    R = np.ascontiguousarray(R, dtype=np.float64)
+    p = np.ascontiguousarray(p, dtype=np.float64)
+    if R.shape != (3, 3) or p.shape != (3,):
+        raise InvalidInputError(f"{name}: expected R (3, 3) and p (3,), got {R.shape} and {p.shape}")
+    if not math.isfinite(R.sum() + p.sum()):
+        raise InvalidInputError(f"{name}: pose is not finite")
+    if max(p.max(), -p.min()) > distance._MAX_COORD or max(R.max(), -R.min()) > distance._MAX_ROT:
+        raise InvalidInputError(f"{name}: out of bounds")
+    return R, p
 
 m = mujoco.MjModel.from_xml_path("models/tunnel/scene.xml")
 gate = Gate(m, margin=0.001)
@@ -31,6 +49,8 @@ def use(on):
         engine._EXTRUSION_DIRECT = on
     if "start" in switches:
         ongoing._START_BOUND = on
+    if "pose" in switches:
+        distance._check_pose = NEW_POSE if on else old_check_pose
 
 
 def key(c):
