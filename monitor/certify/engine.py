@@ -680,6 +680,24 @@ class _WindowPairs:
             out[self.unfin] = "budget"
         return out
 
+    def start_lower(self) -> dict[int, float]:
+        """{k: lower bound (m) of pair k's distance at t0} for every pair the kernel did not cull.
+
+        ``k`` is the pair's position in :meth:`build_pairs`' tuple; the pairs not in the dict
+        were culled (``WK_CULLED`` / ``WK_SS``: "certified"). The bound is the window kernel's
+        start-pose test (``R_START_LO``: ``posed_distance`` of the motion pack's poses at t0,
+        float-verified; the test that certifies static pairs and start poses for the engine),
+        NaN where that test did not write the row (``WK_PYTHON``: left to the Python pipeline
+        in stage 0; a static pair the test left there is not proven clear anyway).
+        """
+        KS = _kernels()
+        code = self.code
+        py = KS.WK_PYTHON
+        out: dict[int, float] = {}
+        for s, k in enumerate(self.surv.tolist()):
+            out[k] = math.nan if int(code[k]) == py else self.res.item(s, KS.R_START_LO)
+        return out
+
     def build_pairs(self) -> tuple:
         KS = _kernels()
 
@@ -860,6 +878,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code,
                        gap, surv, res, sc, sr, info)
         done_to = S
+    if _EXTRUSION_DIRECT and method != "toleranced" and done_to == S and not stopped:
+        # every survivor on the extrusion route (the tunnel's window): its certificate without the
+        # general stages and tail (see _extrusion_decided); None leaves it to them
+        cert = _extrusion_decided(scene, plan, sel, pid, code, gap, surv, res, info, S, mp=mp, t0=t0, t1=t1,
+                                  margin=margin, epsilon=epsilon, method=method, bud=bud, tol=tol,
+                                  wall0=wall0, allowed=allowed, sc=sc, sr=sr, KS=KS)
+        if cert is not None:
+            return cert
     # -- colliding pairs the whole-shape stage left open: its full search for a witness -------
     full_tests = 0
     sv = surv[:done_to]
@@ -1053,17 +1079,129 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         witness = lazy.kernel_witness(best_v[2], best_v[3])
         earliest = float(min(starts + firsts))
         clears.append(float("-inf"))
+    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+    return _window_certificate(verdict, witness, earliest, clears, lazy, info, P, S, tests, depth, mix, {},
+                               t0=t0, t1=t1, margin=margin, epsilon=epsilon, method=method, bud=bud,
+                               wall0=wall0, allowed=allowed, KS=KS)
+
+
+def _window_certificate(verdict: Verdict, witness: Witness | None, earliest: float | None,
+                        clears: list[float], lazy: _WindowPairs, info: np.ndarray, P: int, S: int, tests: int,
+                        depth: int, mix: dict, extra: dict, *, t0: float, t1: float, margin: float,
+                        epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
+                        KS: Any) -> Certificate:
+    """The certificate of a window whose S survivors were all decided, the general tail's values.
+
+    For :func:`_kernel_decided` and :func:`_extrusion_decided`: clearance the smallest of
+    ``clears`` (the pairs') and the best culled gap (``info[WI_BEST]``, when finite), inf if
+    none; the general tail's stats (``extra``: the extrusion stats) with ``P - S`` pairs culled.
+    """
     best_cull = info.item(KS.WI_BEST)
     if best_cull < float("inf"):
         clears.append(best_cull)
     clearance = float(min(clears)) if clears else float("inf")
     stats = {"pairs": P, "pairs_culled": P - S, "tests": tests, "max_depth": depth,
              "wall_seconds": time.perf_counter() - wall0, "checker_mix": mix,
-             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False}
-    verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
+             "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **extra}
     return Certificate._trusted(verdict, (t0, t1), margin, epsilon, _METHOD_OF[method], witness, earliest,
                                 clearance, lazy, stats, allowed)
 
+
+
+_EXTRUSION_DIRECT = True
+"""Let :func:`_certify_fast` build the certificate of an all-extrusion-route window itself
+(:func:`_extrusion_decided`); tests switch it off to compare with the general stages."""
+
+
+def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, code: np.ndarray,
+                       gap: np.ndarray, surv: np.ndarray, res: np.ndarray, info: np.ndarray, S: int, *,
+                       mp: Any, t0: float,
+                       t1: float, margin: float, epsilon: float, method: str, bud: Budget, tol: Tolerances,
+                       wall0: float, allowed: tuple, sc: np.ndarray, sr: np.ndarray,
+                       KS: Any) -> Certificate | None:
+    """The certificate :func:`_certify_fast` builds when all S survivors take the extrusion route.
+
+    None unless every survivor is ``WK_OPEN`` (start pose tested clear by the window kernel,
+    not narrowed) and both of its bodies translate (:func:`_translates`, then
+    ``translation_segments``); then the general stages and tail run (a survivor for the
+    toleranced checker, ``method="extrusion"`` on a rotating pair: its InvalidInputError, a
+    budget spent while posing the waypoints). Otherwise the same calls as the general path
+    (:func:`_python_stages`' dispatch, :func:`_run_extrusion`: the compiled swept pass, the
+    Python checker for what it leaves; :func:`extrusion_stats`; :func:`_checked_result` with
+    its witness confirmation), in the same order with the same budget, and the general
+    tail's values with no kernel-decided survivor and nothing unfinished: violation if a
+    pair is, else uncertain if one is, else certified; the witness of the smallest
+    (time, pair index); the earliest time the smallest interval start / witness time;
+    clearance the smallest pair clearance and the best culled gap; ``checker_mix``
+    {"culled", "extrusion"}; the extrusion stats. Issue 12 (tunnel gate).
+
+    Args:
+        sel, pid, code, gap, surv, res, info, sc, sr: the window kernel's arrays
+            (:func:`_certify_fast`); S: survivors, all run by the kernel.
+        mp: the motion pack (its body flags route the pairs).
+        others: as in :func:`_certify_fast`.
+    """
+    sv = surv[:S]
+    wk_open = KS.WK_OPEN
+    if S == 1:
+        if int(code[int(sv[0])]) != wk_open:
+            return None
+    elif any(c != wk_open for c in code.take(sv).tolist()):
+        return None
+    geoms = scene.geoms
+    items = []
+    trans: dict[int, bool] = {}
+    try:
+        for k, a, b in zip(sv.tolist(), pid[sv, 0].tolist(), pid[sv, 1].tolist()):
+            ga, gb = geoms[a], geoms[b]
+            for body in (ga.body_id, gb.body_id):
+                if body not in trans:
+                    trans[body] = _translates(plan, mp, body)
+                if not trans[body]:
+                    return None
+            sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
+            if sa is None or sb is None:
+                return None
+            items.append((int(sel[k]), ga, gb, (sa, sb)))
+    except BudgetExhausted:
+        return None
+    ext_stats: dict[str, Any] = {}
+    try:
+        outs = _run_extrusion(plan, items, margin, tol, bud, t0, t1)
+        ext_stats = extrusion_stats(outs)
+    except BudgetExhausted:
+        outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in items]
+    P = len(sel)
+    mix: dict[str, int] = {}
+    if P - S:
+        mix["culled"] = P - S
+    results: dict[int, PairResult] = {}
+    tests, depth = 0, 0
+    for (i, ga, gb, _), o in zip(items, outs):
+        tests += int(o.tests)
+        depth = max(depth, int(o.max_depth))
+        r = results[i] = _checked_result(plan, "extrusion", o, ga, gb, False, t0, t1, margin, tol, bud)
+        mix[r.method] = mix.get(r.method, 0) + 1
+    checked_r = [results[i] for i in sorted(results)]
+    has_viol = any(r.verdict == "violation" for r in checked_r)
+    verdict = ("violation" if has_viol else "uncertain" if any(r.verdict == "uncertain" for r in checked_r)
+               else "certified")
+    lazy = _WindowPairs(sel, pid, code, gap, sv, res[:S], np.zeros(P, bool), results, geoms, (t0, t1),
+                        sc, sr, info.item(KS.WI_PAD))
+    cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
+            if r.verdict == "violation" and r.witness is not None]
+    witness = None
+    if cand:
+        witness = (cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1])))[2]
+    earliest = None
+    if verdict != "certified":
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+        starts += [c[0] for c in cand]
+        earliest = float(min(starts)) if starts else t0
+    clears = [r.clearance for r in checked_r]
+    return _window_certificate(_VERDICT_OF[verdict], witness, earliest, clears, lazy, info, P, S, tests,
+                               depth, mix, ext_stats, t0=t0, t1=t1, margin=margin, epsilon=epsilon,
+                               method=method, bud=bud, wall0=wall0, allowed=allowed, KS=KS)
 
 _VERDICT_OF = {v.value: v for v in Verdict}
 _METHOD_OF = {m.value: m for m in Method}
@@ -1271,7 +1409,6 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
     # -- 3. start pose -----------------------------------------------------------------
     from monitor.geometry.distance import shape_distance
 
-    witness_of: dict[int, Witness] = {}
     start_unproven: set[int] = set()
     checked = []
     try:
@@ -1382,40 +1519,10 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
         ga, gb = by_i[i]
         tests_total += int(o.tests)
         depth_max = max(depth_max, int(o.max_depth))
-        names, bodies = (ga.name, gb.name), (ga.body, gb.body)
-        # The start-pose rule serves the toleranced argument (boundary tests need
-        # disjoint cores at t0); the extrusion checker decides t0 itself, exactly.
-        if o.verdict == "certified" and (meth == "extrusion" or i not in start_unproven):
-            clear = o.clearance if np.isfinite(o.clearance) else margin
-            if meth == "toleranced":
-                clear = max(clear, margin)
-                refine.append(i)
-            done(i, PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (), float(clear)))
-            continue
-        intervals = list(o.intervals)
-        if o.verdict == "certified":  # start pose not proven clear
-            intervals = [(t0, t0)]
-        cands: list[float] = []
-        if o.verdict == "violation" and o.witness_time is not None:
-            cands.append(float(o.witness_time))
-            if not intervals:
-                intervals = [(float(o.witness_time), float(o.witness_time))]
-        for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
-            k = 1 if b <= a else max(2, tol.witness_candidates)
-            cands += list(np.linspace(a, b, k))
-        w = None
-        if cands:
-            try:  # a budget that runs out here leaves the pair "uncertain" (no witness)
-                w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol, bud)
-            except BudgetExhausted:
-                w = None
-        if w is not None:
-            witness_of[i] = w
-            done(i, PairResult(names, bodies, "violation", meth, o.tests, o.max_depth,
-                               tuple(intervals), float("-inf"), w))
-        else:
-            done(i, PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
-                               tuple(intervals) if intervals else ((t0, t1),), float("-inf")))
+        r = _checked_result(plan, meth, o, ga, gb, i in start_unproven, t0, t1, margin, tol, bud)
+        if r.verdict == "certified" and meth == "toleranced":
+            refine.append(i)
+        done(i, r)
     cl = []
     if refine and not bud.exhausted:  # better clearance bounds for toleranced-certified pairs
         try:
@@ -1429,6 +1536,48 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
                 results[i] = PairResult(r.geoms, r.bodies, r.verdict, r.method, r.tests, r.max_depth,
                                         r.intervals, float(c), r.witness)
     return tests_total, depth_max, ext_stats
+
+
+def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unproven: bool, t0: float,
+                    t1: float, margin: float, tol: Tolerances, bud: Budget) -> PairResult:
+    """Stage 5 for one checked pair: the PairResult of checker ``meth``'s outcome ``o``.
+
+    ``unproven``: the pair's start pose is not proven clear (the toleranced argument needs
+    disjoint cores at t0; the extrusion checker decides t0 itself, exactly). A certified
+    outcome keeps its clearance (the margin when not finite; at least the margin for the
+    toleranced checker). Anything else gets a witness confirmed by the engine's own rule
+    (:func:`_find_witness`: the plan's poses, exact static distance) at the checker's
+    witness time and ``tol.witness_candidates`` times per open interval: "violation" with it,
+    else "uncertain" (also when the budget runs out here).
+    """
+    names, bodies = (ga.name, gb.name), (ga.body, gb.body)
+    if o.verdict == "certified" and (meth == "extrusion" or not unproven):
+        clear = o.clearance if np.isfinite(o.clearance) else margin
+        if meth == "toleranced":
+            clear = max(clear, margin)
+        return PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (), float(clear))
+    intervals = list(o.intervals)
+    if o.verdict == "certified":  # start pose not proven clear
+        intervals = [(t0, t0)]
+    cands: list[float] = []
+    if o.verdict == "violation" and o.witness_time is not None:
+        cands.append(float(o.witness_time))
+        if not intervals:
+            intervals = [(float(o.witness_time), float(o.witness_time))]
+    for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
+        k = 1 if b <= a else max(2, tol.witness_candidates)
+        cands += np.linspace(a, b, k).tolist()   # Python floats: the same values, cheaper set/sort
+    w = None
+    if cands:
+        try:  # a budget that runs out here leaves the pair "uncertain" (no witness)
+            w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol, bud)
+        except BudgetExhausted:
+            w = None
+    if w is not None:
+        return PairResult(names, bodies, "violation", meth, o.tests, o.max_depth, tuple(intervals),
+                          float("-inf"), w)
+    return PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
+                      tuple(intervals) if intervals else ((t0, t1),), float("-inf"))
 
 
 def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: float, t1: float,

@@ -152,18 +152,27 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
         # every pair is certified (any other pair verdict makes the combined verdict
         # "uncertain" or "violation"): no ongoing pair; cert.pairs need not be built here
         return cert
+    # read before cert.pairs (building the pairs drops the kernel's arrays)
+    known = _start_lower(cert) if _START_BOUND else None
+    if known is not None and all(lo > margin for lo in known.values()):
+        return cert   # every pair the kernel did not cull is proven clear at t0: none is ongoing
     cand = [k for k, p in enumerate(cert.pairs) if p.verdict != "certified"]
     if not cand:
         return cert
     t0 = float(cert.window[0])
-    pos, rot = plan.body_poses(np.array([t0]))
+    poses = None
     geoms = list(scene.geoms)
     pair_rows: list[tuple[int, int]] = []
     names: list[tuple[str, str]] = []
     meta: list[tuple[int, float]] = []  # (index in cert.pairs, achieved shrink)
     for k in cand:
+        if known is not None and known.get(k, math.nan) > margin:
+            continue  # proven clear at t0 by the window kernel's start-pose test: a new contact
         p = cert.pairs[k]
         ga, gb = scene.geom(p.geoms[0]), scene.geom(p.geoms[1])
+        if poses is None:
+            poses = plan.body_poses(np.array([t0]))
+        pos, rot = poses
         dist = shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
                               gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]), tolerances=tolerances)
         if dist.lower > margin:
@@ -215,6 +224,27 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
                                note=f"{POLYTOPE_NOTE}: penetration < {tol_txt} cannot be certified "
                                     f"(only {s:g} m of radius to shrink)")
     return _recombine(cert, pairs, len(meta), penetration_tol)
+
+
+_START_BOUND = True
+"""Let :func:`deepen` take the window kernel's start-pose bound where it proves a pair clear
+(:func:`_start_lower`); tests switch it off to compare with ``shape_distance`` alone."""
+
+
+def _start_lower(cert: Certificate) -> dict[int, float] | None:
+    """{position in ``cert.pairs``: lower bound (m) of the pair's distance at t0}, or None.
+
+    From the engine's compiled path, whose window kernel tests every surviving pair's start
+    pose exactly (float-verified ``posed_distance``, the test the engine certifies start
+    poses with): the certificate's unbuilt pairs object answers
+    (:meth:`monitor.certify.engine._WindowPairs.start_lower`), one entry per pair the kernel
+    did not cull (NaN where the test did not run); every other pair is "certified" (culled).
+    None for a certificate whose pairs are a tuple (the Python pipeline, ``replace``, pairs
+    already read): then every pair is measured.
+    """
+    store = cert.__dict__.get("_pairs_store")
+    f = getattr(store, "start_lower", None)
+    return None if f is None else f()
 
 
 def _recombine(cert: Certificate, pairs: list[PairResult], n_ongoing: int, tol: float) -> Certificate:

@@ -230,6 +230,14 @@ def _check_pose(X, name: str) -> tuple[np.ndarray, np.ndarray]:
         raise InvalidInputError(f"{name}: expected a pose (R (3, 3), p (3,))") from None
     if R.shape != (3, 3) or p.shape != (3,):
         raise InvalidInputError(f"{name}: expected R (3, 3) and p (3,), got {R.shape} and {p.shape}")
+    # The common case on 12 Python floats (~1 us instead of six numpy reductions, issue 12): every
+    # entry within its bound (so finite: NaN and inf fail the comparison) passes the checks below;
+    # anything else takes them and their messages.
+    x, y, z = p.tolist()
+    if -_MAX_COORD <= x <= _MAX_COORD and -_MAX_COORD <= y <= _MAX_COORD and -_MAX_COORD <= z <= _MAX_COORD:
+        r = R.ravel().tolist()
+        if min(r) >= -_MAX_ROT and max(r) <= _MAX_ROT and all(v == v for v in r):
+            return R, p
     # any NaN / inf entry makes the sum non-finite
     if not math.isfinite(R.sum() + p.sum()):
         raise InvalidInputError(f"{name}: pose is not finite")

@@ -1,0 +1,53 @@
+"""Helpers of the old-vs-new switch tests (test_engine_extrusion_direct.py, test_ongoing_start_bound.py).
+
+A module flag switches a shortcut off so that the path it replaces is the oracle; certificates
+are compared in full (``to_dict()`` without the wall time).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def cert_key(cert) -> str:
+    """``cert.to_dict()`` without ``stats["wall_seconds"]``, as a string (bit-exact floats)."""
+    d = cert.to_dict()
+    d["stats"].pop("wall_seconds")
+    return repr(d)
+
+
+def on_and_off(module, flag: str, run):
+    """(``run()`` with ``module.flag`` True, with it False); the flag is restored afterwards."""
+    old = getattr(module, flag)
+    try:
+        setattr(module, flag, True)
+        a = run()
+        setattr(module, flag, False)
+        b = run()
+    finally:
+        setattr(module, flag, old)
+    return a, b
+
+
+def tunnel_gate_keys(steps: int = 60) -> list[str]:
+    """:func:`cert_key` of every certificate of ``steps`` plain ``Gate.step`` windows on models/tunnel.
+
+    The bench's controller (velocity towards +-0.3 m, switching every 15 windows; one 10 ms step
+    each), ``Gate(margin=0.001)``, ball from the ``start`` keyframe: certified and violation windows.
+    """
+    import mujoco
+
+    from monitor._paths import scene_path
+    from monitor.gate import Gate
+
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    gate = Gate(m, margin=0.001)
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    out = []
+    for k in range(steps):
+        target = 0.3 if (k // 15) % 2 == 0 else -0.3
+        r = gate.step(d, np.clip([12.0 * (target - d.qpos[0])], -6, 6), nstep=1)
+        out.append(cert_key(r.certificate))
+    out.append(d.qpos.tobytes().hex())
+    return out
