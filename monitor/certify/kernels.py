@@ -1129,15 +1129,12 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         ta = tq * step + t0
         tb = t1 if tq == T - 1 else (tq + 1) * step + t0
         _bounds_core(mp, ta, tb, need_all, pos[tq], rot[tq], trans[tq], ang[tq], ws)
+        grow_f = 1.0 + 8.0 * rel_pad
         all_open = pairs.shape[0] > 0 and not long_window
         if all_open:
-            magq = 0.0
-            for b in range(nbody):
-                for r in range(3):
-                    magq = max(magq, abs(pos[tq, b, r]))
-            magq += 1.0
+            # this sub-range's share of the full path's ``mag`` (NaN propagates: then nothing is proven)
+            magq = np.abs(pos[tq]).max() + 1.0
             padq = rel_pad * magq + abs_pad + prm[WP_SCALE_PAD] * magq
-            grow_q = 1.0 + 8.0 * rel_pad
             cq = np.empty((2, 3))
             rq = np.empty(2)
             for k in range(pairs.shape[0]):
@@ -1156,7 +1153,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
                     R = rot[tq, b]
                     rr = rad + (trans[tq, b] + 2.0 * math.sin(0.5 * min(ang[tq, b], math.pi)) * lever
-                                ) * grow_q
+                                ) * grow_f
                     if not rr >= 0.0:
                         rr = np.inf
                     rq[j] = rr
@@ -1196,7 +1193,6 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         mag = max(mag, abs(pos[t, b, r]))
             mag += 1.0
             pad = rel_pad * mag + abs_pad + prm[WP_SCALE_PAD] * mag
-            grow_f = 1.0 + 8.0 * rel_pad
             lo = np.empty((G, 3))
             hi = np.empty((G, 3))
             for g in range(G):
