@@ -1061,7 +1061,10 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     sub-interval's sphere gap (a ball lies in its box), so when it exceeds the margin
     the pair is culled without the O(T) sphere test, unless it could still be the
     smallest culled gap (then the exact gap is computed, so ``info[WI_BEST]`` is the
-    same minimum as the pairwise sphere test gives). Pairs not culled are survivors.
+    same minimum as the pairwise sphere test gives). Pairs not culled are survivors. The middle
+    sub-range is bounded first: when it alone shows every selected pair of cores within the
+    margin, none can be culled and the other sub-ranges are skipped (early survival; the
+    argument is in stage 0's comment; not for long windows, which read every sub-range).
 
     Stage 1 (per survivor): the exact start-pose test at t0 (``posed_distance``:
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
