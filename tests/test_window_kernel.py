@@ -316,3 +316,72 @@ def test_a_key_whose_first_plan_failed_its_own_check_checks_every_later_plan(mon
     third = _arm_plan(m, 42)
     assert K.trajectory_pack(third) is not None
     assert any(c is third for c in calls)
+
+
+_THREE_XML = """<mujoco><worldbody>
+  <body name="a"><freejoint/><geom name="ga" type="box" size="0.05 0.08 0.03"/></body>
+  <body name="b"><freejoint/><geom name="gb" type="box" size="0.06 0.04 0.05"/></body>
+  <body name="c"><freejoint/><geom name="gc" type="sphere" size="0.05"/></body>
+</worldbody></mujoco>"""
+
+
+def _three_body_motion(rng, gap_b: float) -> monitor.BodyMotion:
+    """a spins and slides along x; b starts ``gap_b`` beyond a's reach and drifts; c stays 5 m away."""
+    pos = np.zeros((2, 4, 3))
+    pos[:, 1] = [[0.0, 0.0, 0.0], [rng.uniform(0.0, 0.2), rng.uniform(-0.05, 0.05), 0.0]]
+    pos[0, 2] = [0.2 + gap_b, rng.uniform(-0.05, 0.05), 0.0]
+    pos[1, 2] = pos[0, 2] + rng.uniform(-0.1, 0.1, 3)
+    pos[:, 3] = [5.0, 0.0, 0.0]
+    quat = np.zeros((2, 4, 4))
+    quat[..., 0] = 1.0
+    axis = rng.normal(size=3)
+    ang = rng.uniform(0.0, 2.0)
+    quat[1, 1] = [np.cos(ang / 2), *(np.sin(ang / 2) * axis / np.linalg.norm(axis))]
+    return monitor.BodyMotion([0.0, 0.1], pos, quat)
+
+
+def test_early_survival_gives_the_full_broad_phase_outcome(monkeypatch):
+    """Stage 0 first tries the middle sub-range: when it shows every selected pair within the margin,
+    the other sub-ranges are skipped. Oracles: the numpy swept-sphere broad phase (which pairs are
+    culled) and the full stage 0 (the same pair certified together with a far pair that it culls, so
+    the early path cannot be taken): the pair's result is the same, field for field."""
+    m = mujoco.MjModel.from_xml_string(_THREE_XML)
+    scene = monitor.Scene.from_model(m, pairs="all")
+    shapes = [g.shape for g in scene.geoms]
+    bodies = np.array([g.body_id for g in scene.geoms])
+    names = [g.name for g in scene.geoms]
+    ia, ib = names.index("ga"), names.index("gb")
+    infos = []
+    orig = engine._window_kernel
+
+    def spy(*a):
+        out = orig(*a)
+        if a[7] == 0:
+            infos.append(a[-1].copy())
+        return out
+
+    monkeypatch.setattr(engine, "_window_kernel", spy)
+    rng = np.random.default_rng(20261128)
+    early = full_only = 0
+    for k in range(20):
+        bm = _three_body_motion(rng, rng.uniform(-0.12, 0.25))
+        sph = swept_geom_spheres(bm, shapes, bodies, (0.0, 0.1), 8)
+        want_gap = float(sphere_pair_gaps(sph, np.array([ia]), np.array([ib]))[0])
+        if abs(want_gap) < 1e-9:
+            continue
+        infos.clear()
+        lone = monitor.certify(scene, bm, pairs=[("ga", "gb")], epsilon=1e-3, method="toleranced")
+        assert (lone.pairs[0].method == "culled") == (want_gap > 0.0), (k, want_gap, lone.pairs[0])
+        took_early = bool(np.isnan(infos[0][K.WI_PAD]))
+        assert not (took_early and want_gap > 0.0), k           # never for a pair the spheres cull
+        early += took_early
+        full_only += not took_early
+        infos.clear()
+        both = monitor.certify(scene, bm, pairs=[("ga", "gb"), ("ga", "gc")], epsilon=1e-3,
+                               method="toleranced")
+        assert not np.isnan(infos[0][K.WI_PAD]), k             # ga-gc is culled: the full stage 0
+        assert both.pairs[1].method == "culled"
+        assert both.pairs[0].to_dict() == lone.pairs[0].to_dict(), k      # incl. witness, floats exactly
+        if lone.verdict == "violation":
+            assert (both.witness.time, both.witness.distance) == (lone.witness.time, lone.witness.distance)
+    assert early >= 4 and full_only >= 4, (early, full_only)

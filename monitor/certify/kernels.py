@@ -1061,7 +1061,10 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     sub-interval's sphere gap (a ball lies in its box), so when it exceeds the margin
     the pair is culled without the O(T) sphere test, unless it could still be the
     smallest culled gap (then the exact gap is computed, so ``info[WI_BEST]`` is the
-    same minimum as the pairwise sphere test gives). Pairs not culled are survivors.
+    same minimum as the pairwise sphere test gives). Pairs not culled are survivors. The middle
+    sub-range is bounded first: when it alone shows every selected pair of cores within the
+    margin, none can be culled and the other sub-ranges are skipped (early survival; the
+    argument is in stage 0's comment; not for long windows, which read every sub-range).
 
     Stage 1 (per survivor): the exact start-pose test at t0 (``posed_distance``:
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
@@ -1092,6 +1095,13 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     rel_pad, abs_pad = prm[WP_REL], prm[WP_ABS]
     max_depth = int(prm[WP_MAX_DEPTH])
     max_tests = int(prm[WP_MAX_TESTS])
+    # a long window: at least as many waypoints inside [t0, t1] as sub-ranges (a window and its
+    # braking tail); single-segment motions keep the whole-window search
+    n_in = 0
+    for i in range(mp.times.shape[0]):
+        if t0 < mp.times[i] < t1:
+            n_in += 1
+    long_window = n_in >= sc.shape[0]
     S = 0
     if stage == 0:
         # -- swept spheres and AABBs per geom (the argument of broadphase.swept_geom_spheres) --
@@ -1107,113 +1117,173 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         # numbers: _bounds_core's result does not depend on the scratch's contents on entry)
         need_all = np.ones(nbody, np.int64)
         ws = bounds_workspace(mp)
-        for t in range(T):
-            ta = t * step + t0
-            tb = t1 if t == T - 1 else (t + 1) * step + t0
-            _bounds_core(mp, ta, tb, need_all, pos[t], rot[t], trans[t], ang[t], ws)
-        mag = 0.0
-        for t in range(T):
-            for b in range(nbody):
-                for r in range(3):
-                    mag = max(mag, abs(pos[t, b, r]))
-        mag += 1.0
-        pad = rel_pad * mag + abs_pad + prm[WP_SCALE_PAD] * mag
+        # Early survival (issue 12, pair-window median): the middle sub-range first. When every
+        # selected pair is a pair of cores (not both static) whose swept spheres on that one sub-range
+        # are within the margin, no pair can be culled: the full path's sphere gap is the minimum over
+        # the T sub-ranges minus pad, so at most this sub-range's (pad grows with the positions of all
+        # T sub-ranges, and rounding is monotone: computed with the same expressions, this pad is a
+        # lower bound of the full one), and the AABB pre-test never culls a pair whose sphere gap is
+        # <= margin (its separation is a lower bound on every sub-range's sphere gap). Then every pair
+        # is WK_OPEN with gap NaN, S = P and no best culled gap: the full path's outputs. The other
+        # outputs (sc, sr, info[WI_PAD]) are read only for culled pairs and by long windows (excluded
+        # here); they are set to "unbounded" (never culls, never clears). Otherwise the full path runs
+        # (reusing this sub-range's bounds: _bounds_core's results do not depend on the order).
+        tq = T // 2
+        ta = tq * step + t0
+        tb = t1 if tq == T - 1 else (tq + 1) * step + t0
+        _bounds_core(mp, ta, tb, need_all, pos[tq], rot[tq], trans[tq], ang[tq], ws)
         grow_f = 1.0 + 8.0 * rel_pad
-        lo = np.empty((G, 3))
-        hi = np.empty((G, 3))
-        for g in range(G):
-            b = gp.body[g]
-            rad = gp.brad[g]
-            if gp.kind[g] < 0 or not rad < np.inf:
-                for t in range(T):
+        all_open = pairs.shape[0] > 0 and not long_window
+        if all_open:
+            # this sub-range's share of the full path's ``mag`` (NaN propagates: then nothing is proven)
+            magq = np.abs(pos[tq]).max() + 1.0
+            padq = rel_pad * magq + abs_pad + prm[WP_SCALE_PAD] * magq
+            cq = np.empty((2, 3))
+            rq = np.empty(2)
+            for k in range(pairs.shape[0]):
+                ga, gb = pairs[k, 0], pairs[k, 1]
+                both_fixed = fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0
+                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0:
+                    all_open = False
+                    break
+                for j in range(2):
+                    g = ga if j == 0 else gb
+                    b = gp.body[g]
+                    rad = gp.brad[g]
+                    cg = gp.bcenter[g]
+                    ref = mp.ref_points[b]
+                    # the geom loop's sphere of sub-range tq, the same expressions
+                    lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+                    R = rot[tq, b]
+                    rr = rad + (trans[tq, b] + 2.0 * math.sin(0.5 * min(ang[tq, b], math.pi)) * lever
+                                ) * grow_f
+                    if not rr >= 0.0:
+                        rr = np.inf
+                    rq[j] = rr
+                    for r in range(3):
+                        cq[j, r] = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[tq, b, r]
+                d = (_norm3(cq[0, 0] - cq[1, 0], cq[0, 1] - cq[1, 1], cq[0, 2] - cq[1, 2]) - rq[0] - rq[1])
+                if not (gp.brad[ga] < np.inf and gp.brad[gb] < np.inf and d > -np.inf and d - padq <= margin):
+                    all_open = False
+                    break
+        if all_open:
+            for t in range(T):
+                for g in range(G):
                     sr[t, g] = np.inf
                     for r in range(3):
                         sc[t, g, r] = 0.0
-                for r in range(3):
-                    lo[g, r] = -np.inf
-                    hi[g, r] = np.inf
-                continue
-            cg = gp.bcenter[g]
-            ref = mp.ref_points[b]
-            lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
-            for r in range(3):
-                lo[g, r] = np.inf
-                hi[g, r] = -np.inf
-            for t in range(T):
-                R = rot[t, b]
-                rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
-                if not rr >= 0.0:
-                    rr = np.inf
-                sr[t, g] = rr
-                for r in range(3):
-                    x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[t, b, r]
-                    sc[t, g, r] = x
-                    if not x - rr >= lo[g, r]:
-                        lo[g, r] = x - rr
-                    if not x + rr <= hi[g, r]:
-                        hi[g, r] = x + rr
-            for r in range(3):    # NaN anywhere: an unbounded box (never culls)
-                if not (lo[g, r] == lo[g, r] and hi[g, r] == hi[g, r]):
-                    lo[g, r] = -np.inf
-                    hi[g, r] = np.inf
-        info[WI_PAD] = pad
-        # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
-        best = np.inf
-        for k in range(pairs.shape[0]):
-            ga, gb = pairs[k, 0], pairs[k, 1]
-            if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
-                code[k] = WK_SS
-                gap[k] = np.inf
-                continue
-            ka, kb = gp.kind[ga], gp.kind[gb]
-            gap[k] = np.nan
-            if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
-                code[k] = WK_PYTHON
-                surv[S] = k
-                S += 1
-                continue
-            if ka == -1 or kb == -1:
-                h, c = (ga, gb) if ka == -1 else (gb, ga)
-                g = _halfspace_gap(gp.normals[gp.nstart[h]], gp.verts[gp.vstart[h]], gp.body[h], c, sc, sr,
-                                   trans, ang, rot, pos, pad)
-            else:
-                sep = -np.inf
-                scale = 1.0
-                for r in range(3):
-                    s1 = lo[gb, r] - hi[ga, r]
-                    s2 = lo[ga, r] - hi[gb, r]
-                    if s1 > sep:
-                        sep = s1
-                    if s2 > sep:
-                        sep = s2
-                    scale = max(scale, abs(lo[ga, r]), abs(hi[ga, r]), abs(lo[gb, r]), abs(hi[gb, r]))
-                # rounding of c +- r and of the separation: 1e-12 relative covers it many times over
-                sep = sep - pad - 1e-12 * scale
-                if sep > margin and sep >= best:
-                    code[k] = WK_CULLED
-                    continue
-                g = sphere_gap(sc, sr, ga, gb, pad)
-            if g > margin:
-                code[k] = WK_CULLED
-                gap[k] = g
-                if g < best:
-                    best = g
-            else:
+            for k in range(pairs.shape[0]):
                 code[k] = WK_OPEN
+                gap[k] = np.nan
                 surv[S] = k
                 S += 1
-        info[WI_BEST] = best
-        info[WI_SURV] = S
-        k0 = 0
-        k1 = min(k1, S)
+            info[WI_PAD] = np.nan
+            info[WI_BEST] = np.inf
+            info[WI_SURV] = S
+            k0 = 0
+            k1 = min(k1, S)
+        else:
+            for t in range(T):
+                if t == tq:
+                    continue      # computed above
+                ta = t * step + t0
+                tb = t1 if t == T - 1 else (t + 1) * step + t0
+                _bounds_core(mp, ta, tb, need_all, pos[t], rot[t], trans[t], ang[t], ws)
+            mag = 0.0
+            for t in range(T):
+                for b in range(nbody):
+                    for r in range(3):
+                        mag = max(mag, abs(pos[t, b, r]))
+            mag += 1.0
+            pad = rel_pad * mag + abs_pad + prm[WP_SCALE_PAD] * mag
+            lo = np.empty((G, 3))
+            hi = np.empty((G, 3))
+            for g in range(G):
+                b = gp.body[g]
+                rad = gp.brad[g]
+                if gp.kind[g] < 0 or not rad < np.inf:
+                    for t in range(T):
+                        sr[t, g] = np.inf
+                        for r in range(3):
+                            sc[t, g, r] = 0.0
+                    for r in range(3):
+                        lo[g, r] = -np.inf
+                        hi[g, r] = np.inf
+                    continue
+                cg = gp.bcenter[g]
+                ref = mp.ref_points[b]
+                lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+                for r in range(3):
+                    lo[g, r] = np.inf
+                    hi[g, r] = -np.inf
+                for t in range(T):
+                    R = rot[t, b]
+                    rr = rad + (trans[t, b] + 2.0 * math.sin(0.5 * min(ang[t, b], math.pi)) * lever) * grow_f
+                    if not rr >= 0.0:
+                        rr = np.inf
+                    sr[t, g] = rr
+                    for r in range(3):
+                        x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[t, b, r]
+                        sc[t, g, r] = x
+                        if not x - rr >= lo[g, r]:
+                            lo[g, r] = x - rr
+                        if not x + rr <= hi[g, r]:
+                            hi[g, r] = x + rr
+                for r in range(3):    # NaN anywhere: an unbounded box (never culls)
+                    if not (lo[g, r] == lo[g, r] and hi[g, r] == hi[g, r]):
+                        lo[g, r] = -np.inf
+                        hi[g, r] = np.inf
+            info[WI_PAD] = pad
+            # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
+            best = np.inf
+            for k in range(pairs.shape[0]):
+                ga, gb = pairs[k, 0], pairs[k, 1]
+                if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
+                    code[k] = WK_SS
+                    gap[k] = np.inf
+                    continue
+                ka, kb = gp.kind[ga], gp.kind[gb]
+                gap[k] = np.nan
+                if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
+                    code[k] = WK_PYTHON
+                    surv[S] = k
+                    S += 1
+                    continue
+                if ka == -1 or kb == -1:
+                    h, c = (ga, gb) if ka == -1 else (gb, ga)
+                    g = _halfspace_gap(gp.normals[gp.nstart[h]], gp.verts[gp.vstart[h]], gp.body[h], c, sc,
+                                       sr, trans, ang, rot, pos, pad)
+                else:
+                    sep = -np.inf
+                    scale = 1.0
+                    for r in range(3):
+                        s1 = lo[gb, r] - hi[ga, r]
+                        s2 = lo[ga, r] - hi[gb, r]
+                        if s1 > sep:
+                            sep = s1
+                        if s2 > sep:
+                            sep = s2
+                        scale = max(scale, abs(lo[ga, r]), abs(hi[ga, r]), abs(lo[gb, r]), abs(hi[gb, r]))
+                    # rounding of c +- r and of the separation: 1e-12 relative covers it many times over
+                    sep = sep - pad - 1e-12 * scale
+                    if sep > margin and sep >= best:
+                        code[k] = WK_CULLED
+                        continue
+                    g = sphere_gap(sc, sr, ga, gb, pad)
+                if g > margin:
+                    code[k] = WK_CULLED
+                    gap[k] = g
+                    if g < best:
+                        best = g
+                else:
+                    code[k] = WK_OPEN
+                    surv[S] = k
+                    S += 1
+            info[WI_BEST] = best
+            info[WI_SURV] = S
+            k0 = 0
+            k1 = min(k1, S)
     # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
-    # a long window: at least as many waypoints inside [t0, t1] as sub-ranges (a window and its
-    # braking tail); single-segment motions keep the whole-window search
-    n_in = 0
-    for i in range(mp.times.shape[0]):
-        if t0 < mp.times[i] < t1:
-            n_in += 1
-    long_window = n_in >= sc.shape[0]
     stack = np.empty((max_depth + 2, 3))
     out = np.empty(OUT_SIZE)
     w = np.empty(3)
