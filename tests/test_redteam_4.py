@@ -1,0 +1,117 @@
+"""Red team 4: ``certified`` for a motion that collides, or a gate that runs another motion (rt4).
+
+Every test here failed on the base commit 1c16a97 (see docs/notes/redteam-4.md) unless its
+docstring says it is a guard. Oracles are independent of the checkers: a sphere on a slide
+joint along x and a box wall that MuJoCo does not collide (contype 0, an explicitly monitored
+pair); the distance of the ball to the wall is the closed form ``|x_wall - x| - half - r``,
+evaluated on the live data after the step (the motion that actually ran; the ball moves
+monotonically within one window, so sampling the segment between its end states suffices).
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.envs.mujoco.mujoco_env import MujocoEnv
+
+from monitor.errors import InvalidInputError
+from monitor.gym_gate import SafetyGate
+
+BALL_R, WALL_HALF = 0.01, 0.005
+
+_SLIDE_XML = f"""<mujoco><option timestep="0.002" gravity="0 0 0"/><worldbody>
+<geom name="wall" type="box" pos="{{wall_x}} 0 0" size="{WALL_HALF} 0.2 0.2" contype="0" conaffinity="0"/>
+<body name="ball"><joint name="x" type="slide" axis="1 0 0"/>
+  <geom name="ball" type="sphere" size="{BALL_R}" mass="0.01" contype="0" conaffinity="0"/></body>
+</worldbody><actuator><velocity name="vx" joint="x" kv="10" ctrlrange="-6 6"/></actuator></mujoco>"""
+
+
+def _gap(x0: float, x1: float, wall_x: float) -> float:
+    """Closed-form least distance (m) of the ball to the wall while x goes monotonically x0 -> x1."""
+    lo, hi = min(x0, x1), max(x0, x1)
+    nearest = min(max(wall_x, lo), hi)
+    return abs(wall_x - nearest) - WALL_HALF - BALL_R
+
+
+class _EditingEnv(MujocoEnv):
+    """A user's env whose ``step`` edits the model (``edit``) and then simulates."""
+
+    metadata = {"render_modes": ["human", "rgb_array", "depth_array", "rgbd_tuple"], "render_fps": 100}
+
+    def __init__(self, path: str, edit: str, v0: float = 0.0) -> None:
+        self.edit, self.v0 = edit, v0
+        MujocoEnv.__init__(self, path, 5,
+                           observation_space=gym.spaces.Box(-np.inf, np.inf, shape=(2,), dtype=np.float64))
+
+    def step(self, action):
+        if self.edit == "geom_pos":   # a static obstacle moved onto the ball's path (moving obstacles)
+            self.model.geom_pos[0, 0] = float(self.data.qpos[0]) + 0.01
+        elif self.edit == "timestep":  # the env changes its integration step
+            self.model.opt.timestep = 0.02
+        self.do_simulation(action, self.frame_skip)
+        return np.array([self.data.qpos[0], self.data.qvel[0]]), 0.0, False, False, {}
+
+    def reset_model(self):
+        self.set_state(np.zeros(1), np.array([self.v0]))
+        return np.zeros(2)
+
+
+def _env_path(tmp_path, wall_x: float) -> str:
+    path = tmp_path / "slide_wall.xml"
+    path.write_text(_SLIDE_XML.format(wall_x=wall_x))
+    return str(path)
+
+
+@pytest.mark.parametrize("commit", [True, False])
+def test_env_step_moving_a_static_obstacle_is_not_certified(tmp_path, commit):
+    """Base: the env's ``step`` moved the wall (``model.geom_pos``) onto the ball's path after the
+    gate decided; the window ran through it (closed-form gap -0.0148 m) and was reported
+    ``applied_verdict == "certified"`` (with the commit hook the scratch window was copied in;
+    without it the qpos rows matched, since the wall does not act on the ball). Now refused:
+    before the motion runs with the hook, right after it without."""
+    env = SafetyGate(_EditingEnv(_env_path(tmp_path, 1.0), "geom_pos"), pairs=[("ball", "wall")])
+    env.commit = commit
+    env.reset(seed=0)
+    d, m = env.unwrapped.data, env.unwrapped.model
+    t0 = float(d.time)
+    with pytest.raises(InvalidInputError, match="geom_pos"):
+        for _ in range(2):
+            x0 = float(d.qpos[0])
+            info = env.step(np.array([2.0]))[4]
+            gap = _gap(x0, float(d.qpos[0]), float(m.geom_pos[0, 0]))
+            assert not (gap < 0.0 and info["safety"]["applied_verdict"] == "certified"), gap
+    if commit:
+        assert float(d.time) == t0  # refused before simulating anything
+    env.close()
+
+
+def test_env_step_changing_the_timestep_is_detected_without_commit(tmp_path):
+    """Base: with ``commit=False`` (the setting the docs recommend for envs that edit dynamics in
+    ``step``) an env that sets ``opt.timestep`` 10x larger inside ``step`` ran 0.1 s instead of the
+    certified 0.01 s: the ball went from x = 0 to 0.5 m, through the wall at 0.1 m (closed-form gap
+    < 0), ``applied_verdict == "certified"`` (``data.time`` was not a row of the certified window and
+    the check returned). Now InvalidInputError after the step, never silent."""
+    env = SafetyGate(_EditingEnv(_env_path(tmp_path, 0.1), "timestep", v0=5.0), pairs=[("ball", "wall")])
+    env.commit = False
+    env.reset(seed=0)
+    d = env.unwrapped.data
+    x0 = float(d.qpos[0])
+    with pytest.raises(InvalidInputError, match="substep time"):
+        info = env.step(np.array([5.0]))[4]
+        assert not (_gap(x0, float(d.qpos[0]), 0.1) < 0 and info["safety"]["applied_verdict"] == "certified")
+    assert _gap(x0, float(d.qpos[0]), 0.1) < 0.0  # the oracle: the motion that ran went through the wall
+    env.close()
+
+
+def test_timestep_edit_with_commit_runs_the_certified_window(tmp_path):
+    """Guard (passes on base): with the commit hook the certified window is copied in, so a
+    timestep edit inside ``step`` does not change the motion of that step (the ball stays clear)."""
+    env = SafetyGate(_EditingEnv(_env_path(tmp_path, 0.1), "timestep", v0=5.0), pairs=[("ball", "wall")])
+    env.reset(seed=0)
+    d = env.unwrapped.data
+    x0 = float(d.qpos[0])
+    info = env.step(np.array([5.0]))[4]
+    assert info["safety"]["applied_verdict"] == "certified"
+    assert _gap(x0, float(d.qpos[0]), 0.1) > 0.0
+    env.close()
