@@ -115,3 +115,61 @@ def test_timestep_edit_with_commit_runs_the_certified_window(tmp_path):
     assert info["safety"]["applied_verdict"] == "certified"
     assert _gap(x0, float(d.qpos[0]), 0.1) > 0.0
     env.close()
+
+
+# --------------------------------------------------------------------------- geom frames (geom_sameframe)
+_SAMEFRAME_XML = """<mujoco><worldbody>
+<geom name="wall" type="sphere" size="0.05"/>
+<geom name="obs" type="sphere" size="0.05" pos="0.3 0.25 0"/>
+<body name="b" pos="0 -0.5 0"><freejoint/>
+  <geom name="ball" type="capsule" size="0.05 0.02" pos="0.3 0 0" euler="0 90 0"/></body>
+</worldbody></mujoco>"""
+
+
+def _mujoco_gap(m, qpos, cap: int, sph: int) -> float:
+    """Closed-form distance (m) of a capsule and a sphere geom where MuJoCo's own kinematics put them."""
+    import mujoco
+
+    d = mujoco.MjData(m)
+    d.qpos[:] = qpos
+    mujoco.mj_kinematics(m, d)
+    c, axis, half = d.geom_xpos[cap], d.geom_xmat[cap].reshape(3, 3)[:, 2], m.geom_size[cap, 1]
+    s = d.geom_xpos[sph]
+    u = float(np.clip(np.dot(s - c, axis), -half, half))   # nearest point of the capsule's segment
+    return float(np.linalg.norm(s - (c + u * axis)) - m.geom_size[cap, 0] - m.geom_size[sph, 0])
+
+
+@pytest.mark.parametrize("edit", ["body_ipos", "geom_pos"])
+def test_geom_frame_follows_mujoco_geom_sameframe(edit):
+    """Base: the Scene placed every geom at ``geom_pos``/``geom_quat`` in its body frame, but MuJoCo
+    places a geom whose frame the compiler found equal to its body's inertial frame (``geom_sameframe``
+    INERTIA: any single-geom body with inertia from the geom) at ``body_ipos``/``body_iquat``, and one at
+    its body's frame (BODY) at the body frame, ignoring ``geom_pos``. Centre-of-mass randomisation
+    (``body_ipos``) moved the ball onto the obstacle in MuJoCo (closed-form distance -0.05 m on MuJoCo's
+    own geom_xpos) and ``certify`` said certified (it saw the ball 0.2 m away); a ``geom_pos`` edit of a
+    world geom at the origin moved nothing in MuJoCo, yet the Scene moved the wall out of the ball's path."""
+    import mujoco
+
+    from monitor import Plan, Scene, certify
+
+    m = mujoco.MjModel.from_xml_string(_SAMEFRAME_XML)
+    ball, wall, obs = m.geom("ball").id, m.geom("wall").id, m.geom("obs").id
+    q0 = np.array(m.qpos0)
+    q1 = q0.copy()
+    if edit == "body_ipos":
+        assert int(m.geom_sameframe[ball]) == int(mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA)  # set-up
+        m.body_ipos[m.body("b").id] = (0.3, 0.2, 0.0)      # the COM 0.2 m along y (randomised)
+        q0[:3], q1[:3] = (0.0, 0.0, 0.0), (0.002, 0.0, 0.0)
+        other, pairs = obs, [("ball", "obs")]
+    else:
+        assert int(m.geom_sameframe[wall]) == int(mujoco.mjtSameFrame.mjSAMEFRAME_BODY)  # set-up
+        m.geom_pos[wall] = (2.0, 0.0, 0.0)                   # MuJoCo keeps the wall at the origin
+        q0[:3], q1[:3] = (-0.3, 0.0, 0.0), (-0.3, 0.0, 0.0)
+        q1[0] += 0.002
+        other, pairs = wall, [("ball", "wall")]
+    # the oracle: MuJoCo's own geom positions; the ball translates 2 mm, so the distance along the
+    # segment is within 1 mm of its value at either end (Lipschitz margin)
+    gap = min(_mujoco_gap(m, q, ball, other) for q in (q0, q1))
+    assert gap + 0.001 < 0.0
+    cert = certify(Scene.from_model(m, pairs=pairs), Plan([0.0, 0.1], [q0, q1], m), margin=0.0)
+    assert cert.verdict != "certified", (edit, gap, cert.clearance)
