@@ -173,3 +173,38 @@ def test_geom_frame_follows_mujoco_geom_sameframe(edit):
     assert gap + 0.001 < 0.0
     cert = certify(Scene.from_model(m, pairs=pairs), Plan([0.0, 0.1], [q0, q1], m), margin=0.0)
     assert cert.verdict != "certified", (edit, gap, cert.clearance)
+
+
+def test_geom_frame_within_the_compilers_tolerance():
+    """Base, on an UNEDITED model: MuJoCo's compiler treats a geom frame within ~1e-6 m / ~2e-6 rad of
+    the body's inertial frame as the same (``geom_sameframe`` INERTIA) and places the geom there. A
+    box whose explicit ``<inertial pos>`` is 9e-7 m off its ``pos`` sits 9e-7 m from where the Scene
+    put it: a sphere overlapping MuJoCo's box by 1e-7 m (closed form on MuJoCo's geom_xpos/geom_xmat)
+    was certified at margin 0 with clearance ~6.8e-7 m."""
+    import mujoco
+
+    from monitor import Plan, Scene, certify
+
+    r, half, off = 0.05, np.array([0.1, 0.05, 0.05]), 9e-7
+    u = np.array([np.cos(np.pi / 6), np.sin(np.pi / 6), 0.0])          # the box's local +x in the world
+    s = np.array([0.3 + off, 0.0, 0.0]) + u * (half[0] + r - 1e-7)    # 1e-7 m into MuJoCo's box
+    xml = (f'<mujoco><worldbody><geom name="obs" type="sphere" size="{r}" '
+           f'pos="{float(s[0])!r} {float(s[1])!r} 0"/><body name="b"><freejoint/>'
+           f'<inertial pos="{0.3 + off!r} 0 0" euler="0 0 30" mass="1" diaginertia=".1 .2 .3"/>'
+           '<geom name="box" type="box" size=".1 .05 .05" pos=".3 0 0" euler="0 0 30"/>'
+           '</body></worldbody></mujoco>')
+    m = mujoco.MjModel.from_xml_string(xml)
+    box, obs = m.geom("box").id, m.geom("obs").id
+    assert int(m.geom_sameframe[box]) == int(mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA)  # set-up
+    q0 = np.array(m.qpos0)
+    q1 = q0.copy()
+    q1[2] += 1e-3    # along the box face: the distance is constant over the motion
+    for q in (q0, q1):   # the oracle: MuJoCo's own box pose, closed-form sphere-box distance
+        d = mujoco.MjData(m)
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        local = d.geom_xmat[box].reshape(3, 3).T @ (d.geom_xpos[obs] - d.geom_xpos[box])
+        dist = np.linalg.norm(local - np.clip(local, -half, half)) - r
+        assert dist < -5e-8
+    cert = certify(Scene.from_model(m, pairs=[("box", "obs")]), Plan([0.0, 0.1], [q0, q1], m), margin=0.0)
+    assert cert.verdict != "certified", cert.clearance
