@@ -208,3 +208,89 @@ def test_geom_frame_within_the_compilers_tolerance():
         assert dist < -5e-8
     cert = certify(Scene.from_model(m, pairs=[("box", "obs")]), Plan([0.0, 0.1], [q0, q1], m), margin=0.0)
     assert cert.verdict != "certified", cert.clearance
+
+
+# --------------------------------------------------------------------------- extrusion: a span one ulp long
+@pytest.mark.parametrize("swept_first", [True, False])
+@pytest.mark.parametrize("s0", [1.0, 1.7e9])
+def test_extrusion_span_one_ulp_long_uses_its_own_segment(monkeypatch, swept_first, s0):
+    """Base: on a span one ulp long the extrusion checkers (the compiled first pass and the Python
+    checker) picked the segment by the span's midpoint, which rounds to ``s0`` (ties to even) and so
+    took the PREVIOUS segment's velocity. A piecewise-linear plan whose waypoints ``s0`` and
+    ``nextafter(s0)`` are 0.5 m apart (e.g. two trajectories concatenated at a rounded time) moves a
+    sphere straight through another (closed-form least distance -0.02 m on that segment) and was
+    certified with clearance 0.23 m. Now the span's own segment (``searchsorted(s0, side="right")``)."""
+    import mujoco
+
+    from monitor import Scene, certify
+    from monitor.certify import engine
+    from monitor.motion.bodymotion import BodyMotion
+
+    monkeypatch.setattr(engine, "_SWEPT_FIRST", swept_first)
+    r = 0.01
+    m = mujoco.MjModel.from_xml_string(
+        f'<mujoco><worldbody><geom name="B" type="sphere" size="{r}"/><body name="a" mocap="true">'
+        f'<geom name="A" type="sphere" size="{r}"/></body></worldbody></mujoco>')
+    s1 = float(np.nextafter(s0, 2.0 * s0))
+    assert 0.5 * (s0 + s1) == s0  # set-up: the midpoint rounds to the span's start
+    jump = np.array([0.0, -0.5, 0.0])
+    p0 = -0.5 * jump                                  # the segment [p0, p0 + jump] passes B's centre
+    times = np.array([s0 - 1.0, s0, s1, s0 + 1.0])
+    pos = np.zeros((4, 2, 3))
+    pos[:, 1] = [p0 - (0.0, 0.0, 1.0), p0, p0 + jump, p0 + jump + (0.0, 0.0, 1.0)]
+    quat = np.zeros((4, 2, 4))
+    quat[..., 0] = 1.0
+    # the oracle: closed-form distance of B's centre (the origin) to the segment, minus the radii
+    u = np.clip(-p0 @ jump / (jump @ jump), 0.0, 1.0)
+    assert np.linalg.norm(p0 + u * jump) - 2 * r < -0.01
+    cert = certify(Scene.from_model(m, pairs=[("A", "B")]), BodyMotion(times, pos, quat), margin=0.0,
+                   method="extrusion")
+    assert cert.verdict != "certified", cert.clearance
+
+
+# ---------------------------------------------------------- motion bounds: a sub-interval one ulp long
+def _qz(angle: float) -> list[float]:
+    return [float(np.cos(angle / 2)), 0.0, 0.0, float(np.sin(angle / 2))]
+
+
+@pytest.mark.parametrize("motion", ["lerp_slerp", "screw", "free_joint_plan"])
+def test_rotation_bound_of_a_sub_interval_one_ulp_long(motion):
+    """Base: the rotation bound of a sub-interval ``[s0, s1]`` one ulp long took the segment of its
+    midpoint, which rounds to ``s1`` (here ``s0 = nextafter(1.7e9)``, odd mantissa), i.e. the segment
+    AFTER the interval, so a body turning 90 degrees between the waypoints ``s0`` and ``s1`` got the
+    bound 0 (compiled ``_rot_dev`` and ``screw_poses_bounds``, Python ``IntervalVertices``). A 1 m rod
+    sweeping through a sphere was certified (auto and toleranced). Closed-form oracle: at 45 degrees
+    (on the slerp and on the screw motion about the fixed origin) the sphere's centre is on the rod."""
+    import mujoco
+
+    from monitor import Plan, Scene, certify
+    from monitor.motion.bodymotion import BodyMotion
+
+    s0 = float(np.nextafter(1.7e9, 2e9))
+    s1 = float(np.nextafter(s0, 2e9))
+    assert 0.5 * (s0 + s1) == s1  # set-up: the midpoint rounds to the interval's end
+    joint = "<freejoint/>" if motion == "free_joint_plan" else ""
+    body = f'<body name="a"{"" if joint else " mocap=" + chr(34) + "true" + chr(34)}>{joint}'
+    m = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><geom name="B" type="sphere" size="0.01" pos="0.35 0.35 0"/>'
+        f'{body}<geom name="A" type="box" size="0.5 0.01 0.01" pos="0.5 0 0"/></body></worldbody></mujoco>')
+    times = np.array([s0 - 1.0, s0, s1, s0 + 1.0])
+    angles = [0.0, 0.0, np.pi / 2, np.pi / 2]
+    if motion == "free_joint_plan":
+        plan = Plan(times, [[0.0, 0.0, 0.0, *_qz(a)] for a in angles], m)
+    else:
+        quat = np.zeros((4, 2, 4))
+        quat[..., 0] = 1.0
+        quat[:, 1] = [_qz(a) for a in angles]
+        plan = BodyMotion(times, np.zeros((4, 2, 3)), quat, interpolation=motion)
+    # the oracle: the rod at 45 degrees (box frame: centre 0.5 m along its axis), closed-form sphere-box
+    c = 0.5 * np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0])
+    R = np.array([[np.cos(np.pi / 4), -np.sin(np.pi / 4), 0.0], [np.sin(np.pi / 4), np.cos(np.pi / 4), 0.0],
+                  [0.0, 0.0, 1.0]])
+    local = R.T @ (np.array([0.35, 0.35, 0.0]) - c)
+    half = np.array([0.5, 0.01, 0.01])
+    assert np.linalg.norm(local - np.clip(local, -half, half)) - 0.01 <= 0.0 and np.all(np.abs(local) < half)
+    scene = Scene.from_model(m, pairs=[("A", "B")])
+    for method in ("auto", "toleranced"):
+        cert = certify(scene, plan, margin=0.0, method=method)
+        assert cert.verdict != "certified", (motion, method, cert.clearance)
