@@ -339,6 +339,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         ``n_frames``): gymnasium's own simulation.
         """
         u = self._unwrapped
+        self._check_geometry("nothing was simulated")  # refused BEFORE the motion runs
         if u.model is self.gate.model and self.gate._rollout.commit(u.data, ctrl, int(n_frames)):
             mujoco.mj_rnePostConstraint(u.model, u.data)
             self.gate.stats["committed"] += 1
@@ -371,6 +372,21 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         if self._unwrapped.model is not self.gate.model:
             return "env.unwrapped.model is not the model the gate certified against"
         return "the simulator state (time, qpos, qvel, act, ...) was changed after the gate decided"
+
+    def _check_geometry(self, outcome: str) -> None:
+        """Raise if a watched model array (``scene.SYNC_FIELDS``) was edited since the gate decided.
+
+        :meth:`Gate.decide` re-read the model into the scene (``Scene.sync``); an edit between
+        then and the simulation (e.g. an obstacle's ``geom_pos``/``body_pos`` moved inside the
+        env's ``step``) runs the motion against geometry the gate never certified.
+        """
+        snap = getattr(self.gate._scene, "_snapshot", None)
+        if snap is None or snap.unchanged():
+            return
+        raise InvalidInputError(
+            f"env: {type(self._unwrapped).__name__}.step edited the model's geometry or kinematics "
+            f"({', '.join(snap.changed())}) after the gate certified the window on the model as it was: "
+            f"{outcome} (edit the model before calling step: the gate re-reads it every step)")
 
     def _check_applied_ctrl(self, applied: Any) -> None:
         """Raise if the control the env wrote is not the one the gate certified (rollout predictor)."""
@@ -459,7 +475,13 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             return  # the scratch does not hold the applied window (not the gate's own rollout)
         hits = np.flatnonzero(rows[1:, 0] == d.time)
         if len(hits) != 1:
-            return  # no substep ran (time checked by _check_elapsed; fewer substeps: a prefix)
+            if d.time == rows[0, 0]:
+                return  # no substep ran (fewer substeps under the same timestep: a row, a prefix)
+            raise InvalidInputError(
+                f"env: after the step data.time = {d.time!r} s is not a substep time of the certified window "
+                f"(from {float(rows[0, 0])!r} s, {nstep} substep(s) to {float(rows[-1, 0])!r} s): "
+                f"{type(self._unwrapped).__name__}.step simulated another motion (opt.timestep or the time "
+                "edited inside step?); the motion that ran was not certified")
         row = rows[1 + int(hits[0]), 1:]
         if row.tobytes() != d.qpos.tobytes():
             raise InvalidInputError(
@@ -519,6 +541,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         finally:
             if hook:
                 del u._step_mujoco_simulation
+        if not (hook and self._expected is None):  # the hook did not run (it checks before simulating)
+            self._check_geometry("the motion that ran was not certified")
         self._check_applied_ctrl(report.applied_ctrl)
         self._check_elapsed(t_start, nstep)
         self._check_window_ran(report.applied_ctrl, nstep, mocap_start,

@@ -2,7 +2,8 @@
 
 This is the only module that reads geoms from MuJoCo. Shapes are built with
 :mod:`monitor.geometry.polytope` (pure numpy/scipy) in the geom frame and moved
-into the frame of the body that carries the geom (``geom_pos``/``geom_quat``).
+into the frame of the body that carries the geom (``geom_pos``/``geom_quat``, or the body's
+(inertial) frame where MuJoCo's ``geom_sameframe`` says so: :func:`geom_frame`).
 
 Geom type -> shape (body frame):
 
@@ -116,6 +117,8 @@ SYNC_FIELDS: tuple[str, ...] = (
     # kinematics: the world-children anchor test of pairs="all" and the motion bounds of a Plan
     "jnt_type", "jnt_qposadr", "jnt_bodyid", "jnt_pos", "jnt_axis", "qpos0", "body_pos", "body_quat",
     "body_jntadr", "body_jntnum", "body_ipos", "geom_rbound",
+    # where MuJoCo puts a geom whose frame is its body's inertial frame (geom_frame)
+    "body_iquat", "geom_sameframe",
 )
 """``MjModel`` arrays that :meth:`Scene.sync` watches for in-place edits."""
 _RUN_GAP = 1024
@@ -257,6 +260,32 @@ def _quat_to_mat(q: np.ndarray) -> np.ndarray:
     return R.reshape(3, 3)
 
 
+_SAME = mujoco.mjtSameFrame
+
+
+def geom_frame(model: Any, g: int) -> tuple[np.ndarray, np.ndarray]:
+    """(R_BG (3, 3), p_BG (3,)): the frame of geom ``g`` in its body's frame, as MuJoCo places it.
+
+    MuJoCo's compiler marks a geom whose frame is (within its tolerance) its body's frame or its
+    body's inertial frame (``geom_sameframe``); ``mj_kinematics`` then takes that frame and ignores
+    ``geom_pos`` / ``geom_quat``: BODY (frame = body), INERTIA (= ``body_ipos``/``body_iquat``),
+    BODYROT (rotation = body's, position ``geom_pos``), INERTIAROT (rotation ``body_iquat``).
+    So an in-place edit of ``geom_pos`` of such a geom moves nothing in the simulation, and an edit
+    of ``body_ipos`` / ``body_iquat`` (centre-of-mass randomisation) moves the geom.
+    """
+    sf = int(model.geom_sameframe[g])
+    b = int(model.geom_bodyid[g])
+    if sf == _SAME.mjSAMEFRAME_BODY:
+        return np.eye(3), np.zeros(3)
+    if sf == _SAME.mjSAMEFRAME_INERTIA:
+        return _quat_to_mat(model.body_iquat[b]), np.array(model.body_ipos[b], dtype=np.float64)
+    if sf == _SAME.mjSAMEFRAME_BODYROT:
+        R = np.eye(3)
+    else:
+        R = _quat_to_mat(model.body_iquat[b] if sf == _SAME.mjSAMEFRAME_INERTIAROT else model.geom_quat[g])
+    return R, np.array(model.geom_pos[g], dtype=np.float64)
+
+
 def _to_body(shape_G: ConvexShape, R_BG: np.ndarray, p_BG: np.ndarray) -> ConvexShape:
     """Move a geom-frame shape into the body frame (x_B = R_BG x_G + p_BG).
 
@@ -392,6 +421,8 @@ class Scene:
     """
 
     allowed_pairs: tuple[tuple[str, str, str], ...] = ()
+    geom_frames: tuple[tuple[np.ndarray, np.ndarray], ...] | None = None
+    """Per geom (R_BG, p_BG), its frame in the body frame (:func:`geom_frame`); set by :meth:`from_model`."""
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
@@ -459,6 +490,7 @@ class Scene:
             raise ModelMismatchError(f"the scene's MjModel was edited in place ({what}) and the scene "
                                      f"cannot be rebuilt: {exc}") from exc
         self.geoms = fresh.geoms
+        self.geom_frames = fresh.geom_frames
         self.pair_ids = fresh.pair_ids
         self.body_names = fresh.body_names
         self.body_static = fresh.body_static
@@ -562,6 +594,7 @@ class Scene:
                     "an explicit pair list without it")
 
         geoms = []
+        frames: list[tuple[np.ndarray, np.ndarray]] = []
         cache: dict[tuple, ConvexShape | None] = {}  # identical primitives / meshes share a geom-frame shape
         for g in range(ngeom):
             b = int(model.geom_bodyid[g])
@@ -570,9 +603,9 @@ class Scene:
                 cache[key] = _geom_shape(model, g, nf, tolerances)
             shape_G = cache[key]
             shape_B = None
+            frames.append(geom_frame(model, g))   # where MuJoCo's kinematics put the geom (geom_sameframe)
             if shape_G is not None:
-                shape_B = _to_body(shape_G, _quat_to_mat(model.geom_quat[g]),
-                                   np.asarray(model.geom_pos[g], dtype=np.float64).copy())
+                shape_B = _to_body(shape_G, *frames[g])
             geoms.append(GeomInfo(
                 name=names[g], id=g, body=body_names[b], body_id=b,
                 type=_GEOM_TYPES.get(int(types[g]), str(int(types[g]))), shape=shape_B,
@@ -581,6 +614,7 @@ class Scene:
         if isinstance(pairs, str) and pairs == "all":
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
         scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene.geom_frames = tuple(frames)
         scene._pairs_spec = pairs
         # rebuilds after model edits reuse the matrix resolved now ("auto" is not recomputed on an
         # edited model: an edit must never turn a hazard into an allowed pair)

@@ -42,24 +42,36 @@ class RandomisedTunnel(TunnelEnv):
         self._wall, self._ball = m.geom("wall").id, m.geom("ball").id
         self._size0 = np.array(m.geom_size, copy=True)
         self._pos0 = np.array(m.geom_pos, copy=True)
+        self._bpos0 = np.array(m.body_pos, copy=True)
         self._dr = np.random.default_rng(seed)
 
     def reset_model(self) -> np.ndarray:
         m, rng = self.model, self._dr
         m.geom_size[self._wall] = self._size0[self._wall] * rng.uniform(0.5, 4.0, 3)
         m.geom_size[self._ball][0] = self._size0[self._ball][0] * rng.uniform(0.5, 4.0)
+        # the wall geom sits at its body's frame (geom_sameframe BODY): MuJoCo ignores this geom_pos
+        # edit; the body_pos edit moves it
         m.geom_pos[self._wall] = self._pos0[self._wall] + [rng.uniform(-0.03, 0.03), 0.0, 0.0]
+        wall_body = m.geom_bodyid[self._wall]
+        m.body_pos[wall_body] = self._bpos0[wall_body] + [rng.uniform(-0.03, 0.03), 0.0, 0.0]
         return super().reset_model()
 
 
 def _ball_wall_distance(m, x: np.ndarray) -> np.ndarray:
-    """Signed distance (m) of the ball (slide value x, (n,)) to the wall box, from the live model."""
+    """Signed distance (m) of the ball (slide value x, (n,)) to the wall box, where MuJoCo puts them.
+
+    The geom centres come from MuJoCo's own kinematics of the live model (``mj_kinematics`` at
+    slide 0: a geom at its body's frame ignores ``geom_pos``, ``geom_sameframe``).
+    """
+    import mujoco
+
     wall, ball = m.geom("wall").id, m.geom("ball").id
     half = np.asarray(m.geom_size[wall], float)
-    c_wall = np.asarray(m.body_pos[m.geom_bodyid[wall]], float) + np.asarray(m.geom_pos[wall], float)
-    ball_body = m.geom_bodyid[ball]
-    c = (np.asarray(m.body_pos[ball_body], float) + np.asarray(m.geom_pos[ball], float))[None, :] \
-        + np.outer(x, [1.0, 0.0, 0.0])  # slide axis (1, 0, 0), wall and ball unrotated
+    d = mujoco.MjData(m)
+    d.qpos[:] = 0.0
+    mujoco.mj_kinematics(m, d)
+    c_wall = np.array(d.geom_xpos[wall])
+    c = np.array(d.geom_xpos[ball])[None, :] + np.outer(x, [1.0, 0.0, 0.0])  # slide axis (1, 0, 0), unrotated
     q = np.abs(c - c_wall) - half
     outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
     inside = np.minimum(q.max(axis=1), 0.0)

@@ -255,8 +255,12 @@ class _Body:
     origins: np.ndarray
 
     def state(self, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
-        """Origin (3,) at ``t0`` and velocity (3,) on the span [t0, t1] (inside one segment)."""
-        i = min(max(int(np.searchsorted(self.times, 0.5 * (t0 + t1))) - 1, 0), len(self.times) - 2)
+        """Origin (3,) at ``t0`` and velocity (3,) on the span [t0, t1] (inside one segment).
+
+        The segment is the one starting at or before ``t0`` (a span's midpoint rounds to an end
+        on a span one ulp long, and would pick a neighbouring segment's velocity).
+        """
+        i = min(max(int(np.searchsorted(self.times, t0, side="right")) - 1, 0), len(self.times) - 2)
         ta, tb = self.times[i], self.times[i + 1]
         v = (self.origins[i + 1] - self.origins[i]) / (tb - ta)
         return self.origins[i] + v * (t0 - ta), v

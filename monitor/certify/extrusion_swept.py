@@ -69,10 +69,13 @@ OUT_SIZE = 14
 
 @njit(cache=True)
 def _body_state(times, origins, s0, s1, o_out, v_out):
-    """Origin at ``s0`` and velocity on the span ``[s0, s1]`` (the checker's ``_Body.state``)."""
-    mid = 0.5 * (s0 + s1)
+    """Origin at ``s0`` and velocity on the span ``[s0, s1]`` (the checker's ``_Body.state``).
+
+    The span lies in the segment that starts at or before ``s0`` (``searchsorted(side="right")``):
+    its midpoint would round to ``s0`` or ``s1`` on a span one ulp long and pick a neighbour.
+    """
     n = times.shape[0]
-    i = np.searchsorted(times, mid) - 1
+    i = np.searchsorted(times, s0, side="right") - 1
     i = min(max(i, 0), n - 2)
     ta = times[i]
     tb = times[i + 1]

@@ -648,9 +648,12 @@ def screw_poses_bounds(times, pos, quat, target, half, phi, cum, same, moving, r
         im, sm, em = _locate(times, tm)
         lo = _search_right(times, t0)
         hi = _search_left(times, t1)
-        j = min(max(_search_right(times, tm) - 1, 0), K - 1)
-        near_left = max(times[j], t0)
-        near_right = max(min(times[min(j + 1, K - 1)], t1), tm)
+        # the segments left / right of m and their waypoints strictly before / after m (on a
+        # sub-interval one ulp long m rounds to t1; t1's own segment would leave [t0, m] out)
+        jl = min(max(_search_left(times, tm) - 1, 0), K - 2)
+        jr = min(max(_search_right(times, tm) - 1, 0), K - 2)
+        near_left = min(max(times[jl], t0), tm)
+        near_right = max(min(times[jr + 1], t1), tm)
         for b in range(nb):
             xm = out_pos[n, b]
             _screw_pose(b, im, sm, em, pos, quat, target, half, same, rotating, omega, v, xm, qm)
@@ -694,10 +697,10 @@ def screw_poses_bounds(times, pos, quat, target, half, phi, cum, same, moving, r
                 th = min(th * (1.0 + rel) + ab, math.pi)
             if rotating[b]:
                 # _screw_ref_deviation: helix pieces of the reference point's world image
-                hseg = times[im + 1] - times[im]
-                left = max(tm - near_left, 0.0) / hseg
-                right = max(near_right - tm, 0.0) / hseg
-                T = _helix_span(hx_d[im, b], hx_P[im, b], hx_th[im, b], max(left, right))
+                left = max(tm - near_left, 0.0) / (times[jl + 1] - times[jl])
+                right = max(near_right - tm, 0.0) / (times[jr + 1] - times[jr])
+                T = max(_helix_span(hx_d[jl, b], hx_P[jl, b], hx_th[jl, b], left),
+                        _helix_span(hx_d[jr, b], hx_P[jr, b], hx_th[jr, b], right))
                 if hi > lo:
                     _quat_mat(qm, Rm)
                     ym0 = xm[0] + Rm[0, 0] * ref[b, 0] + Rm[0, 1] * ref[b, 1] + Rm[0, 2] * ref[b, 2]

@@ -263,18 +263,12 @@ def pack_scene(scene) -> ScenePack:
     return ScenePack(pack_shapes(shapes, bodies, _curved_geoms(scene)), pid)
 
 
-def _quat_mat(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def _curved_geoms(scene) -> list:
     """Exact cylinder / ellipsoid data of the scene's circumscribed geoms (from the model arrays).
 
-    Reads ``geom_size`` / ``geom_pos`` / ``geom_quat`` (body frame) of the scene's MjModel
-    as plain arrays (no mujoco import); each entry is re-checked by :func:`_curved_ok`.
+    Reads ``geom_size`` of the scene's MjModel and the scene's ``geom_frames`` (body frame, as
+    MuJoCo places the geom) as plain arrays (no mujoco import); each entry is re-checked by
+    :func:`_curved_ok`.
     Geoms that are not the model's own (ids past ``ngeom``, or a scene view flagged
     ``derived_geoms``, e.g. the ongoing-contact rule's shrunk / inflated copies, whose
     shapes differ from the model's geom) get None: their packed polytope is used.
@@ -282,18 +276,20 @@ def _curved_geoms(scene) -> list:
     model = getattr(scene, "model", None)
     if model is None:
         return []
+    frames = getattr(scene, "geom_frames", None)   # (R_BG, p_BG) per geom, as MuJoCo places it
     out: list = []
     derived = bool(getattr(scene, "derived_geoms", False))
     ngeom = len(model.geom_size)
     for g in scene.geoms:
         code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
-        if code == CURVE_NONE or g.shape is None or derived or not 0 <= g.id < ngeom:
+        if (code == CURVE_NONE or g.shape is None or derived or not 0 <= g.id < ngeom or frames is None
+                or len(frames) != ngeom):
             out.append(None)
             continue
         size = np.asarray(model.geom_size[g.id], float)
         par = np.array([size[0], size[1], 0.0]) if code == CURVE_CYLINDER else size.copy()
-        c_B = np.asarray(model.geom_pos[g.id], float).copy()
-        out.append((code, par, _quat_mat(model.geom_quat[g.id]), c_B))
+        R_BG, c_B = frames[g.id]
+        out.append((code, par, np.array(R_BG, float), np.array(c_B, float)))
     return out
 
 

@@ -264,11 +264,14 @@ class IntervalVertices:
         prev_t = times[np.clip(self.idx - 1, 0, seg.K - 1)]
         next_t = times[np.clip(self.idx + 1, 0, seg.K - 1)]
         self.outer_t = np.where(left, np.maximum(prev_t, ta[:, None]), np.minimum(next_t, tb[:, None]))
-        # Nearest vertex on each side of the midpoint (same segment as m).
-        j = np.clip(np.searchsorted(times, self.tm, side="right") - 1, 0, seg.K - 1)
-        self.near_left = np.maximum(times[j], ta)
-        self.near_right = np.minimum(times[np.minimum(j + 1, seg.K - 1)], tb)
-        self.near_right = np.maximum(self.near_right, self.tm)
+        # Nearest vertex on each side of the midpoint: the waypoints strictly before / after m
+        # (on a sub-interval one ulp long m rounds to tb; tb's segment would leave [ta, m] out).
+        jl = np.clip(np.searchsorted(times, self.tm, side="left") - 1, 0, seg.K - 1)
+        jr = np.clip(np.searchsorted(times, self.tm, side="right"), 0, seg.K - 1)
+        self.near_left = np.minimum(np.maximum(times[jl], ta), self.tm)
+        self.near_right = np.maximum(np.minimum(times[jr], tb), self.tm)
+        self.seg_left = np.minimum(jl, seg.K - 2)                 # segment of [near_left, m]
+        self.seg_right = np.clip(jr - 1, 0, seg.K - 2)            # segment of [m, near_right]
         self.seg = seg
 
 

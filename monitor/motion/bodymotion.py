@@ -266,10 +266,10 @@ class BodyMotion(WindowTimes):
         h = np.diff(times)
         Km2 = times.shape[0] - 2
         d, P, th = self._hx_d[:, b], self._hx_P[:, b], self._hx_th[:, b]
-        i = iv.loc_m[0]
-        left = np.maximum(iv.tm - iv.near_left, 0.0) / h[i]
-        right = np.maximum(iv.near_right - iv.tm, 0.0) / h[i]
-        dev = S.helix_span(d[i], P[i], th[i], np.maximum(left, right))
+        il, ir = iv.seg_left, iv.seg_right   # the segments left / right of m (one unless m is a waypoint)
+        left = np.maximum(iv.tm - iv.near_left, 0.0) / h[il]
+        right = np.maximum(iv.near_right - iv.tm, 0.0) / h[ir]
+        dev = np.maximum(S.helix_span(d[il], P[il], th[il], left), S.helix_span(d[ir], P[ir], th[ir], right))
         if iv.C:
             ym = xm + np.einsum("nij,j->ni", K.quat_to_mat(qm), self._ref[b])
             d_w = np.linalg.norm(self._ref_W[iv.idx, b] - ym[:, None, :], axis=-1)

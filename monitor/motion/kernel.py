@@ -521,13 +521,10 @@ def _rot_dev(times: np.ndarray, qpos: np.ndarray, qt_adr: np.ndarray, qt_cum: np
     """Bound on the rotation angle of track k from the midpoint over [ta, tb] (rotation_deviation)."""
     K = times.shape[0]
     s_m = _track_path(qt_cum, qt_phi, k, lm[0], lm[1])
-    j = _search_right(times, tm) - 1
-    if j < 0:
-        j = 0
-    if j > K - 1:
-        j = K - 1
-    near_left = max(times[j], ta)
-    near_right = max(min(times[min(j + 1, K - 1)], tb), tm)
+    # the waypoints strictly before / after m (not the segment of m: on a sub-interval one ulp
+    # long m rounds to tb, and tb's own segment would leave [ta, m] out)
+    near_left = min(max(times[max(_search_left(times, tm) - 1, 0)], ta), tm)
+    near_right = max(min(times[min(_search_right(times, tm), K - 1)], tb), tm)
     i_l, s_l, _ = _locate(times, near_left)
     i_r, s_r, _ = _locate(times, near_right)
     dev = max(abs(s_m - _track_path(qt_cum, qt_phi, k, i_l, s_l)),
