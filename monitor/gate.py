@@ -1143,8 +1143,7 @@ class Gate:
         self.frame_skip = int(frame_skip)
         self.reuse = bool(reuse)
         self.brake = bool(brake)
-        horizon_s = _finite_setting(brake_horizon, "brake_horizon", positive=True, what=" of seconds")
-        self.brake_steps = max(1, int(math.ceil(horizon_s / model.opt.timestep)))
+        self.brake_horizon = brake_horizon  # validated (property)
         self.brake_vel_tol = _finite_setting(brake_vel_tol, "brake_vel_tol", positive=False, what="")
         self._committed: np.ndarray | None = None
         self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
@@ -1181,6 +1180,29 @@ class Gate:
                 f"monitor.Gate on {where}: no candidate pairs to check under pairs={pairs!r}, so every "
                 "window is certified without checking anything (info['safety']['monitored_pairs'] == 0). "
                 "Pass pairs='all' or a list of geom-name pairs to monitor.", UserWarning, stacklevel=2)
+
+    # ----------------------------------------------------------------- braking tail length
+    @property
+    def brake_horizon(self) -> float:
+        """Longest braking tail (s of simulation time); reassignable (validated, used from the next step)."""
+        return self._brake_horizon
+
+    @brake_horizon.setter
+    def brake_horizon(self, value: float) -> None:
+        self._brake_horizon = _finite_setting(value, "brake_horizon", positive=True, what=" of seconds")
+
+    @property
+    def brake_steps(self) -> int:
+        """Substeps of the longest braking tail: ``ceil(brake_horizon / model.opt.timestep)``, at least 1.
+
+        Read from the live model on every use, so an edited ``opt.timestep`` (a dynamics edit) keeps
+        the horizon in seconds (it was fixed at construction before 2026-11-28: a halved timestep
+        halved the braking tail's simulated time; red team 4).
+        """
+        dt = float(self.model.opt.timestep)
+        if not (math.isfinite(dt) and dt > 0.0):
+            raise InvalidInputError(f"model.opt.timestep must be a finite number > 0, got {dt!r}")
+        return max(1, int(math.ceil(self._brake_horizon / dt)))
 
     # ----------------------------------------------------------------- settings the cache depends on
     @property

@@ -42,3 +42,40 @@ def test_safety_gate_passes_the_horizon_to_its_gate():
     default.close()
     with pytest.raises(InvalidInputError, match="brake_horizon"):
         SafetyGate(gym.make("monitor/Arm-v0"), brake_horizon=-1.0)
+
+
+def _tail_substeps(gate: Gate, model, steps: int) -> list[int]:
+    """Substeps of each braking tail over ``steps`` seeded tunnel steps (the rollout's counter)."""
+    d = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, d, 0)
+    out = []
+    for k in range(steps):
+        before = gate._rollout.tail_substeps
+        gate.step(d, np.array([3.0 if k < 4 else 0.5]), nstep=1)
+        out.append(gate._rollout.tail_substeps - before)
+    return out
+
+
+def test_reassigned_horizon_takes_effect_like_a_constructed_one():
+    """``gate.brake_horizon = h`` gives the tails of ``Gate(model, brake_horizon=h)`` (it was ignored)."""
+    model = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    want = _tail_substeps(Gate(model, margin=0.001, brake_horizon=0.03), model, 6)
+    gate = Gate(model, margin=0.001)
+    gate.brake_horizon = 0.03
+    assert gate.brake_horizon == 0.03 and gate.brake_steps == 3
+    assert _tail_substeps(gate, model, 6) == want
+    assert max(want) == 3  # the ball moves: tails run to the shorter horizon
+    with pytest.raises(InvalidInputError, match="brake_horizon"):
+        gate.brake_horizon = -1.0
+    assert gate.brake_horizon == 0.03  # a refused value changes nothing
+
+
+def test_horizon_stays_in_seconds_after_a_timestep_edit():
+    model = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    gate = Gate(model, brake_horizon=0.25)
+    n = gate.brake_steps
+    model.opt.timestep /= 2  # a dynamics edit: twice the substeps for the same 0.25 s
+    assert gate.brake_steps == math.ceil(0.25 / model.opt.timestep) == 2 * n
+    model.opt.timestep = 0.0
+    with pytest.raises(InvalidInputError, match="timestep"):
+        _ = gate.brake_steps
