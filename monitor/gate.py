@@ -1103,11 +1103,20 @@ class Gate:
         action_shape: shape of the actions :meth:`decide` receives, against which an
             array ``fallback`` is checked (default ``(nu,)``: the action is the control).
 
-    ``margin``, ``epsilon`` and ``tolerances`` may be reassigned (validated; the reuse
-    cache is keyed on them). A gate whose model has no candidate pairs under
-    ``pairs`` warns (``UserWarning``) once, at construction, since it checks nothing; the scene
-    itself is built at the first decision (``allowed="auto"`` needs the first state as its
-    reference pose), and then warns once more if the allowed-contact matrix left nothing.
+    Settings reassigned after construction act from the next step, validated when assigned
+    (``margin``, ``epsilon``, ``tolerances``, ``budget``, ``ongoing``, ``penetration_tol``,
+    ``brake_horizon``, ``frame_skip``, ``reuse``, ``brake``, ``predictor``, ``on_violation``,
+    ``unsafe``, ``fallback``, ``brake_vel_tol``; the reuse cache is keyed on what it depends on).
+    Those that fix WHAT is certified and that the log records as the pair policy (``model``,
+    ``pairs``, ``allowed``, ``hazards``, ``allow``; ``reference_qpos`` once the scene is built)
+    raise InvalidInputError: construct a new Gate (:mod:`monitor.gate_settings`). The log's run
+    metadata keeps ``predictor``, ``on_violation``, ``unsafe`` and ``frame_skip`` as they were when
+    it was opened (each window records its own times, request and replacement).
+
+    A gate whose model has no candidate pairs under ``pairs`` warns (``UserWarning``) once, at
+    construction, since it checks nothing; the scene itself is built at the first decision
+    (``allowed="auto"`` needs the first state as its reference pose), and then warns once more
+    if the allowed-contact matrix left nothing.
 
     Raises:
         InvalidInputError: on an unknown option, a bad ``log``, ``fallback``, ``budget`` or

@@ -170,6 +170,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             ongoing-contact rule, see :class:`monitor.Gate` (defaults ``"auto"``, None,
             None, ``"deepen"``, 0.005 m).
 
+    ``predictor_mode``, ``user_fallback`` and ``action_chain`` are fixed (assignment raises
+    InvalidInputError); the certification settings are ``gate``'s (:class:`monitor.Gate`: they act
+    or raise the same way), except ``gate.frame_skip``: the windows certified are the ones the env
+    steps, so set ``env.unwrapped.frame_skip`` (a different ``gate.frame_skip`` raises at the step).
+
     Raises:
         InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data, an option is invalid,
             or a wrapper between the gate and the MuJoCo env could change the action in a way
