@@ -1190,8 +1190,7 @@ class Gate:
         self._log = None
         self._log_owned = False
         self._log_lock: Any = None
-        self.log_path: Path | None = None
-        """The file the gate writes (None until the first window, or when not logging to a path)."""
+        self._log_path: Path | None = None  # log_path (read-only property)
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
@@ -1213,6 +1212,8 @@ class Gate:
     allowed = fixed_setting("allowed", "the allowed-contact matrix, recorded in the log's pair policy")
     hazards = fixed_setting("hazards", "the pattern items selecting the checked pairs, recorded in the log")
     allow = fixed_setting("allow", "the pattern items of user-allowed pairs, recorded in the log")
+    log_path = fixed_setting("log_path", "the file the gate writes: None until the first window, or when "
+                                         "not logging to a path", arg="log")
     reference_qpos = checked_setting("reference_qpos", check_reference,
                                      "(nq,) pose ``allowed='auto'`` is resolved at (None: the first state); "
                                      "only before the scene is first built.")
@@ -1928,7 +1929,7 @@ class Gate:
             if path != Path(spec):
                 warnings.warn(f"monitor.Gate: log {str(spec)!r} is being written by another gate; this gate "
                               f"writes {str(path)!r}", UserWarning, stacklevel=4)
-            self.log_path = path
+            self._log_path = path
             meta = {"margin": self.margin, "epsilon": self.epsilon,
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,

@@ -95,6 +95,18 @@ def test_reference_qpos_is_validated_and_fixed_once_the_scene_is_built():
     assert gate._policy_metadata()["reference_qpos"] == [0.01]
 
 
+def test_log_path_is_read_only(tmp_path):
+    """Base: ``gate.log_path = other`` was accepted and the gate kept writing the first file."""
+    m, d, gate = _setup(log=tmp_path / "run.mcap")
+    gate.decide(d, np.zeros(1))
+    assert gate.log_path == tmp_path / "run.mcap"
+    with pytest.raises(InvalidInputError, match=r"Gate\.log_path cannot be reassigned.*new Gate\(log="):
+        gate.log_path = tmp_path / "other.mcap"
+    gate.decide(d, np.zeros(1))
+    gate.close()
+    assert gate.log_path == tmp_path / "run.mcap" and not (tmp_path / "other.mcap").exists()
+
+
 # ----------------------------------------------------------------------------- how it gates: act, validated
 @pytest.mark.parametrize("name, bad", [
     ("frame_skip", 0), ("frame_skip", 2.5), ("frame_skip", True), ("reuse", "yes"), ("brake", None),
