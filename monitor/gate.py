@@ -65,6 +65,14 @@ from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
 from monitor.certify.request import BudgetLimits, CertifyRequest
 from monitor.errors import InvalidInputError
 from monitor.gate_policy import announce, applied_cost, block_reason, describe_gate, safety_keys
+from monitor.gate_settings import (
+    check_choice,
+    check_flag,
+    check_reference,
+    checked_setting,
+    fixed_setting,
+    frozen_items,
+)
 from monitor.tolerances import DEFAULT, Tolerances
 
 _LOG = logging.getLogger("monitor.gate")
@@ -892,6 +900,13 @@ _MODEL_EDITS_KEY = "model_edits"
 """Run metadata key ``monitor.log.topics.MODEL_EDITS_KEY`` (spelled here: gate.py imports no mcap)."""
 
 
+def _check_predictor(predictor: Any) -> Any:
+    """``predictor``: ``"rollout"`` or a callable, else InvalidInputError."""
+    if not (callable(predictor) or (isinstance(predictor, str) and predictor in PREDICTORS)):
+        raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
+    return predictor
+
+
 def _check_nstep(n: Any, name: str) -> int:
     """``n`` as a substep count: an integer >= 1 (not a bool, a float or a string), else InvalidInputError."""
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
@@ -1088,11 +1103,20 @@ class Gate:
         action_shape: shape of the actions :meth:`decide` receives, against which an
             array ``fallback`` is checked (default ``(nu,)``: the action is the control).
 
-    ``margin``, ``epsilon`` and ``tolerances`` may be reassigned (validated; the reuse
-    cache is keyed on them). A gate whose model has no candidate pairs under
-    ``pairs`` warns (``UserWarning``) once, at construction, since it checks nothing; the scene
-    itself is built at the first decision (``allowed="auto"`` needs the first state as its
-    reference pose), and then warns once more if the allowed-contact matrix left nothing.
+    Settings reassigned after construction act from the next step, validated when assigned
+    (``margin``, ``epsilon``, ``tolerances``, ``budget``, ``ongoing``, ``penetration_tol``,
+    ``brake_horizon``, ``frame_skip``, ``reuse``, ``brake``, ``predictor``, ``on_violation``,
+    ``unsafe``, ``fallback``, ``brake_vel_tol``; the reuse cache is keyed on what it depends on).
+    Those that fix WHAT is certified and that the log records as the pair policy (``model``,
+    ``pairs``, ``allowed``, ``hazards``, ``allow``; ``reference_qpos`` once the scene is built)
+    raise InvalidInputError: construct a new Gate (:mod:`monitor.gate_settings`). The log's run
+    metadata keeps ``predictor``, ``on_violation``, ``unsafe`` and ``frame_skip`` as they were when
+    it was opened (each window records its own times, request and replacement).
+
+    A gate whose model has no candidate pairs under ``pairs`` warns (``UserWarning``) once, at
+    construction, since it checks nothing; the scene itself is built at the first decision
+    (``allowed="auto"`` needs the first state as its reference pose), and then warns once more
+    if the allowed-contact matrix left nothing.
 
     Raises:
         InvalidInputError: on an unknown option, a bad ``log``, ``fallback``, ``budget`` or
@@ -1115,8 +1139,7 @@ class Gate:
             raise InvalidInputError(f"on_violation must be one of {ON_VIOLATION}, got {on_violation!r}")
         if unsafe not in UNSAFE:
             raise InvalidInputError(f"unsafe must be one of {UNSAFE}, got {unsafe!r}")
-        if not (callable(predictor) or predictor in PREDICTORS):
-            raise InvalidInputError(f"predictor must be 'rollout' or a callable, got {predictor!r}")
+        _check_predictor(predictor)
         _check_nstep(frame_skip, "frame_skip")
         _make_budget(budget)  # validate early
         self._margin, self._epsilon, self._tolerances = 0.0, 1e-3, DEFAULT  # set below (validated)
@@ -1128,23 +1151,25 @@ class Gate:
         self._request: CertifyRequest | None = None  # built from the settings below on first use
         check_rule(ongoing, penetration_tol)  # validate both before either is set
         self.penetration_tol = penetration_tol
-        self.ongoing, self.allowed, self.hazards, self.allow = ongoing, allowed, hazards, allow
-        self.reference_qpos: np.ndarray | None = None  # allowed="auto": Default's reference pose
-        self.model = model
-        self.pairs = pairs
+        self.ongoing = ongoing
+        # fixed (gate_settings): what is certified and what the log records as the pair policy
+        self._model, self._pairs = model, frozen_items(pairs)
+        self._allowed, self._hazards = frozen_items(allowed), frozen_items(hazards)
+        self._allow = frozen_items(allow)
+        self.reference_qpos = None  # allowed="auto": Default's reference pose (validated property)
         self.margin = margin
         self.epsilon = epsilon
         self.predictor = predictor
         self.on_violation = on_violation
         self.unsafe = unsafe
         self._fallback_shape = (model.nu,) if action_shape is None else tuple(action_shape)
-        self.fallback = _check_fallback(fallback, self._fallback_shape)
+        self.fallback = fallback  # validated (property), as are the settings below
         self.budget = budget
-        self.frame_skip = int(frame_skip)
+        self.frame_skip = frame_skip
         self.reuse = bool(reuse)
         self.brake = bool(brake)
         self.brake_horizon = brake_horizon  # validated (property)
-        self.brake_vel_tol = _finite_setting(brake_vel_tol, "brake_vel_tol", positive=False, what="")
+        self.brake_vel_tol = brake_vel_tol
         self._committed: np.ndarray | None = None
         self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
         self._joint_hint = True  # try the joint window + tail call (see decide)
@@ -1165,21 +1190,49 @@ class Gate:
         self._log = None
         self._log_owned = False
         self._log_lock: Any = None
-        self.log_path: Path | None = None
-        """The file the gate writes (None until the first window, or when not logging to a path)."""
+        self._log_path: Path | None = None  # log_path (read-only property)
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
                       "tail_replay_differs": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0,
                       "committed": 0, "joint": 0, "tail_refuted": 0}
         self._warned = False
-        if _no_candidate_pairs(model, pairs):  # cheap (no shapes): the scene is built at first use
+        if _no_candidate_pairs(model, self._pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
             where = self._log_options.get("env_id") or _model_name(model) or "the model"
             warnings.warn(
                 f"monitor.Gate on {where}: no candidate pairs to check under pairs={pairs!r}, so every "
                 "window is certified without checking anything (info['safety']['monitored_pairs'] == 0). "
                 "Pass pairs='all' or a list of geom-name pairs to monitor.", UserWarning, stacklevel=2)
+
+    # ----------------------------------------------------------------- settings (see monitor.gate_settings)
+    model = fixed_setting("model", "the MjModel the scene, rollout and log are built on; edit it in place, "
+                                   "the gate re-reads it every step")
+    pairs = fixed_setting("pairs", "the scene's candidate pairs, recorded in the log's pair policy")
+    allowed = fixed_setting("allowed", "the allowed-contact matrix, recorded in the log's pair policy")
+    hazards = fixed_setting("hazards", "the pattern items selecting the checked pairs, recorded in the log")
+    allow = fixed_setting("allow", "the pattern items of user-allowed pairs, recorded in the log")
+    log_path = fixed_setting("log_path", "the file the gate writes: None until the first window, or when "
+                                         "not logging to a path", arg="log")
+    reference_qpos = checked_setting("reference_qpos", check_reference,
+                                     "(nq,) pose ``allowed='auto'`` is resolved at (None: the first state); "
+                                     "only before the scene is first built.")
+    frame_skip = checked_setting("frame_skip", lambda g, v: _check_nstep(v, "frame_skip"),
+                                 "Default substeps per window (an integer >= 1).")
+    reuse = checked_setting("reuse", check_flag("reuse"), "Reuse results of fixed, unchanged pairs.")
+    brake = checked_setting("brake", check_flag("brake"), "Recoverability check with a committed brake.")
+    predictor = checked_setting("predictor", lambda g, v: _check_predictor(v),
+                                "``\"rollout\"`` or a callable ``predictor(data, ctrl, nstep) -> Plan``.")
+    on_violation = checked_setting("on_violation", check_choice("on_violation", ON_VIOLATION),
+                                   "``\"block\" | \"terminate\" | \"warn\"``.")
+    unsafe = checked_setting("unsafe", check_choice("unsafe", UNSAFE),
+                             "``\"uncertain\"`` or ``\"violation\"``.")
+    fallback = checked_setting("fallback", lambda g, v: _check_fallback(v, g._fallback_shape),
+                               "None (hold position), an action array or a callable ``fallback(data)``; a "
+                               "brake committed by the last accepted window stays in force until the next.")
+    brake_vel_tol = checked_setting(
+        "brake_vel_tol", lambda g, v: _finite_setting(v, "brake_vel_tol", positive=False, what=""),
+        "The braking tail ends once every ``|qvel|`` is at most this (rad/s, m/s).")
 
     # ----------------------------------------------------------------- braking tail length
     @property
@@ -1701,9 +1754,9 @@ class Gate:
             _check_data(self.model, data)
             self._data_checked = weakref.ref(data)
         _check_ctrl(ctrl, self._fallback_shape)
-        if self._scene is None and self.reference_qpos is None:  # issue 13: first state = ACM reference
-            # (before the scene is built: `allowed="auto"` frees the pairs touching at THIS pose)
-            self.reference_qpos = np.array(data.qpos)
+        if self._scene_builds == 0 and self._reference_qpos is None:  # issue 13: first state = ACM reference
+            # (before the scene is first built: `allowed="auto"` frees the pairs touching at THIS pose)
+            self._reference_qpos = np.array(data.qpos)
         self._sync_scene()  # certify against the model as it is now (domain randomisation, tuning)
         if cast is None:
             def cast(c: Any) -> np.ndarray:
@@ -1876,7 +1929,7 @@ class Gate:
             if path != Path(spec):
                 warnings.warn(f"monitor.Gate: log {str(spec)!r} is being written by another gate; this gate "
                               f"writes {str(path)!r}", UserWarning, stacklevel=4)
-            self.log_path = path
+            self._log_path = path
             meta = {"margin": self.margin, "epsilon": self.epsilon,
                     "predictor": self.predictor if isinstance(self.predictor, str) else "callable",
                     "on_violation": self.on_violation, "unsafe": self.unsafe, "frame_skip": self.frame_skip,

@@ -64,6 +64,7 @@ from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL
 from monitor.errors import InvalidInputError
 from monitor.gate import Gate, StepReport, safety_info
 from monitor.gate_policy import safety_keys
+from monitor.gate_settings import fixed_setting
 
 _W = gymnasium.wrappers
 _PASS_THROUGH_STEPS = frozenset({
@@ -169,6 +170,11 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             ongoing-contact rule, see :class:`monitor.Gate` (defaults ``"auto"``, None,
             None, ``"deepen"``, 0.005 m).
 
+    ``predictor_mode``, ``user_fallback`` and ``action_chain`` are fixed (assignment raises
+    InvalidInputError); the certification settings are ``gate``'s (:class:`monitor.Gate`: they act
+    or raise the same way), except ``gate.frame_skip``: the windows certified are the ones the env
+    steps, so set ``env.unwrapped.frame_skip`` (a different ``gate.frame_skip`` raises at the step).
+
     Raises:
         InvalidInputError: if ``env.unwrapped`` has no MuJoCo model/data, an option is invalid,
             or a wrapper between the gate and the MuJoCo env could change the action in a way
@@ -201,7 +207,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 f"{type(u).__name__} has none")
         if not isinstance(env.action_space, gymnasium.spaces.Box):
             raise InvalidInputError(f"SafetyGate needs a Box action space, got {env.action_space}")
-        self.action_chain = action_wrappers(env)
+        self._action_chain = action_wrappers(env)
         self._action_shape = tuple(env.action_space.shape)
         inner_space = u.action_space if self.action_chain else env.action_space
         if not isinstance(inner_space, gymnasium.spaces.Box):
@@ -214,8 +220,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             raise InvalidInputError(
                 f"predictor='rollout' writes the action to data.ctrl, but the action shape "
                 f"{inner_shape} is not (nu,) = ({model.nu},); use predictor='plan' or a callable")
-        self.predictor_mode = predictor
-        self.user_fallback = fallback
+        self._predictor_mode, self._user_fallback = predictor, fallback  # fixed (see the properties)
         self.timing = bool(timing)
         gate_fallback = None if callable(fallback) else fallback
         if gate_fallback is not None and self.action_chain:  # an action: the env receives T(fallback)
@@ -232,6 +237,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          action_shape=inner_shape, allowed=allowed, hazards=hazards, allow=allow,
                          ongoing=ongoing, penetration_tol=penetration_tol, brake_horizon=brake_horizon)
         self._unwrapped = u
+        self._gate_frame_skip = self.gate.frame_skip  # the count this wrapper last gave the gate
         self._obs: Any = None
         self._commit_ok = predictor == "rollout" and _steps_like_mujoco_env(u)
         self._expected: tuple[np.ndarray, int, bytes] | None = None  # the certified window (see _commit_sim)
@@ -242,6 +248,13 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         friction) after the gate decided and before it simulates: the scratch window was
         integrated with the model as it was at the decision, and the commit compares the
         integration state and control, not the model."""
+
+    action_chain = fixed_setting("action_chain", "the action wrappers between the gate and the MuJoCo env, "
+                                                 "found at construction", arg="env")
+    predictor_mode = fixed_setting("predictor_mode", "the predictor; the commit hook and the brake check "
+                                                     "were chosen for it", arg="predictor")
+    user_fallback = fixed_setting("user_fallback", "the fallback; an action array was converted into the "
+                                                   "gate's fallback at construction", arg="fallback")
 
     def describe(self) -> str:
         """What the gate monitors (pairs, allowed pairs by reason, ongoing-contact rule)."""
@@ -414,8 +427,13 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         if isinstance(fs, (bool, np.bool_)) or not isinstance(fs, (int, np.integer)) or fs < 1:
             raise InvalidInputError(f"env.unwrapped.frame_skip must be an integer >= 1, got {fs!r}")
         fs = int(fs)
-        if fs != self.gate.frame_skip:
-            self.gate.frame_skip = fs
+        gate_fs = self.gate.frame_skip
+        if gate_fs != self._gate_frame_skip and gate_fs != fs:  # the user's gate.frame_skip cannot act here
+            raise InvalidInputError(
+                f"SafetyGate.gate.frame_skip was set to {gate_fs!r}, but the gate certifies the windows the "
+                f"env steps: env.unwrapped.frame_skip ({fs}) substeps; set env.unwrapped.frame_skip instead")
+        if fs != gate_fs:
+            self.gate.frame_skip = self._gate_frame_skip = fs
         return fs
 
     def _check_elapsed(self, t_start: float, nstep: int) -> None:
@@ -558,7 +576,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         """Reset the wrapped env; ``info["safety"]`` has the same keys with verdict ``""``."""
         obs, info = self.env.reset(seed=seed, options=options)
         self.gate.reset()
-        if self.gate._scene is None and self.gate.reference_qpos is None:
+        if self.gate._scene_builds == 0 and self.gate.reference_qpos is None:
             # issue 13: the first reset state is the ACM's reference pose (scene built and announced now)
             self.gate.reference_qpos = np.array(self.env.unwrapped.data.qpos)
         self._obs = obs

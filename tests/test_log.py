@@ -276,6 +276,29 @@ def test_same_sized_other_model_is_not_attached_as_xml():
         assert "xml_error" in exp.info
 
 
+def test_export_pins_mesh_geoms_where_mujoco_places_them():
+    """A mesh geom alone in its body sits at the body's inertial frame (``geom_sameframe`` INERTIA):
+    after a centre-of-mass edit (``body_ipos``, domain randomisation) MuJoCo moves it there and
+    ignores ``geom_pos``. Base b036d4c pinned the exported geom at ``geom_pos``: the recompiled XML
+    was 0.21 m off and no XML was attached. Oracle: MuJoCo's own ``geom_xpos`` of both models
+    (:func:`geometry_deviation`, ``mj_kinematics``), at ``qpos0`` and a random pose."""
+    xml = """<mujoco><asset><mesh name="tet" vertex="0 0 0  1 0 0  0 1 0  0 0 1" scale=".1 .1 .1"/></asset>
+    <worldbody><body name="b" pos="0 -0.5 0"><freejoint/><geom name="m" type="mesh" mesh="tet"/></body>
+    <body name="c" pos="0.5 0 0"><freejoint/><geom name="m2" type="mesh" mesh="tet" pos="0.1 0 0"/>
+    <geom name="s" type="sphere" size="0.02"/></body></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    g = model.geom("m").id
+    assert int(model.geom_sameframe[g]) == int(mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA)  # set-up
+    model.body_ipos[model.body("b").id] += (0.0, 0.2, 0.05)
+    exp = export_model(model)
+    assert exp.xml is not None, exp.info
+    back = mujoco.MjModel.from_xml_string(exp.xml, assets=exp.assets)
+    q = np.array(model.qpos0)
+    q[:3], q[3:7] = (0.1, 0.2, 0.3), np.array([0.9, 0.1, -0.3, 0.2]) / np.linalg.norm([0.9, 0.1, -0.3, 0.2])
+    for qpos in (None, q):
+        assert geometry_deviation(model, back, qpos) <= XML_GEOMETRY_TOL
+
+
 def test_plan_model_attached_lazily_and_default_path(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     p = default_path("monitor/Arm-v0")

@@ -92,12 +92,22 @@ def body_frame(model: Any, b: int) -> str:
 
 
 def geom_primitives(model: Any, g: int, color: Color) -> dict[str, list[Any]]:
-    """Foxglove primitives of geom ``g`` in its body frame (sizes are full extents)."""
+    """Foxglove primitives of geom ``g`` in its body frame (sizes are full extents).
+
+    The geom's pose in the body is :func:`monitor.scene.geom_frame`: a geom MuJoCo's compiler
+    marked ``geom_sameframe`` sits at its body's (or inertial) frame whatever ``geom_pos`` /
+    ``geom_quat`` say, and the drawing must show where the simulation (and the Scene) has it.
+    """
     import mujoco
+
+    from monitor.scene import geom_frame
 
     G = mujoco.mjtGeom
     t, s = int(model.geom_type[g]), model.geom_size[g]
-    pose = Pose(position=_vec(model.geom_pos[g]), orientation=fox_quat(model.geom_quat[g]))
+    R_BG, p_BG = geom_frame(model, g)  # where MuJoCo's kinematics put it (geom_sameframe; red team 4)
+    q_BG = np.empty(4)  # (w, x, y, z)
+    mujoco.mju_mat2Quat(q_BG, np.ascontiguousarray(R_BG).ravel())
+    pose = Pose(position=_vec(p_BG), orientation=fox_quat(q_BG))
     if t == G.mjGEOM_BOX:
         return {"cubes": [CubePrimitive(pose=pose, size=_vec(2 * s), color=color)]}
     if t == G.mjGEOM_SPHERE:
@@ -108,10 +118,8 @@ def geom_primitives(model: Any, g: int, color: Color) -> dict[str, list[Any]]:
         return {"cylinders": [CylinderPrimitive(pose=pose, size=_vec([2 * s[0], 2 * s[0], 2 * s[1]]),
                                                 bottom_scale=1.0, top_scale=1.0, color=color)]}
     if t == G.mjGEOM_CAPSULE:
-        R = np.empty(9)
-        mujoco.mju_quat2Mat(R, model.geom_quat[g])
-        axis = R.reshape(3, 3)[:, 2]
-        ends = [model.geom_pos[g] + sgn * s[1] * axis for sgn in (-1.0, 1.0)]
+        axis = R_BG[:, 2]
+        ends = [p_BG + sgn * s[1] * axis for sgn in (-1.0, 1.0)]
         return {"cylinders": [CylinderPrimitive(pose=pose, size=_vec([2 * s[0], 2 * s[0], 2 * s[1]]),
                                                 bottom_scale=1.0, top_scale=1.0, color=color)],
                 "spheres": [SpherePrimitive(pose=Pose(position=_vec(e), orientation=Quaternion(w=1.0)),

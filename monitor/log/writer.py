@@ -258,12 +258,18 @@ def _self_contained_xml(model: Any, spec: Any) -> tuple[str, dict[str, bytes]]:
     spec.meshdir = ""
     spec.texturedir = ""
     spec.assets = dict(assets)
+    from monitor.scene import geom_frame
+
     spec.compile()  # assigns compiled ids to spec elements
     for g in spec.geoms:
         if g.type == mujoco.mjtGeom.mjGEOM_MESH and 0 <= g.id < model.ngeom:
-            g.pos = model.geom_pos[g.id].copy()
+            # where MuJoCo places it (geom_sameframe: the body or inertial frame), not geom_pos/geom_quat
+            R_BG, p_BG = geom_frame(model, g.id)
+            quat = np.empty(4)
+            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(R_BG).ravel())
+            g.pos = p_BG
             g.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT
-            g.quat = model.geom_quat[g.id].copy()
+            g.quat = quat
     return spec.to_xml(), assets
 
 
