@@ -1,15 +1,7 @@
 """In a real gate process (no pickling): ensure_warm, then the bench's seeds; which dispatchers load during the run."""
 import time, sys
 import gymnasium as gym
-from numba.core import dispatcher
-_orig = dispatcher.Dispatcher._compile_for_args
-active = [False]
-def cfa(self, *a, **k):
-    t = time.perf_counter()
-    try: return _orig(self, *a, **k)
-    finally:
-        if active[0]: print(f"  load {self.py_func.__module__}.{self.py_func.__name__}: {(time.perf_counter()-t)*1e3:.1f} ms")
-dispatcher.Dispatcher._compile_for_args = cfa
+from loadlog import active
 from monitor.warmup import ensure_warm
 ensure_warm()
 import monitor.envs  # noqa

@@ -1,22 +1,15 @@
-"""Which numba dispatchers load from the disk cache during the first rare call (after gate warm steps)."""
+"""Which numba dispatchers load during the first rare call (after gate warm steps); argv: case index [warm: ensure_warm first]."""
 import time, sys
 import gymnasium as gym
 import monitor, monitor.envs  # noqa
 import monitor.certify.engine as E
 from monitor.gym_gate import SafetyGate
-from numba.core import dispatcher
 import load
 caps = load.load()
-_orig = dispatcher.Dispatcher._compile_for_args
-active = [False]
-def cfa(self, *a, **k):
-    t = time.perf_counter()
-    try: return _orig(self, *a, **k)
-    finally:
-        if active[0]: print(f"  load {self.py_func.__module__}.{self.py_func.__name__}: {(time.perf_counter()-t)*1e3:.1f} ms")
-dispatcher.Dispatcher._compile_for_args = cfa
-import builtins
-_imp = builtins.__import__
+from loadlog import active
+if len(sys.argv) > 2:
+    from monitor.warmup import ensure_warm
+    ensure_warm()
 env = SafetyGate(gym.make("monitor/Arm-v0"))
 env.reset(seed=1000); env.action_space.seed(1000)
 for _ in range(3): env.step(env.action_space.sample())
