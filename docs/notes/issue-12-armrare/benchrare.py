@@ -1,20 +1,9 @@
-"""The bench's gym_gate (Arm, brake) with the rare Python-stage calls logged; argv[1]=preload: load the rare path first."""
+"""The bench's gym_gate (Arm, brake) with the rare Python-stage calls logged; argv[1]=preload: ensure_warm first. Written BEFORE commit d764d95 (gym_gate now preloads itself): use benchab.py for the A/B on this tree."""
 import sys, time, json
-import monitor.certify.engine as E
+import rarelog
 pre = sys.argv[1] == "preload"
 steps, reps = int(sys.argv[2]), int(sys.argv[3])
-log = []
-_c = E.certify
-def c(scene, plan, *a, **k):
-    n0 = n[0]; t = time.perf_counter(); r = _c(scene, plan, *a, **k); dt = time.perf_counter() - t
-    if n[0] > n0: log.append(round(dt * 1e3, 2))
-    return r
-E.certify = c
-n = [0]
-_ps = E._python_stages
-def ps(*a, **k):
-    n[0] += 1; return _ps(*a, **k)
-E._python_stages = ps
+log = rarelog.install()
 if pre:
     from monitor.warmup import ensure_warm
     t = time.perf_counter(); ensure_warm(); print("ensure_warm", round(time.perf_counter() - t, 3), "s")

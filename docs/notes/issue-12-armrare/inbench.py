@@ -8,23 +8,13 @@ if sys.argv[1] == "old":
     gc.collect = lambda *a: 0
 from monitor.bench.suites import BenchConfig
 from monitor.bench.targets import pair_windows, gym_gate
-import monitor.certify.engine as E
+import rarelog
 cfg = BenchConfig(quick=True, out=Path(tempfile.mkdtemp()), log=lambda s: None)
 t = time.perf_counter(); pair_windows(cfg); print("pair_windows", round(time.perf_counter() - t, 1), "s")
 from monitor.certify import kernels
 print("loaded after pair_windows: pair_window", len(kernels.pair_window.signatures), "toleranced imported", "monitor.certify.toleranced" in sys.modules)
 if "monitor.certify.fat_kernels" in sys.modules:
     F = sys.modules["monitor.certify.fat_kernels"]; print(" fat_level", len(F.fat_level.signatures), "traj_balls", len(F.traj_balls.signatures))
-log, n = [], [0]
-_c = E.certify
-def c(scene, plan, *a, **k):
-    n0 = n[0]; t = time.perf_counter(); r = _c(scene, plan, *a, **k); dt = time.perf_counter() - t
-    if n[0] > n0: log.append(round(dt * 1e3, 2))
-    return r
-E.certify = c
-_ps = E._python_stages
-def ps(*a, **k):
-    n[0] += 1; return _ps(*a, **k)
-E._python_stages = ps
+log = rarelog.install()
 out = gym_gate("monitor/Arm-v0", steps_gated=10, steps_ungated=200, reps=3, brake=True)
 print(json.dumps({"mode": sys.argv[1], "ratio": round(out["ratio"], 2), "gated_us": round(out["gated_s"] * 1e6), "rare_calls_ms": log}))
