@@ -29,6 +29,7 @@ No target is a pass/fail test: rows say MET / MISSED against the issue's target 
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import os
@@ -382,13 +383,22 @@ def gym_gate(
     """Seconds per ``env.step`` of ``SafetyGate(gym.make(env_id), pairs=pairs, brake=brake)``, bare env.
 
     Both see the same seeded action sequences; one untimed warm-up block each (the gate resolves
-    its ACM and loads kernels on its first step). Returns medians over ``reps`` interleaved blocks.
+    its ACM and loads kernels on its first step). Before it, :func:`monitor.warmup.ensure_warm`
+    loads every certify kernel in this process, the rarely used ones included (the per-pair
+    search entry ``pair_window`` and the fat-feature kernels: ~50-90 ms of numba cache loading and
+    imports the first time a window reaches the Python stages, which a 2-step warm-up block
+    seldom does; docs/notes/issue-12-armrare.md), and after the warm-up blocks one full garbage
+    collection (else a 30-50 ms gen-2 pass over those objects lands in a timed block). Returns
+    medians over ``reps`` interleaved blocks.
     """
     import gymnasium as gym
 
     if env_id.startswith("monitor/"):
         import monitor.envs  # noqa: F401
     from monitor.gym_gate import SafetyGate
+    from monitor.warmup import ensure_warm
+
+    ensure_warm()   # one-time loads stay out of the timed blocks (a no-op once done in this process)
 
     envs = {"ungated": gym.make(env_id), "gated": SafetyGate(gym.make(env_id), pairs=pairs, brake=brake)}
     verdicts: Counter = Counter()
@@ -416,6 +426,9 @@ def gym_gate(
     try:
         block("ungated", 5, 1000, False)
         block("gated", 2, 1000, False)
+        # a full collection now: the warm-up's garbage (and ensure_warm's imports) are not
+        # scanned by a gen-2 collection that the next allocations would trigger in a timed block
+        gc.collect()
         per = _blocks(
             {
                 "ungated": lambda r: block("ungated", steps_ungated, r),
