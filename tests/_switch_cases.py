@@ -1,4 +1,5 @@
-"""Helpers of the old-vs-new switch tests (test_engine_extrusion_direct.py, test_ongoing_start_bound.py).
+"""Helpers of the old-vs-new switch tests (test_engine_extrusion_direct.py, test_ongoing_start_bound.py,
+test_extrusion_swept.py).
 
 A module flag switches a shortcut off so that the path it replaces is the oracle; certificates
 are compared in full (``to_dict()`` without the wall time).
@@ -51,3 +52,18 @@ def tunnel_gate_keys(steps: int = 60) -> list[str]:
         out.append(cert_key(r.certificate))
     out.append(d.qpos.tobytes().hex())
     return out
+
+
+def agv_scene_plan(name: str, skewed: bool):
+    """(scene with pairs="all", Plan) of Cameron's §5 AGV scene ``name`` (29 primitives), skewed or not."""
+    import mujoco
+
+    import monitor
+    from monitor._paths import models_dir
+    from monitor.bench.extrusion_scenes import schedule
+
+    m = mujoco.MjModel.from_xml_path(str(models_dir() / "agv_trays" / ("scene_skewed.xml" if skewed
+                                                                         else "scene.xml")))
+    scene = monitor.Scene.from_model(m, pairs="all")
+    s = schedule(name)
+    return scene, monitor.Plan(s["times"], s["qpos"], model=m)

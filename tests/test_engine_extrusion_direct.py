@@ -24,8 +24,8 @@ from monitor.certify.engine import certify
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from _switch_cases import agv_scene_plan, on_and_off, tunnel_gate_keys  # noqa: E402
 from _switch_cases import cert_key as _key  # noqa: E402
-from _switch_cases import on_and_off, tunnel_gate_keys  # noqa: E402
 
 
 def _both(run):
@@ -118,16 +118,10 @@ def test_tunnel_gate_same_certificates():
 def test_agv_scenes_same_certificates(name, skewed):
     """Cameron's §5 AGV scenes (29 primitives, pairs="all": culled pairs, several survivors per window),
     whole plan and sub-windows, margins 0 and 5 mm: identical certificates."""
-    mujoco = pytest.importorskip("mujoco")
+    pytest.importorskip("mujoco")
     import monitor
-    from monitor._paths import models_dir
-    from monitor.bench.extrusion_scenes import schedule
 
-    m = mujoco.MjModel.from_xml_path(str(models_dir() / "agv_trays" / ("scene_skewed.xml" if skewed
-                                                                         else "scene.xml")))
-    scene = monitor.Scene.from_model(m, pairs="all")
-    s = schedule(name)
-    plan = monitor.Plan(s["times"], s["qpos"], model=m)
+    scene, plan = agv_scene_plan(name, skewed)
     t = np.linspace(plan.t0, plan.t1, 5)
     n_direct, culled = 0, 0
     for window in [None] + list(zip(t[:-1], t[1:])):

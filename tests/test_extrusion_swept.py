@@ -16,6 +16,9 @@ Oracles, independent of the kernel:
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.optimize import linprog
@@ -351,16 +354,13 @@ def test_same_certificates_as_the_python_checker_on_crosscheck_cases():
 @pytest.mark.parametrize(("name", "skewed"), [("straight", False), ("weaving", False), ("weaving", True)])
 def test_agv_scenes_same_certificate_with_the_compiled_pass(name, skewed):
     """Cameron's §5 AGV scenes (29 primitives): same verdict, witness pair, earliest time, clearance."""
-    mujoco = pytest.importorskip("mujoco")
+    pytest.importorskip("mujoco")
     import monitor
-    from monitor._paths import models_dir
-    from monitor.bench.extrusion_scenes import schedule
 
-    m = mujoco.MjModel.from_xml_path(str(models_dir() / "agv_trays" / ("scene_skewed.xml" if skewed
-                                                                         else "scene.xml")))
-    scene = monitor.Scene.from_model(m, pairs="all")
-    s = schedule(name)
-    plan = monitor.Plan(s["times"], s["qpos"], model=m)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from _switch_cases import agv_scene_plan
+
+    scene, plan = agv_scene_plan(name, skewed)
     a, b = _both(lambda: monitor.certify(scene, plan, method="auto"))
     assert a.verdict == b.verdict
     assert a.stats["extrusion"].get("swept_kernel", 0) > 0
