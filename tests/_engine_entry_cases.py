@@ -1,10 +1,14 @@
 """Seeded certify calls shared by ``tests/test_engine_entry.py`` and its golden-file recorder.
 
 Run as a script to (re)record the golden file from the tree on ``PYTHONPATH``:
-``PYTHONPATH=<tree> python tests/_engine_entry_cases.py tests/assets/engine_entry_golden.json``.
-The committed file was recorded on main 691a867, before the engine-entry changes of issue 12
-(``docs/notes/issue-12-entry.md``). A deliberate change of the kernels' search (test counts,
-clearances) changes the certificates; re-record it then and say why in the commit.
+``PYTHONPATH=<tree> python tests/_engine_entry_cases.py tests/assets/engine_entry_golden.json``
+(for one CPU family: ``engine_entry_golden.<llvmlite.binding.get_host_cpu_name()>.json``, which
+the test prefers on that family). The committed default file was recorded on main 691a867 (AMD
+EPYC), before the engine-entry changes of issue 12 (``docs/notes/issue-12-entry.md``); the
+``rocketlake`` file on 2026-11-28 (Intel Xeon), identical from 1c16a97 and from that day's tree.
+Recording, like the test, runs with the engine's compiled translating pass off (``_SWEPT_FIRST``).
+A deliberate change of the kernels' search (test counts, clearances) changes the certificates;
+re-record then (every CPU family's file) and say why in the commit.
 """
 
 from __future__ import annotations
@@ -138,7 +142,13 @@ def pusher_calls() -> Iterator[tuple[str, Any]]:
 
 
 def record(path: str) -> None:
-    out = {name: _summary(run()) for name, run in calls()}
+    from monitor.certify import engine
+
+    old, engine._SWEPT_FIRST = engine._SWEPT_FIRST, False  # as test_engine_entry._check_all compares
+    try:
+        out = {name: _summary(run()) for name, run in calls()}
+    finally:
+        engine._SWEPT_FIRST = old
     with open(path, "w") as f:   # one call per line
         f.write("{\n" + ",\n".join(f"{json.dumps(k)}: {json.dumps(v, sort_keys=True)}"
                                     for k, v in sorted(out.items())) + "\n}\n")

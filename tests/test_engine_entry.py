@@ -26,7 +26,31 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _engine_entry_cases import _summary, bench_calls, box_calls, calls, pusher_calls  # noqa: E402
 
-GOLDEN = Path(__file__).resolve().parent / "assets" / "engine_entry_golden.json"
+
+def _golden_file() -> Path:
+    """The recording for this host's CPU family when there is one, else the original recording.
+
+    numba compiles for the host CPU (``llvmlite.binding.get_host_cpu_name()``): FMA contraction and
+    vector widths move floats in their last bits, and on a few grazing calls that moves a search
+    path (a test count, an earliest time). ``engine_entry_golden.json`` was recorded on an AMD EPYC;
+    ``engine_entry_golden.rocketlake.json`` on the 2026-11-28 session's Intel Xeon, where the
+    previous main 1c16a97 and the tree of that session recorded byte-identical files (all calls).
+    """
+    import llvmlite.binding as llvm
+
+    assets = Path(__file__).resolve().parent / "assets"
+    own = assets / f"engine_entry_golden.{llvm.get_host_cpu_name()}.json"
+    return own if own.is_file() else assets / "engine_entry_golden.json"
+
+
+GOLDEN = _golden_file()
+
+
+_SOLVER_COUNTS = frozenset({".stats.extrusion.nnls"})
+"""Counters of an iterative solver's calls (the Python extrusion checker's NNLS solves while it
+bisects a first-contact time): a last-bit difference moves the bisection by a solve or two, so they
+compare to within 2 (or 2 %). On the Xeon, 1 of the 30 slow bench-sample calls gave 106 for the
+EPYC's 107; every other field of those calls compared as below."""
 
 
 def _first_difference(got, want, path: str = "") -> str | None:
@@ -38,6 +62,8 @@ def _first_difference(got, want, path: str = "") -> str | None:
     processor to another (an Intel Xeon gave 2e-16 m on four of the 24 box calls recorded on
     an AMD EPYC). A changed stage, verdict or search moves them far more than that.
     """
+    if path in _SOLVER_COUNTS and isinstance(got, int) and isinstance(want, int):
+        return None if abs(got - want) <= max(2, 0.02 * abs(want)) else f"{path}: {got!r} != {want!r}"
     if isinstance(got, float) or isinstance(want, float):
         ok = (isinstance(got, (int, float)) and isinstance(want, (int, float))
               and not isinstance(got, bool) and not isinstance(want, bool)
@@ -101,6 +127,10 @@ def test_the_comparison_tolerates_only_last_bits():
     assert _first_difference(dict(want, pairs=[{"w": [0.1, 2.0 + 1e-6]}]), want).startswith(".pairs[0].w[1]:")
     assert _first_difference(dict(want, pairs=[]), want) == ".pairs: length 0 != 1"
     assert _first_difference({"verdict": "certified"}, want).startswith(": keys")
+    solves = {"stats": {"extrusion": {"nnls": 107}}}
+    assert _first_difference({"stats": {"extrusion": {"nnls": 106}}}, solves) is None
+    far = _first_difference({"stats": {"extrusion": {"nnls": 100}}}, solves)
+    assert far == ".stats.extrusion.nnls: 100 != 107"
 
 
 def test_pusher_and_edited_certificates_match_recorded():
