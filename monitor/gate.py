@@ -1547,7 +1547,7 @@ class Gate:
         if self.unsafe != "uncertain":
             return False
         if self.ongoing != "violation":   # "deepen": the pair must not be ongoing at the tail's start
-            from monitor.geometry.distance import shape_distance
+            from monitor.certify.ongoing import start_distance
 
             scene = self.scene
             try:
@@ -1555,10 +1555,7 @@ class Gate:
             except InvalidInputError:   # not a geom of the scene (cannot happen on the gate's path)
                 return False
             plan = tail.plan
-            pos, rot = plan.body_poses(np.array([float(plan.times[0])]))
-            dist = shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
-                                  gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]),
-                                  tolerances=self.tolerances)
+            dist = start_distance(ga, gb, plan.body_poses(np.array([float(plan.times[0])])), self.tolerances)
             if not dist.lower > self.margin:
                 return False
         return True

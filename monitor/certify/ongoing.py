@@ -146,8 +146,6 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     Returns:
         the certificate with ongoing pairs re-judged (unchanged when there are none).
     """
-    from monitor.geometry.distance import shape_distance
-
     if cert.verdict == "certified":
         # every pair is certified (any other pair verdict makes the combined verdict
         # "uncertain" or "violation"): no ongoing pair; cert.pairs need not be built here
@@ -172,9 +170,7 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
         ga, gb = scene.geom(p.geoms[0]), scene.geom(p.geoms[1])
         if poses is None:
             poses = plan.body_poses(np.array([t0]))
-        pos, rot = poses
-        dist = shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
-                              gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]), tolerances=tolerances)
+        dist = start_distance(ga, gb, poses, tolerances)
         if dist.lower > margin:
             continue  # clear at t0: a new contact, the full rule stands
         floor = float(dist.lower) - penetration_tol
@@ -224,6 +220,20 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
                                note=f"{POLYTOPE_NOTE}: penetration < {tol_txt} cannot be certified "
                                     f"(only {s:g} m of radius to shrink)")
     return _recombine(cert, pairs, len(meta), penetration_tol)
+
+
+def start_distance(ga: Any, gb: Any, poses: tuple[np.ndarray, np.ndarray], tolerances: Any) -> Any:
+    """Exact static distance of geoms ``ga``, ``gb`` (``GeomInfo``) at the first time of ``poses``.
+
+    ``poses`` = ``plan.body_poses(times)``: ((T, nbody, 3) positions, (T, nbody, 3, 3) rotations);
+    row 0 is used. The test by which :func:`deepen` calls a pair ongoing (``lower <= margin``);
+    :meth:`monitor.gate.Gate._tail_refuted` asks the same question of a tail's start.
+    """
+    from monitor.geometry.distance import shape_distance
+
+    pos, rot = poses
+    return shape_distance(ga.shape, (rot[0, ga.body_id], pos[0, ga.body_id]),
+                          gb.shape, (rot[0, gb.body_id], pos[0, gb.body_id]), tolerances=tolerances)
 
 
 _START_BOUND = True
