@@ -61,11 +61,40 @@ def test_ongoing_pair_within_margin_closing_on_a_plane_is_not_certified(floor, m
 
 @pytest.mark.parametrize("method", ["auto", "extrusion", "toleranced"])
 def test_ongoing_pair_within_margin_closing_less_than_the_tolerance_is_certified(floor, method):
-    """Guard (passes on ff8b94e too): a drop by 0.0025 m (< penetration_tol) stays certified, with a
-    clearance that is a lower bound of the closed-form one and above 0.03 - 0.005."""
+    """A drop by 0.0025 m (< penetration_tol) stays certified (a guard: the fix does not block what
+    the rule allows), with a clearance that is a lower bound of the closed-form one (0.0275 m) and
+    above 0.03 - 0.005. On ff8b94e it was certified with clearance 0.0525 m (overstated by x)."""
     model, scene = floor
     gap1 = START_GAP - 0.0025
     cert = certify(scene, _drop(model, START_GAP, gap1), margin=MARGIN, method=method, ongoing="deepen",
                    penetration_tol=TOL)
     assert cert.verdict == "certified", [p.note for p in cert.pairs]
     assert START_GAP - TOL < cert.clearance <= gap1 + 1e-12
+
+
+_SLIDE_FLOOR_XML = """<mujoco><option timestep="0.002" gravity="0 0 0"/><worldbody>
+<geom name="floor" type="plane" size="5 5 0.1" contype="0" conaffinity="0"/>
+<body name="ball"><joint name="z" type="slide" axis="0 0 1"/>
+  <geom name="ball" type="sphere" size="0.1" mass="0.1" contype="0" conaffinity="0"/></body>
+</worldbody><actuator><velocity name="vz" joint="z" kv="50" ctrlrange="-5 5"/></actuator></mujoco>"""
+
+
+def test_gate_does_not_run_a_step_closing_on_a_floor_by_more_than_the_tolerance():
+    """The default Gate (ongoing="deepen", penetration_tol 5 mm), margin 0.05, a ball 0.03 m above
+    a floor plane driven down at 1 m/s for 0.02 s. Oracle: the ball's height on the live data after
+    the step (the motion that ran; monotone within the window): a certified applied motion keeps
+    the gap above 0.03 - 0.005. On ff8b94e the proposal was certified and ran to 0.010 m."""
+    import monitor
+
+    model = mujoco.MjModel.from_xml_string(_SLIDE_FLOOR_XML)
+    data = mujoco.MjData(model)
+    data.qpos[0] = BALL_R + START_GAP
+    mujoco.mj_forward(model, data)
+    gate = monitor.Gate(model, margin=MARGIN, frame_skip=10, pairs=[("floor", "ball")])
+    assert gate.ongoing == "deepen" and gate.penetration_tol == TOL
+    for _ in range(2):
+        gap0 = float(data.qpos[0]) - BALL_R
+        report = gate.step(data, np.array([-1.0]))
+        gap1 = float(data.qpos[0]) - BALL_R
+        if report.applied_verdict == "certified":
+            assert min(gap0, gap1) > START_GAP - TOL, (gap0, gap1, report.verdict, report.replaced)
