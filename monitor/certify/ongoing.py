@@ -12,7 +12,8 @@ action deepen the contact beyond a set penetration?* With
   rule: clearance > margin over the whole window.
 * An ongoing pair that is provably apart at t0 (``0 < lower - d``, i.e. inside the
   margin but not touching) may close by at most ``d``: it is re-certified at margin 0
-  with A's radius *inflated* by ``x = (lower - d)(1 + 1e-9)`` (exact: the signed
+  with A's radius (B's when A is a half-space, whose solid has no radius)
+  *inflated* by ``x = (lower - d)(1 + 1e-9)`` (exact: the signed
   distance drops by exactly x), so certified => clearance > lower - d > 0 at every
   instant; it can never be driven into contact under this rule.
 * Any other ongoing pair is acceptable iff its penetration never exceeds ``d`` during
@@ -179,7 +180,10 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
             # never down to contact. Inflating a radius by x is exact (sd drops by exactly x),
             # so certifying the inflated pair at margin 0 proves sd > x >= floor.
             x = floor * (1.0 + _REL)
-            sa, sb, s = replace(ga.shape, radius=float(ga.shape.radius) + x), gb.shape, -x
+            if ga.shape.kind != "halfspace":
+                sa, sb, s = replace(ga.shape, radius=float(ga.shape.radius) + x), gb.shape, -x
+            else:  # a half-space's solid ignores its radius: inflate B's (the same exact drop by x)
+                sa, sb, s = ga.shape, replace(gb.shape, radius=float(gb.shape.radius) + x), -x
         else:  # touching or penetrating: penetration may not exceed penetration_tol
             sa, sb, s = shrink_pair(ga.shape, gb.shape, penetration_tol)
         ia, ib = len(geoms), len(geoms) + 1
