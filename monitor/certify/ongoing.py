@@ -15,7 +15,10 @@ action deepen the contact beyond a set penetration?* With
   with A's radius (B's when A is a half-space, whose solid has no radius)
   *inflated* by ``x = (lower - d)(1 + 1e-9)`` (exact: the signed
   distance drops by exactly x), so certified => clearance > lower - d > 0 at every
-  instant; it can never be driven into contact under this rule.
+  instant; it cannot reach contact within this window. The rule is per window: over
+  successive windows such a pair can close step by step, reach contact and then
+  penetrate, never by more than ``d`` (the next bullet), which is what
+  ``penetration_tol`` allows for contacts that belong to the task.
 * Any other ongoing pair is acceptable iff its penetration never exceeds ``d`` during
   the window, certified soundly: the pair is re-certified at margin 0 with its
   shapes *shrunk* by ``s <= d``:
