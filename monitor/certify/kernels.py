@@ -90,27 +90,6 @@ import weakref
 import numpy as np
 from numba import njit
 
-from monitor.certify.packed import (
-    G_BCENTER,
-    G_CCENTER,
-    G_CFRAME,
-    G_CPARAM,
-    I_BODY,
-    I_CURVE,
-    I_EROW,
-    I_GROW,
-    I_KIND,
-    I_MROW,
-    I_MW,
-    I_NROW,
-    I_VROW,
-    S_APPROX,
-    S_BRAD,
-    S_DPAD,
-    S_OFFSET,
-    S_RADIUS,
-    S_RHO_MAX,
-)
 from monitor.geometry._gjk import (
     OUT_SIZE,
     _compact,
@@ -195,34 +174,34 @@ def posed_distance(gp, ga, Ra, pa, gb, Rb, pb, rel_pad, abs_pad, out, w_out):
     world point between the closest / common points into ``w_out`` (3,). Both geoms
     must have shapes and not both be half-spaces (checked by the caller).
     """
-    ka, kb = gp.idx[I_KIND, ga], gp.idx[I_KIND, gb]
-    ra, rb = gp.scal[S_RADIUS, ga], gp.scal[S_RADIUS, gb]
+    ka, kb = gp.kind[ga], gp.kind[gb]
+    ra, rb = gp.radius[ga], gp.radius[gb]
     if kb == -1 or ka == -1:
         if kb == -1:
             h, c, Rh, ph, Rc, pc = gb, ga, Rb, pb, Ra, pa
         else:
             h, c, Rh, ph, Rc, pc = ga, gb, Ra, pa, Rb, pb
-        PC = gp.rows[gp.idx[I_VROW, c]:gp.idx[I_VROW, c + 1]]
-        halfspace_distance(gp.rows[gp.idx[I_NROW, h]], gp.scal[S_OFFSET, h], Rh, ph, PC, Rc, pc, rel_pad,
-                           abs_pad, out)
+        n0 = gp.nstart[h]
+        PC = gp.verts[gp.vstart[c]:gp.vstart[c + 1]]
+        halfspace_distance(gp.normals[n0], gp.offset[h], Rh, ph, PC, Rc, pc, rel_pad, abs_pad, out)
         for r in range(3):
             w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pc[r]
-        rc = gp.scal[S_RADIUS, c]
+        rc = gp.radius[c]
         return out[2] - rc, out[3] - rc
-    PA = gp.rows[gp.idx[I_VROW, ga]:gp.idx[I_VROW, ga + 1]]
-    PB = gp.rows[gp.idx[I_VROW, gb]:gp.idx[I_VROW, gb + 1]]
-    EA = gp.edges[gp.idx[I_EROW, ga]:gp.idx[I_EROW, ga + 1]]
-    EB = gp.edges[gp.idx[I_EROW, gb]:gp.idx[I_EROW, gb + 1]]
-    NA = gp.rows[gp.idx[I_NROW, ga]:gp.idx[I_NROW, ga + 1]]
-    NB = gp.rows[gp.idx[I_NROW, gb]:gp.idx[I_NROW, gb + 1]]
+    PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+    PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+    EA = gp.edges[gp.estart[ga]:gp.estart[ga + 1]]
+    EB = gp.edges[gp.estart[gb]:gp.estart[gb + 1]]
+    NA = gp.normals[gp.nstart[ga]:gp.nstart[ga + 1]]
+    NB = gp.normals[gp.nstart[gb]:gp.nstart[gb + 1]]
     # np.int64(...): int64, not Literal[int], so this is the specialisation the Python callers
     # (monitor.geometry.distance) compile too: one compile of core_distance per process
-    core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, ka, kb, gp.scal[S_DPAD, ga], gp.scal[S_DPAD, gb],
-                  rel_pad, abs_pad, _EPS_REL, np.int64(_MAX_ITER), np.int64(_MAX_EDGE_PAIRS), out)
+    core_distance(PA, Ra, pa, EA, NA, PB, Rb, pb, EB, NB, ka, kb, gp.dpad[ga], gp.dpad[gb], rel_pad, abs_pad,
+                  _EPS_REL, np.int64(_MAX_ITER), np.int64(_MAX_EDGE_PAIRS), out)
     for r in range(3):
         w_out[r] = 0.5 * (out[4 + r] + out[7 + r]) + pa[r]
     if ka == 2 and kb == 2 and out[0] != 0.0 and not out[3] < 0.0:
-        _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, gp.scal[S_DPAD, ga], gp.scal[S_DPAD, gb], out)
+        _common_point_depth(PA, Ra, NA, PB, Rb, pb, pa, NB, gp.dpad[ga], gp.dpad[gb], out)
     return out[2] - ra - rb, out[3] - ra - rb
 
 
@@ -267,8 +246,7 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     axis z of its frame) ``h(d) = r |d_xy| + h |d_z|``, ellipsoid ``h(d) = |diag(radii) d|``,
     with d in the geom frame, plus ``d . centre``. The value is computed in closed form;
     the extreme point (for GJK's simplex only) goes into ``pt`` (3,). The geom g's rows of the
-    pack are passed (``gp.idx[I_CURVE, g]`` and the rows ``G_CPARAM``, ``G_CFRAME`` (3), ``G_CCENTER`` of
-    g's per-geom block ``gp.rows[gp.idx[I_GROW, g]:]``), not the pack:
+    pack are passed (``gp.curve[g], gp.cparam[g], gp.cframe[g], gp.ccenter[g]``), not the pack:
     a compiled function typed on the 22-array pack costs several times more to compile.
     """
     # (scalars, no scratch arrays: the same sums in the same order as the former loops over
@@ -352,34 +330,33 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
     clears ``X[4, 2]`` before a call on new poses.
 
     Both geoms must be cores (no half-spaces). A circumscribed
-    cylinder / ellipsoid (``gp.idx[I_CURVE] > 0``) is replaced by
+    cylinder / ellipsoid (``gp.curve > 0``) is replaced by
     its exact geom through :func:`_curved_support`: the exact geom lies inside the polytope
     (checked when packing), so S (from the polytope's vertices) still bounds its
     coordinates, and a lower bound on the distance of the exact geoms is what a
     certificate needs (the polytope only over-approximates them).
     """
-    sa0, na = gp.idx[I_VROW, ga], gp.idx[I_VROW, ga + 1] - gp.idx[I_VROW, ga]
-    sb0, nb = gp.idx[I_VROW, gb], gp.idx[I_VROW, gb + 1] - gp.idx[I_VROW, gb]
+    sa0, na = gp.vstart[ga], gp.vstart[ga + 1] - gp.vstart[ga]
+    sb0, nb = gp.vstart[gb], gp.vstart[gb + 1] - gp.vstart[gb]
     S = 0.0
     for i in range(na):
         for r in range(3):
-            x = (Ra[r, 0] * gp.rows[sa0 + i, 0] + Ra[r, 1] * gp.rows[sa0 + i, 1]
-                 + Ra[r, 2] * gp.rows[sa0 + i, 2])
+            x = (Ra[r, 0] * gp.verts[sa0 + i, 0] + Ra[r, 1] * gp.verts[sa0 + i, 1]
+                 + Ra[r, 2] * gp.verts[sa0 + i, 2])
             VA[i, r] = x
             S = max(S, abs(x))
     for i in range(nb):
         for r in range(3):
-            x = (Rb[r, 0] * gp.rows[sb0 + i, 0] + Rb[r, 1] * gp.rows[sb0 + i, 1]
-                 + Rb[r, 2] * gp.rows[sb0 + i, 2] + (pb[r] - pa[r]))
+            x = (Rb[r, 0] * gp.verts[sb0 + i, 0] + Rb[r, 1] * gp.verts[sb0 + i, 1]
+                 + Rb[r, 2] * gp.verts[sb0 + i, 2] + (pb[r] - pa[r]))
             VB[i, r] = x
             S = max(S, abs(x))
     pad = 2.0 * rel_pad * S + abs_pad
     tiny = 8.0 * 2.0**-53 * S
     tiny_len2 = (1e-14 * S) ** 2
     tiny_area2 = (1e-14 * S * S) ** 2
-    curved_a = gp.idx[I_CURVE, ga] > 0
-    curved_b = gp.idx[I_CURVE, gb] > 0
-    ra0, rb0 = gp.idx[I_GROW, ga], gp.idx[I_GROW, gb]     # the geoms' per-geom rows (G_*)
+    curved_a = gp.curve[ga] > 0
+    curved_b = gp.curve[gb] > 0
     zero = X[0]
     off_b = X[1]
     for r in range(3):
@@ -411,9 +388,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
             return best
         sv = math.sqrt(vv)
         if curved_a:
-            ia, sa = -1, -_curved_support(gp.idx[I_CURVE, ga], gp.rows[ra0 + G_CPARAM],
-                                          gp.rows[ra0 + G_CFRAME:ra0 + G_CFRAME + 3],
-                                          gp.rows[ra0 + G_CCENTER], Ra, zero, v, -1.0, xa)
+            ia, sa = -1, -_curved_support(gp.curve[ga], gp.cparam[ga], gp.cframe[ga], gp.ccenter[ga], Ra,
+                                          zero, v, -1.0, xa)
         else:
             ia, sa = 0, np.inf
             for i in range(na):
@@ -423,9 +399,8 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
             for r in range(3):
                 xa[r] = VA[ia, r]
         if curved_b:
-            ib, sb = -1, _curved_support(gp.idx[I_CURVE, gb], gp.rows[rb0 + G_CPARAM],
-                                         gp.rows[rb0 + G_CFRAME:rb0 + G_CFRAME + 3], gp.rows[rb0 + G_CCENTER],
-                                         Rb, off_b, v, 1.0, xb)
+            ib, sb = -1, _curved_support(gp.curve[gb], gp.cparam[gb], gp.cframe[gb], gp.ccenter[gb], Rb,
+                                         off_b, v, 1.0, xb)
         else:
             ib, sb = 0, -np.inf
             for i in range(nb):
@@ -475,7 +450,7 @@ def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad
 def _lever(P, ref, dist_out):
     """Max over the points P (n, 3) of a geom of |v - ref| (body frame), padded; dist_out[i] = |P_i - ref|.
 
-    Takes the geom's rows ``gp.rows[gp.idx[I_VROW, g]:gp.idx[I_VROW, g + 1]]`` (or its mass points), not the
+    Takes the geom's rows ``gp.verts[gp.vstart[g]:gp.vstart[g + 1]]`` (or its mass points), not the
     pack (compile cost). ``dist_out`` (n,) is :func:`_rel_terms`'s ``dP`` (issue 12, kernel cost).
     """
     lv = 0.0
@@ -547,38 +522,38 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     exactly), which is what ``body_bound`` would return; its pose is then not recomputed:
     the caller must have written it into (pA, RA) / (pB, RB) (:func:`pair_window` does).
     """
-    ba, bb = gp.idx[I_BODY, ga], gp.idx[I_BODY, gb]
+    ba, bb = gp.body[ga], gp.body[gb]
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
     mva, mvb = mp.body_moving[ba] != 0, mp.body_moving[bb] != 0
     if mva or mvb:
         TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws)
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
-    hsA, hsB = gp.idx[I_KIND, ga] == -1, gp.idx[I_KIND, gb] == -1
+    hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
     best = np.inf
     paper = False
     if not hsA and not hsB:
         best = TA + chA * levers[0] + TB + chB * levers[1]
     if not hsA:
-        PA = gp.rows[gp.idx[I_VROW, ga]:gp.idx[I_VROW, ga + 1]]
+        PA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
         d = _rel_terms(PA, dref[0], TA, chA, RA, pA, TB, chB, cB, RB, pB, gp.mw, 0.0)
         if d < best:
             best = d
-        M = gp.rows[gp.idx[I_MROW, ga]:gp.idx[I_MROW, ga + 1]]
-        W = gp.mw[gp.idx[I_MW, ga]:gp.idx[I_MW, ga + 1]]
-        d = _rel_terms(M, dref[1], TA, chA, RA, pA, TB, chB, cB, RB, pB, W, 1.0) * gp.scal[S_RHO_MAX, ga]
+        M = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
+        W = gp.mw[gp.mstart[ga]:gp.mstart[ga + 1]]
+        d = _rel_terms(M, dref[1], TA, chA, RA, pA, TB, chB, cB, RB, pB, W, 1.0) * gp.rho_max[ga]
         if d < best:
             best = d
             paper = True
     if not hsB:
-        PB = gp.rows[gp.idx[I_VROW, gb]:gp.idx[I_VROW, gb + 1]]
+        PB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
         d = _rel_terms(PB, dref[2], TB, chB, RB, pB, TA, chA, cA, RA, pA, gp.mw, 0.0)
         if d < best:
             best = d
             paper = False
-        M = gp.rows[gp.idx[I_MROW, gb]:gp.idx[I_MROW, gb + 1]]
-        W = gp.mw[gp.idx[I_MW, gb]:gp.idx[I_MW, gb + 1]]
-        d = _rel_terms(M, dref[3], TB, chB, RB, pB, TA, chA, cA, RA, pA, W, 1.0) * gp.scal[S_RHO_MAX, gb]
+        M = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
+        W = gp.mw[gp.mstart[gb]:gp.mstart[gb + 1]]
+        d = _rel_terms(M, dref[3], TB, chB, RB, pB, TA, chA, cA, RA, pA, W, 1.0) * gp.rho_max[gb]
         if d < best:
             best = d
             paper = True
@@ -715,36 +690,35 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     RA = np.empty((3, 3))
     RB = np.empty((3, 3))
     stats = np.zeros(1)
-    ka, kb = gp.idx[I_KIND, ga], gp.idx[I_KIND, gb]
-    if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
+    if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
     pws = pair_workspace(mp)
     times = mp.times
     cum = np.empty(times.shape[0])      # step control only (see _path_profile)
     _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum, mp.jnt_type, mp.jnt_qposadr,
-                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.idx[I_BODY, ga], gp.idx[I_BODY, gb], cum)
-    approx = gp.scal[S_APPROX, ga] + gp.scal[S_APPROX, gb]
+                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
+    approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
-    refA, refB = mp.ref_points[gp.idx[I_BODY, ga]], mp.ref_points[gp.idx[I_BODY, gb]]
-    PvA = gp.rows[gp.idx[I_VROW, ga]:gp.idx[I_VROW, ga + 1]]
-    PmA = gp.rows[gp.idx[I_MROW, ga]:gp.idx[I_MROW, ga + 1]]
-    PvB = gp.rows[gp.idx[I_VROW, gb]:gp.idx[I_VROW, gb + 1]]
-    PmB = gp.rows[gp.idx[I_MROW, gb]:gp.idx[I_MROW, gb + 1]]
+    refA, refB = mp.ref_points[gp.body[ga]], mp.ref_points[gp.body[gb]]
+    PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
+    PmA = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
+    PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
+    PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
     dref = (np.empty(PvA.shape[0]), np.empty(PmA.shape[0]), np.empty(PvB.shape[0]), np.empty(PmB.shape[0]))
     lv_a = _lever(PvA, refA, dref[0])
     _lever(PmA, refA, dref[1])
     lv_b = _lever(PvB, refB, dref[2])
     _lever(PmB, refB, dref[3])
-    if gp.idx[I_KIND, ga] != -1:
+    if gp.kind[ga] != -1:
         levers[0] = lv_a
-    if gp.idx[I_KIND, gb] != -1:
+    if gp.kind[gb] != -1:
         levers[1] = lv_b
-    lean = gp.idx[I_KIND, ga] >= 0 and gp.idx[I_KIND, gb] >= 0
-    rsum = gp.scal[S_RADIUS, ga] + gp.scal[S_RADIUS, gb]
-    VA = np.empty((max(gp.idx[I_VROW, ga + 1] - gp.idx[I_VROW, ga], 1), 3))
-    VB = np.empty((max(gp.idx[I_VROW, gb + 1] - gp.idx[I_VROW, gb], 1), 3))
+    lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
+    rsum = gp.radius[ga] + gp.radius[gb]
+    VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
+    VB = np.empty((max(gp.vstart[gb + 1] - gp.vstart[gb], 1), 3))
     W4 = np.zeros((4, 3))
     IA = np.zeros(4, np.int64)
     IB = np.zeros(4, np.int64)
@@ -758,10 +732,10 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     W = t1 - t0
     Lmin = W * 2.0**-max_depth
     # poses of bodies the motion does not move: constant, set once (see interval_bound)
-    if mp.body_moving[gp.idx[I_BODY, ga]] == 0:
-        body_pose(mp, gp.idx[I_BODY, ga], t0, pA, RA)
-    if mp.body_moving[gp.idx[I_BODY, gb]] == 0:
-        body_pose(mp, gp.idx[I_BODY, gb], t0, pB, RB)
+    if mp.body_moving[gp.body[ga]] == 0:
+        body_pose(mp, gp.body[ga], t0, pA, RA)
+    if mp.body_moving[gp.body[gb]] == 0:
+        body_pose(mp, gp.body[gb], t0, pB, RB)
     if res[R_STARTED] == 0.0 or res[R_STARTED] == 2.0:
         start_done = res[R_STARTED] == 2.0     # the caller ran the start-pose test already
         res[R_STARTED] = 1.0
@@ -774,8 +748,8 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         res[R_PAPER] = 0.0
         if not start_done:
             # start pose: exact static test at t0
-            body_pose(mp, gp.idx[I_BODY, ga], t0, pA, RA)
-            body_pose(mp, gp.idx[I_BODY, gb], t0, pB, RB)
+            body_pose(mp, gp.body[ga], t0, pA, RA)
+            body_pose(mp, gp.body[gb], t0, pB, RB)
             lo, up = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
             spent += 1
             res[R_TESTS] += 1.0
@@ -1133,7 +1107,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         # -- swept spheres and AABBs per geom (the argument of broadphase.swept_geom_spheres) --
         T = sc.shape[0]
         nbody = mp.body_parent.shape[0]
-        G = gp.scal.shape[1]
+        G = gp.kind.shape[0]
         pos = np.empty((T, nbody, 3))
         rot = np.empty((T, nbody, 3, 3))
         trans = np.empty((T, nbody))
@@ -1168,15 +1142,15 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             rq = np.empty(2)
             for k in range(pairs.shape[0]):
                 ga, gb = pairs[k, 0], pairs[k, 1]
-                both_fixed = fixed[gp.idx[I_BODY, ga]] != 0 and fixed[gp.idx[I_BODY, gb]] != 0
-                if both_fixed or gp.idx[I_KIND, ga] < 0 or gp.idx[I_KIND, gb] < 0:
+                both_fixed = fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0
+                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0:
                     all_open = False
                     break
                 for j in range(2):
                     g = ga if j == 0 else gb
-                    b = gp.idx[I_BODY, g]
-                    rad = gp.scal[S_BRAD, g]
-                    cg = gp.rows[gp.idx[I_GROW, g] + G_BCENTER]
+                    b = gp.body[g]
+                    rad = gp.brad[g]
+                    cg = gp.bcenter[g]
                     ref = mp.ref_points[b]
                     # the geom loop's sphere of sub-range tq, the same expressions
                     lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
@@ -1189,8 +1163,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     for r in range(3):
                         cq[j, r] = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + pos[tq, b, r]
                 d = (_norm3(cq[0, 0] - cq[1, 0], cq[0, 1] - cq[1, 1], cq[0, 2] - cq[1, 2]) - rq[0] - rq[1])
-                if not (gp.scal[S_BRAD, ga] < np.inf and gp.scal[S_BRAD, gb] < np.inf and d > -np.inf
-                        and d - padq <= margin):
+                if not (gp.brad[ga] < np.inf and gp.brad[gb] < np.inf and d > -np.inf and d - padq <= margin):
                     all_open = False
                     break
         if all_open:
@@ -1226,9 +1199,9 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             lo = np.empty((G, 3))
             hi = np.empty((G, 3))
             for g in range(G):
-                b = gp.idx[I_BODY, g]
-                rad = gp.scal[S_BRAD, g]
-                if gp.idx[I_KIND, g] < 0 or not rad < np.inf:
+                b = gp.body[g]
+                rad = gp.brad[g]
+                if gp.kind[g] < 0 or not rad < np.inf:
                     for t in range(T):
                         sr[t, g] = np.inf
                         for r in range(3):
@@ -1237,7 +1210,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         lo[g, r] = -np.inf
                         hi[g, r] = np.inf
                     continue
-                cg = gp.rows[gp.idx[I_GROW, g] + G_BCENTER]
+                cg = gp.bcenter[g]
                 ref = mp.ref_points[b]
                 lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
                 for r in range(3):
@@ -1265,11 +1238,11 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             best = np.inf
             for k in range(pairs.shape[0]):
                 ga, gb = pairs[k, 0], pairs[k, 1]
-                if fixed[gp.idx[I_BODY, ga]] != 0 and fixed[gp.idx[I_BODY, gb]] != 0:
+                if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
                     code[k] = WK_SS
                     gap[k] = np.inf
                     continue
-                ka, kb = gp.idx[I_KIND, ga], gp.idx[I_KIND, gb]
+                ka, kb = gp.kind[ga], gp.kind[gb]
                 gap[k] = np.nan
                 if ka < -1 or kb < -1 or (ka == -1 and kb == -1):
                     code[k] = WK_PYTHON
@@ -1278,8 +1251,8 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     continue
                 if ka == -1 or kb == -1:
                     h, c = (ga, gb) if ka == -1 else (gb, ga)
-                    g = _halfspace_gap(gp.rows[gp.idx[I_NROW, h]], gp.rows[gp.idx[I_VROW, h]],
-                                       gp.idx[I_BODY, h], c, sc, sr, trans, ang, rot, pos, pad)
+                    g = _halfspace_gap(gp.normals[gp.nstart[h]], gp.verts[gp.vstart[h]], gp.body[h], c, sc,
+                                       sr, trans, ang, rot, pos, pad)
                 else:
                     sep = -np.inf
                     scale = 1.0
@@ -1323,7 +1296,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         if code[k] != WK_OPEN:
             continue
         ga, gb = pairs[k, 0], pairs[k, 1]
-        ba, bb = gp.idx[I_BODY, ga], gp.idx[I_BODY, gb]
+        ba, bb = gp.body[ga], gp.body[gb]
         row = res[s]
         for j in range(R_SIZE):
             row[j] = 0.0
@@ -1334,7 +1307,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
         info[WI_TESTS] += 1.0
         row[R_START_LO] = lo_d
-        approx = gp.scal[S_APPROX, ga] + gp.scal[S_APPROX, gb]
+        approx = gp.approx[ga] + gp.approx[gb]
         if up_d + approx < margin:
             code[k] = WK_STATIC_VIOL
             row[R_VERDICT] = VIOLATION
@@ -1359,7 +1332,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         # windows): only the span from the first to the last sub-range where they are not goes
         # to the narrow phase (see the docstring: "Stage 1").
         ta_s, tb_s, sph = t0, t1, np.inf
-        if long_window and gp.idx[I_KIND, ga] >= 0 and gp.idx[I_KIND, gb] >= 0:
+        if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
             T = sc.shape[0]
             step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
             jf, jl = -1, -1

@@ -11,10 +11,7 @@ the Schröcker & Weber metric of its core (§2: feature points ``m_i`` and weigh
 core's vertices (rho is convex, so this is its maximum over the core).
 
 Everything is body frame, metres, float64 / int64 and C-contiguous, so a
-:class:`GeomPack` is a numba-typable tuple. It is stored as five stacked arrays (float rows
-of 3, per-geom float scalars, int64 offsets and codes, edges, metric weights) with named row
-constants (``I_*``, ``S_*``, ``G_*``): the compile cost of every kernel typed on the pack grows
-with the number of arrays in it (issue 12 item 7).
+:class:`GeomPack` is a numba-typable tuple.
 """
 
 from __future__ import annotations
@@ -35,147 +32,57 @@ _RHO_INFLATE = 1.0 + 1e-12
 """Upward relative inflation of rho_max (covers the float evaluation of eq. 4)."""
 
 
-# Columns of the stacked arrays (issue 12 item 7, docs/notes/issue-12-coldstart-3.md): the compiled
-# kernels index ``GeomPack.idx[I_*, g]``, ``GeomPack.scal[S_*, g]`` and the row ranges of ``GeomPack.rows``
-# directly (no accessor function: a compiled helper typed on the pack is one more compile).
-I_VROW = 0
-"""``idx`` row: first row of geom g's core vertices in ``rows`` (row G: end of the vertex block)."""
-I_EROW = 1
-"""``idx`` row: first row of geom g's edges in ``edges``."""
-I_NROW = 2
-"""``idx`` row: first row of geom g's face normals (half-space: its normal) in ``rows``."""
-I_MROW = 3
-"""``idx`` row: first row of geom g's metric feature points in ``rows``."""
-I_MW = 4
-"""``idx`` row: first entry of geom g's metric weights in ``mw``."""
-I_KIND = 5
-"""``idx`` row: kind code (0 point, 1 segment, 2 polytope, -1 half-space, -2 none)."""
-I_BODY = 6
-"""``idx`` row: body id of geom g."""
-I_CURVE = 7
-"""``idx`` row: exact curved geom behind a circumscribed polytope (0 none, 1 cylinder, 2 ellipsoid)."""
-I_GROW = 8
-"""``idx`` row: first of geom g's ``G_ROWS`` per-geom rows in ``rows`` (see ``G_*``)."""
-I_SIZE = 9
-
-S_RADIUS = 0
-"""``scal`` row: radius (m)."""
-S_OFFSET = 1
-"""``scal`` row: half-space offset (m; 0 otherwise)."""
-S_DPAD = 2
-"""``scal`` row: depth pad of the face normals (m; inf: no depth certificate)."""
-S_APPROX = 3
-"""``scal`` row: over-approximation ``approx_error`` (m)."""
-S_RHO_MAX = 4
-"""``scal`` row: max of rho over the core vertices (eq. 4), padded up."""
-S_BRAD = 5
-"""``scal`` row: radius (m) of the bounding sphere (inf for half-spaces and geoms without a shape)."""
-S_SIZE = 6
-
-G_CPARAM = 0
-"""Per-geom row offset: cylinder (radius, half length, 0) / ellipsoid radii (m)."""
-G_CCENTER = 1
-"""Per-geom row offset: geom origin of the curved geom in the body frame (m)."""
-G_BCENTER = 2
-"""Per-geom row offset: centre of the bounding sphere, body frame (m)."""
-G_CFRAME = 3
-"""Per-geom row offset: 3 rows, rotation geom frame -> body frame of the curved geom."""
-G_ROWS = 6
-
-
 class GeomPack(NamedTuple):
-    """G geoms stacked into five arrays (numba-typable; few arrays = cheap compiles, issue 12 item 7).
+    """Flat arrays of G geoms (numba-typable).
 
     Attributes:
-        rows: (R, 3) float64 rows, body frames (m): the core vertices of all geoms, then their
-            face normals (half-spaces: the plane normal), then their metric feature points,
-            then ``G_ROWS`` rows per geom (``G_CPARAM``, ``G_CCENTER``, ``G_BCENTER``, the 3
-            rows of ``G_CFRAME``).
-        idx: (I_SIZE, G + 1) int64: row ranges (``I_VROW``, ``I_EROW``, ``I_NROW``, ``I_MROW``,
-            ``I_MW``: geom g's rows are ``[idx[i, g], idx[i, g + 1])``) and the per-geom codes
-            ``I_KIND``, ``I_BODY``, ``I_CURVE``, ``I_GROW`` (column G: 0).
-        scal: (S_SIZE, G) float64 per-geom scalars (``S_*``).
+        verts: (V, 3) core vertices of all geoms, body frame (m).
+        vstart: (G + 1,) int64 offsets into ``verts``.
         edges: (E, 2) int64 edges, vertex indices local to the geom.
-        mw: (M,) float64 metric weights.
-
-    The properties give the former per-field arrays (views; Python callers and tests):
-    ``verts``, ``vstart``, ``edges``, ``estart``, ``normals``, ``nstart``, ``kind``, ``radius``,
-    ``offset``, ``dpad``, ``approx``, ``body``, ``mpts``, ``mw``, ``mstart``, ``rho_max``,
-    ``curve``, ``cparam``, ``cframe``, ``ccenter``, ``bcenter``, ``brad`` (meanings as in
-    :func:`pack_shapes`).
+        estart: (G + 1,) int64 offsets into ``edges``.
+        normals: (N, 3) face normals (polytopes) / the plane normal (half-spaces).
+        nstart: (G + 1,) int64 offsets into ``normals``.
+        kind: (G,) int64 kind code (0 point, 1 segment, 2 polytope, -1 half-space, -2 none).
+        radius: (G,) radius (m).
+        offset: (G,) half-space offset (m; 0 otherwise).
+        dpad: (G,) depth pad of the face normals (m; inf: no depth certificate).
+        approx: (G,) over-approximation ``approx_error`` (m).
+        body: (G,) int64 body id of each geom.
+        mpts: (M, 3) metric feature points of all geoms (body frame, m).
+        mw: (M,) their weights.
+        mstart: (G + 1,) int64 offsets into ``mpts``.
+        rho_max: (G,) max of rho over the core vertices (1/m units of eq. 4), padded up.
+        curve: (G,) int64 exact curved geom behind a circumscribed polytope: 0 none,
+            1 cylinder (axis z of its frame), 2 ellipsoid.
+        cparam: (G, 3) cylinder (radius, half length, 0) / ellipsoid radii (m).
+        cframe: (G, 3, 3) rotation geom frame -> body frame of the curved geom.
+        ccenter: (G, 3) geom origin in the body frame (m).
+        bcenter: (G, 3) centre of a sphere containing the geom (core + radius), body frame (m).
+        brad: (G,) its radius (m); inf for half-spaces and geoms without a shape.
     """
 
-    rows: np.ndarray
-    idx: np.ndarray
-    scal: np.ndarray
+    verts: np.ndarray
+    vstart: np.ndarray
     edges: np.ndarray
+    estart: np.ndarray
+    normals: np.ndarray
+    nstart: np.ndarray
+    kind: np.ndarray
+    radius: np.ndarray
+    offset: np.ndarray
+    dpad: np.ndarray
+    approx: np.ndarray
+    body: np.ndarray
+    mpts: np.ndarray
     mw: np.ndarray
-
-    def _block(self, i: int) -> np.ndarray:
-        return self.rows[self.idx[i, 0]:self.idx[i, -1]]
-
-    def _start(self, i: int) -> np.ndarray:
-        return self.idx[i] - self.idx[i, 0]
-
-    def _per_geom(self, k: int, n: int = 1) -> np.ndarray:
-        G = self.scal.shape[1]
-        g0 = self.idx[I_GROW, 0] if G else 0
-        per = self.rows[g0:g0 + G_ROWS * G].reshape(G, G_ROWS, 3)
-        return per[:, k] if n == 1 else per[:, k:k + n]
-
-    verts = property(lambda self: self._block(I_VROW), doc="(V, 3) core vertices (body frame, m).")
-    vstart = property(lambda self: self._start(I_VROW), doc="(G + 1,) offsets into ``verts``.")
-    estart = property(lambda self: self.idx[I_EROW], doc="(G + 1,) offsets into ``edges``.")
-    normals = property(lambda self: self._block(I_NROW), doc="(N, 3) face normals / half-space normals.")
-    nstart = property(lambda self: self._start(I_NROW), doc="(G + 1,) offsets into ``normals``.")
-    mpts = property(lambda self: self._block(I_MROW), doc="(M, 3) metric feature points (body frame, m).")
-    mstart = property(lambda self: self.idx[I_MW], doc="(G + 1,) offsets into ``mpts`` / ``mw``.")
-    kind = property(lambda self: self.idx[I_KIND, :-1], doc="(G,) int64 kind code.")
-    body = property(lambda self: self.idx[I_BODY, :-1], doc="(G,) int64 body id.")
-    curve = property(lambda self: self.idx[I_CURVE, :-1], doc="(G,) int64 curved geom code.")
-    radius = property(lambda self: self.scal[S_RADIUS], doc="(G,) radius (m).")
-    offset = property(lambda self: self.scal[S_OFFSET], doc="(G,) half-space offset (m).")
-    dpad = property(lambda self: self.scal[S_DPAD], doc="(G,) depth pad of the face normals (m).")
-    approx = property(lambda self: self.scal[S_APPROX], doc="(G,) ``approx_error`` (m).")
-    rho_max = property(lambda self: self.scal[S_RHO_MAX], doc="(G,) max of rho (eq. 4), padded up.")
-    brad = property(lambda self: self.scal[S_BRAD], doc="(G,) bounding sphere radius (m).")
-    cparam = property(lambda self: self._per_geom(G_CPARAM), doc="(G, 3) curved geom parameters (m).")
-    ccenter = property(lambda self: self._per_geom(G_CCENTER), doc="(G, 3) curved geom origin (m).")
-    bcenter = property(lambda self: self._per_geom(G_BCENTER), doc="(G, 3) bounding sphere centre (m).")
-    cframe = property(lambda self: self._per_geom(G_CFRAME, 3), doc="(G, 3, 3) curved geom frame.")
-
-
-def _stack(verts: np.ndarray, vstart: np.ndarray, edges: np.ndarray, estart: np.ndarray, normals: np.ndarray,
-           nstart: np.ndarray, mpts: np.ndarray, mw: np.ndarray, mstart: np.ndarray, codes: dict,
-           scalars: dict, per_geom: dict) -> GeomPack:
-    """The five stacked arrays of :class:`GeomPack` from the per-field arrays (values copied exactly)."""
-    G = vstart.shape[0] - 1
-    V, N, M = verts.shape[0], normals.shape[0], mpts.shape[0]
-    rows = np.empty((V + N + M + G_ROWS * G, 3), np.float64)
-    rows[:V] = verts
-    rows[V:V + N] = normals
-    rows[V + N:V + N + M] = mpts
-    per = rows[V + N + M:].reshape(G, G_ROWS, 3)
-    per[:, G_CPARAM] = per_geom["cparam"]
-    per[:, G_CCENTER] = per_geom["ccenter"]
-    per[:, G_BCENTER] = per_geom["bcenter"]
-    per[:, G_CFRAME:G_CFRAME + 3] = per_geom["cframe"]
-    idx = np.zeros((I_SIZE, G + 1), np.int64)
-    idx[I_VROW] = vstart
-    idx[I_EROW] = estart
-    idx[I_NROW] = V + nstart
-    idx[I_MROW] = V + N + mstart
-    idx[I_MW] = mstart
-    idx[I_KIND, :G] = codes["kind"]
-    idx[I_BODY, :G] = codes["body"]
-    idx[I_CURVE, :G] = codes["curve"]
-    idx[I_GROW, :G] = V + N + M + G_ROWS * np.arange(G)
-    scal = np.empty((S_SIZE, G), np.float64)
-    for k, name in ((S_RADIUS, "radius"), (S_OFFSET, "offset"), (S_DPAD, "dpad"), (S_APPROX, "approx"),
-                    (S_RHO_MAX, "rho_max"), (S_BRAD, "brad")):
-        scal[k] = scalars[name]
-    return GeomPack(rows, idx, scal, np.ascontiguousarray(edges, np.int64),
-                    np.ascontiguousarray(mw, np.float64))
+    mstart: np.ndarray
+    rho_max: np.ndarray
+    curve: np.ndarray
+    cparam: np.ndarray
+    cframe: np.ndarray
+    ccenter: np.ndarray
+    bcenter: np.ndarray
+    brad: np.ndarray
 
 
 CURVE_NONE = 0
@@ -322,16 +229,18 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
         MP.append(mp_)
         MW.append(mw_)
         rho_max.append(rho_)
-    return _stack(
-        _cat(V, 3, np.float64), _starts([len(v) for v in V]), _cat(E, 2, np.int64),
-        _starts([len(e) for e in E]),
-        _cat(N, 3, np.float64), _starts([len(n) for n in N]), _cat(MP, 3, np.float64),
-        np.concatenate(MW) if MW else np.zeros(0), _starts([len(m) for m in MP]),
-        codes=dict(kind=np.asarray(kind, np.int64), body=bodies, curve=curve),
-        scalars=dict(radius=np.asarray(radius, np.float64), offset=np.asarray(offset, np.float64),
-                     dpad=np.asarray(dpad, np.float64), approx=np.asarray(approx, np.float64),
-                     rho_max=np.asarray(rho_max, np.float64), brad=brad),
-        per_geom=dict(cparam=cparam, ccenter=ccenter, bcenter=bcenter, cframe=cframe))
+    return GeomPack(
+        verts=_cat(V, 3, np.float64), vstart=_starts([len(v) for v in V]),
+        edges=_cat(E, 2, np.int64), estart=_starts([len(e) for e in E]),
+        normals=_cat(N, 3, np.float64), nstart=_starts([len(n) for n in N]),
+        kind=np.asarray(kind, np.int64), radius=np.asarray(radius, np.float64),
+        offset=np.asarray(offset, np.float64), dpad=np.asarray(dpad, np.float64),
+        approx=np.asarray(approx, np.float64), body=np.ascontiguousarray(bodies),
+        mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
+        mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
+        curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
+        ccenter=np.ascontiguousarray(ccenter), bcenter=np.ascontiguousarray(bcenter),
+        brad=np.ascontiguousarray(brad))
 
 
 class ScenePack(NamedTuple):
