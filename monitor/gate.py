@@ -756,7 +756,7 @@ class StepReport:
 
 
 def _all_culled(cert: Certificate) -> int | None:
-    """The number of pairs if every one of them was decided by the broad phase, else None.
+    """The number of pairs if every one of them was decided by the broad phase (0: no pair), else None.
 
     From the certificate's documented stats (``pairs``: the pair count; ``checker_mix``:
     ``{method: count}``), without building its :class:`PairResult` tuple (the engine builds
@@ -767,7 +767,8 @@ def _all_culled(cert: Certificate) -> int | None:
     stats = cert.stats
     n = stats.get("pairs")
     mix = stats.get("checker_mix")
-    if type(n) is int and n > 0 and type(mix) is dict and len(mix) == 1 and mix.get("culled") == n:
+    if type(n) is int and type(mix) is dict and (mix.get("culled") == n > 0 and len(mix) == 1
+                                                 or n == 0 and not mix):  # 0 pairs: nothing to build
         return n
     return None
 
@@ -1175,6 +1176,7 @@ class Gate:
         self._joint_hint = True  # try the joint window + tail call (see decide)
         self._joint_witness: Any = None  # the last failed joint call's witness inside the tail, or None
         self._plain: tuple[CertifyRequest, CertifyRequest] | None = None  # (request, its plain copy)
+        self._nothing_template: tuple[Any, ...] | None = None  # see _certify_nothing
         self._call_request: CertifyRequest | None = None  # set during the joint call (see _certify)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
@@ -1418,6 +1420,58 @@ class Gate:
         self.stats["reused_pairs"] += len(reused)
         self.stats["pairs"] += _npairs(cert)
         return cert, us
+
+    def _certify_nothing(self, win: _WindowRows) -> tuple[Certificate, float] | None:
+        """:meth:`_certify` of the rollout's window when the scene has no candidate pair, without a Plan.
+
+        ``certify`` of such a scene checks its arguments and returns its "nothing to check"
+        certificate (``stats["nothing_checked"]``, 0 pairs, verdict ``"certified"``, the
+        request's ``method``); this makes the same certificate from the window's rows (to_dict
+        equal field for field but ``wall_seconds``; ``tests/test_gate_plumbing.py`` compares
+        them) and the same request, without building the window's Plan. The Plan is built
+        only when something reads it (a log, :attr:`StepReport.plan`).
+
+        The input checks of the Plan and of ``certify`` stay: the window's times finite and
+        strictly increasing (so ``t1 > t0``, both finite), its qpos and the held mocap poses
+        finite. Anything else (a failed check, whose typed error and message the Plan gives;
+        a model with ball / free joints or mocap bodies, whose quaternion norms the Plan
+        validates; a setting that calls for more) returns None: the caller certifies the
+        Plan as before. The scene is the gate's own, synced by :meth:`decide`, and the rows
+        come from the live model, so ``certify``'s model checks hold by construction.
+
+        Args:
+            win: the window's rows (:meth:`Rollout._window`).
+
+        Returns:
+            (certificate, µs) or None.
+        """
+        t_start = time.perf_counter()
+        m = self.model
+        if m.nq != m.nv or m.nmocap or self._call_request is not None:
+            return None  # quaternions to validate (nq != nv: a ball or free joint), or a joint call
+        rows = win.rows
+        times = rows[:, 0]
+        if not ((times[1:] > times[:-1]).all() and -math.inf < times[0] and times[-1] < math.inf
+                and float(np.abs(rows[:, 1:]).max(initial=0.0)) < math.inf):
+            return None  # the Plan raises with its message
+        req = self.request
+        allowed = self.scene.allowed_pairs
+        hit = self._nothing_template
+        if hit is None or hit[0] is not req or hit[1] is not allowed:
+            # built by the constructor once per (request, allowed pairs); each window gets a copy
+            template = Certificate("certified", (0.0, 0.0), req.margin, req.epsilon, req.method.value, None,
+                                   None, math.inf, (), {},
+                                   allowed if type(allowed) is tuple else tuple(allowed))
+            template.__dict__["request"] = req
+            hit = self._nothing_template = (req, allowed, template)
+        cert = object.__new__(Certificate)  # = copy.copy(template): a dataclass's state is its __dict__
+        state = cert.__dict__
+        state.update(hit[2].__dict__)
+        state["window"] = (float(times[0]), float(times[-1]))
+        state["stats"] = {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
+                          "wall_seconds": time.perf_counter() - t_start, "checker_mix": {},
+                          "budget_exhausted": False, "nothing_checked": True}
+        return cert, (time.perf_counter() - t_start) * 1e6
 
     def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,
                        mocap_pos: np.ndarray, mocap_quat: np.ndarray
@@ -1787,7 +1841,9 @@ class Gate:
             cert, tail_cert, us = joint
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
         else:  # today's two calls (also after a joint call that did not certify)
-            cert, us = self._certify(_plan_of(plan))
+            nothing = (self._certify_nothing(plan) if own_predictor and not self.scene.candidate_pairs
+                       else None)  # no candidate pair: certify's own trivial certificate, no Plan
+            cert, us = nothing if nothing is not None else self._certify(_plan_of(plan))
             unsafe = self.is_unsafe(cert.verdict)
             brake_verdict = ""
             if tail is None:
