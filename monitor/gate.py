@@ -1438,6 +1438,8 @@ class Gate:
         validates; a setting that calls for more) returns None: the caller certifies the
         Plan as before. The scene is the gate's own, synced by :meth:`decide`, and the rows
         come from the live model, so ``certify``'s model checks hold by construction.
+        :meth:`decide` uses it only where :meth:`_certify` is this class's own (a replaced
+        ``_certify``, e.g. a test's stub checker, is called as before).
 
         Args:
             win: the window's rows (:meth:`Rollout._window`).
@@ -1842,7 +1844,8 @@ class Gate:
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
         else:  # today's two calls (also after a joint call that did not certify)
             nothing = (self._certify_nothing(plan) if own_predictor and not self.scene.candidate_pairs
-                       else None)  # no candidate pair: certify's own trivial certificate, no Plan
+                       and "_certify" not in self.__dict__ and type(self)._certify is Gate._certify
+                       else None)  # no candidate pair: _certify's own trivial certificate, no Plan
             cert, us = nothing if nothing is not None else self._certify(_plan_of(plan))
             unsafe = self.is_unsafe(cert.verdict)
             brake_verdict = ""

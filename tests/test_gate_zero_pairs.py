@@ -48,26 +48,28 @@ def _without_wall(d: dict) -> dict:
 
 
 @pytest.mark.parametrize("brake", [True, False])
-def test_zero_pair_certificates_are_certifys_own(brake):
+def test_zero_pair_certificates_are_certifys_own(brake, monkeypatch):
     """Every step's certificate equals certify(scene, window plan, request=gate.request) field
     for field (but wall time), carries the gate's request and says "nothing_checked"; no
     certify call and no Plan until a reader asks for one."""
+    import monitor.certify.engine as engine
+
     m, gate = _gate(brake=brake, frame_skip=3)
     d = mujoco.MjData(m)
     rng = np.random.default_rng(5)
     calls = []
-    orig = gate._certify
-    gate._certify = lambda plan: calls.append(plan) or orig(plan)
+    real = engine.certify
+    monkeypatch.setattr(engine, "certify", lambda *a, **k: calls.append(a) or real(*a, **k))
     for _ in range(12):
         r = gate.step(d, rng.uniform(-1.0, 1.0, m.nu))
         assert r.__dict__["_plan_store"]._plan is None  # the window's rows; no Plan built yet
         cert = r.certificate
-        oracle = certify(gate.scene, r.plan, request=gate.request)
+        oracle = real(gate.scene, r.plan, request=gate.request)
         assert _without_wall(cert.to_dict()) == _without_wall(oracle.to_dict())
         assert cert.request is gate.request and cert.stats["nothing_checked"] is True
         assert str(cert.method) == "auto" and cert.pairs == () and cert.certified
         assert r.info()["monitored_pairs"] == 0 and r.info()["checker_mix"] == ""
-    assert calls == []  # the trivial certificate never went through _certify
+    assert calls == []  # the trivial certificate: no certify call
     assert gate.stats["windows"] == 12 and gate.stats["pairs"] == 0
 
 
@@ -153,3 +155,20 @@ def test_zero_pair_log_has_one_record_per_window(tmp_path):
     assert len(certs) == 5
     assert all(c["verdict"] == "certified" and c["stats"]["nothing_checked"] and c["pairs"] == []
                for c in certs)
+
+
+def test_a_replaced_certify_is_still_called_on_a_zero_pair_gate():
+    """A gate whose _certify was replaced (a stub checker) keeps getting its verdicts: the
+    shortcut stands only for Gate._certify's own result."""
+    from monitor.certify.certificate import Certificate
+
+    m, gate = _gate()
+    seen = []
+
+    def stub(plan):
+        seen.append(plan.t0)
+        return Certificate("violation", plan.window, 0.0, 1e-3, "auto", None, plan.t0, -np.inf), 1.0
+
+    gate._certify = stub
+    r = gate.step(mujoco.MjData(m), np.zeros(m.nu))
+    assert seen and r.verdict == "violation" and r.replaced
