@@ -1,6 +1,6 @@
 """Plain-timer split of a gated step: exclusive thread time per wrapped function (us per step).
 
-usage: PYTHONPATH=<tree> python excl.py tunnel|Pusher-v5|monitor/Arm-v0|Reacher-v5 STEPS
+usage: PYTHONPATH=<tree> python excl.py tunnel|Pusher-v5|monitor/Arm-v0|Reacher-v5 STEPS [--pack]
 Each wrapped function's time excludes the wrapped functions it calls (a stack of timers);
 "rest" = the step minus every wrapped function. The timers add ~1 us per wrapped call.
 """
@@ -58,6 +58,13 @@ wrap(G, "hold_ctrl")
 wrap(G.StepReport, "info", "StepReport.info")
 for name in ("step", "_commit_sim", "_check_window_ran", "_check_applied_ctrl", "_check_geometry", "_as_inner"):
     wrap(GG.SafetyGate, name, "SafetyGate." + name)
+if "--pack" in sys.argv:  # the motion pack's parts inside certify (booked apart from "certify")
+    import monitor.certify.kernels as KS
+    import monitor.motion.pack as MP
+    KS.trajectory_pack_memo = timed("pack: trajectory_pack_memo", KS.trajectory_pack_memo)
+    KS._pack_agrees = timed("pack: _pack_agrees", KS._pack_agrees)
+    MP.pack_trajectory = timed("pack: pack_trajectory", MP.pack_trajectory)
+    wrap(Plan, "body_poses", "Plan.body_poses")
 _tr = Plan.__dict__["_trusted"].__func__
 Plan._trusted = classmethod(timed("Plan._trusted", _tr))
 mujoco.mj_step = timed("mj_step", _mj_step)
