@@ -26,7 +26,8 @@ def _key(r):
 
     info = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in sorted(r.info().items())}
     return repr((str(r.verdict), r.replaced, str(r.applied_verdict), r.fallback_certified, r.time,
-                 np.asarray(r.applied_ctrl).tobytes(), cert(r.certificate), cert(r.fallback_certificate), info))
+                 np.asarray(r.applied_ctrl).tobytes(), cert(r.certificate), cert(r.fallback_certificate),
+                 info))
 
 
 def _run(static: bool, steps: int = 150):
