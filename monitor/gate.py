@@ -1433,6 +1433,14 @@ class Gate:
         self.stats["pairs"] += _npairs(cert)
         return cert, us
 
+    def _certify_is_own(self) -> bool:
+        """Whether :meth:`_certify` is this module's own (not replaced on the instance or the class).
+
+        :meth:`_certify_nothing` and :meth:`_certify_static` stand for its result; a replaced
+        ``_certify`` (a test's stub checker or spy) is called as before.
+        """
+        return "_certify" not in self.__dict__ and type(self)._certify is _GATE_CERTIFY
+
     def _certify_nothing(self, win: _WindowRows) -> tuple[Certificate, float] | None:
         """:meth:`_certify` of the rollout's window when the scene has no candidate pair, without a Plan.
 
@@ -1450,8 +1458,7 @@ class Gate:
         validates; a setting that calls for more) returns None: the caller certifies the
         Plan as before. The scene is the gate's own, synced by :meth:`decide`, and the rows
         come from the live model, so ``certify``'s model checks hold by construction.
-        :meth:`decide` uses it only where :meth:`_certify` is this class's own (a replaced
-        ``_certify``, e.g. a test's stub checker, is called as before).
+        :meth:`decide` uses it only where :meth:`_certify_is_own`.
 
         Args:
             win: the window's rows (:meth:`Rollout._window`).
@@ -1504,7 +1511,8 @@ class Gate:
         when every pair is reused (the same cache reads, merged certificate, cache writes
         and counters). Anything else returns None (the caller runs :meth:`_certify`): no
         memo for these rows, another context (:meth:`_certify` empties the cache), or a
-        pair whose cached result does not match (it must be certified).
+        pair whose cached result does not match (it must be certified). :meth:`decide` uses
+        it only where :meth:`_certify_is_own`.
 
         Args:
             win: the window's rows (:meth:`Rollout._window`).
@@ -1926,8 +1934,7 @@ class Gate:
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
         else:  # today's two calls (also after a joint call that did not certify)
             nothing = (self._certify_nothing(plan) if own_predictor and not self.scene.candidate_pairs
-                       and "_certify" not in self.__dict__ and type(self)._certify is Gate._certify
-                       else None)  # no candidate pair: _certify's own trivial certificate, no Plan
+                       and self._certify_is_own() else None)  # no pair: _certify's own trivial certificate
             cert, us = nothing if nothing is not None else self._certify(_plan_of(plan))
             unsafe = self.is_unsafe(cert.verdict)
             brake_verdict = ""
@@ -1980,7 +1987,7 @@ class Gate:
                 fb_cert = covered
                 applied_plan = None
                 self.stats["tail_reused"] += 1
-            elif own_predictor and "_certify" not in self.__dict__ and type(self)._certify is Gate._certify:
+            elif own_predictor and self._certify_is_own():
                 # the rows of predict(applied); the Plan built only when the cache cannot answer
                 win = _WindowRows(self._rollout._window(data, applied, n), self.model, data)
                 got = self._certify_static(win)  # a window with nothing moving: from the cache, no Plan
@@ -2191,5 +2198,8 @@ class Gate:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+
+_GATE_CERTIFY = Gate._certify
+"""The :meth:`Gate._certify` this module defines (see :meth:`Gate._certify_is_own`)."""
 
 __all__ = ["Gate", "StepReport", "Rollout", "hold_ctrl", "safety_info", "ON_VIOLATION", "UNSAFE"]
