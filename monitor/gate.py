@@ -1447,17 +1447,18 @@ class Gate:
         ``certify`` of such a scene checks its arguments and returns its "nothing to check"
         certificate (``stats["nothing_checked"]``, 0 pairs, verdict ``"certified"``, the
         request's ``method``); this makes the same certificate from the window's rows (to_dict
-        equal field for field but ``wall_seconds``; ``tests/test_gate_plumbing.py`` compares
+        equal field for field but ``wall_seconds``; ``tests/test_gate_zero_pairs.py`` compares
         them) and the same request, without building the window's Plan. The Plan is built
         only when something reads it (a log, :attr:`StepReport.plan`).
 
-        The input checks of the Plan and of ``certify`` stay: the window's times finite and
-        strictly increasing (so ``t1 > t0``, both finite), its qpos and the held mocap poses
-        finite. Anything else (a failed check, whose typed error and message the Plan gives;
-        a model with ball / free joints or mocap bodies, whose quaternion norms the Plan
-        validates; a setting that calls for more) returns None: the caller certifies the
-        Plan as before. The scene is the gate's own, synced by :meth:`decide`, and the rows
-        come from the live model, so ``certify``'s model checks hold by construction.
+        The input checks of the Plan and of ``certify`` stay: the window's times and qpos
+        finite (their sum is: a NaN or inf entry makes it NaN or inf; a sum that overflows
+        is declined too) and the times strictly increasing (so ``t1 > t0``). Anything else (a
+        failed check, whose typed error and message the Plan gives; a model with ball / free
+        joints or mocap bodies, whose quaternion norms and mocap poses the Plan validates; the
+        joint call's request) returns None: the caller certifies the Plan as before. The scene
+        is the gate's own, synced by :meth:`decide`, and the rows come from the live model, so
+        ``certify``'s model checks hold by construction.
         :meth:`decide` uses it only where :meth:`_certify_is_own`.
 
         Args:
@@ -1471,10 +1472,11 @@ class Gate:
         if m.nq != m.nv or m.nmocap or self._call_request is not None:
             return None  # quaternions to validate (nq != nv: a ball or free joint), or a joint call
         rows = win.rows
-        times = rows[:, 0]
-        if not ((times[1:] > times[:-1]).all() and -math.inf < times[0] and times[-1] < math.inf
-                and float(np.abs(rows[:, 1:]).max(initial=0.0)) < math.inf):
+        if not math.isfinite(float(rows.sum())):  # a NaN / inf time or qpos (or a sum that overflows)
             return None  # the Plan raises with its message
+        times = rows[:, 0].tolist()
+        if not all(a < b for a, b in zip(times, times[1:])):
+            return None  # not strictly increasing: the Plan raises with its message
         req = self.request
         allowed = self.scene.allowed_pairs
         hit = self._nothing_template
@@ -1488,7 +1490,7 @@ class Gate:
         cert = object.__new__(Certificate)  # = copy.copy(template): a dataclass's state is its __dict__
         state = cert.__dict__
         state.update(hit[2].__dict__)
-        state["window"] = (float(times[0]), float(times[-1]))
+        state["window"] = (times[0], times[-1])  # Python floats, as the Plan's t0 / t1
         state["stats"] = {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                           "wall_seconds": time.perf_counter() - t_start, "checker_mix": {},
                           "budget_exhausted": False, "nothing_checked": True}
