@@ -1441,6 +1441,15 @@ class Gate:
         """
         return "_certify" not in self.__dict__ and type(self)._certify is _GATE_CERTIFY
 
+    def _rows_are_plan_qpos(self) -> bool:
+        """Whether a window's Plan has its rows' qpos bit for bit and no mocap pose.
+
+        True when the model has no ball / free joint (``nq == nv``: no quaternion the Plan
+        normalises) and no mocap body (no mocap pose it normalises and validates).
+        """
+        m = self.model
+        return m.nq == m.nv and not m.nmocap
+
     def _certify_nothing(self, win: _WindowRows) -> tuple[Certificate, float] | None:
         """:meth:`_certify` of the rollout's window when the scene has no candidate pair, without a Plan.
 
@@ -1468,9 +1477,8 @@ class Gate:
             (certificate, µs) or None.
         """
         t_start = time.perf_counter()
-        m = self.model
-        if m.nq != m.nv or m.nmocap or self._call_request is not None:
-            return None  # quaternions to validate (nq != nv: a ball or free joint), or a joint call
+        if not self._rows_are_plan_qpos() or self._call_request is not None:
+            return None  # quaternions or mocap poses to validate, or a joint call
         rows = win.rows
         if not math.isfinite(float(rows.sum())):  # a NaN / inf time or qpos (or a sum that overflows)
             return None  # the Plan raises with its message
@@ -1556,8 +1564,7 @@ class Gate:
         rows' own bytes).
         """
         last, self._last_static = self._last_static, None
-        m = self.model
-        if last is None or last[0] is not plan or m.nq != m.nv or m.nmocap:
+        if last is None or last[0] is not plan or not self._rows_are_plan_qpos():
             return
         context = self._cache_context
         memo = self._static_keys

@@ -73,31 +73,10 @@ mujoco.mj_copyData = timed("mj_copyData", _mj_copy)
 G.mujoco = mujoco
 
 ensure_warm()
-if work == "tunnel":
-    from monitor.bench.targets import _scene_file
-    model = mujoco.MjModel.from_xml_path(str(_scene_file("tunnel")))
-    gate = G.Gate(model, margin=0.001)
-    d = mujoco.MjData(model)
+sys.path.insert(0, __file__.rsplit("/", 1)[0])
+from runners import runner  # noqa: E402
 
-    def run(n):
-        mujoco.mj_resetDataKeyframe(model, d, 0)
-        gate.reset()
-        for k in range(n):
-            target = 0.3 if (k // 100) % 2 == 0 else -0.3
-            gate.step(d, np.clip([12.0 * (target - d.qpos[0])], -6.0, 6.0), nstep=1)
-else:
-    import gymnasium as gym
-    import monitor.envs  # noqa: F401
-    env = GG.SafetyGate(gym.make(work))
-
-    def run(n):
-        env.reset(seed=0)
-        env.action_space.seed(0)
-        acts = [env.action_space.sample() for _ in range(n)]
-        for a in acts:
-            _, _, te, tr, _ = env.step(a)
-            if te or tr:
-                env.reset()
+run = runner(work)
 run(20)
 T.clear()
 C.clear()
