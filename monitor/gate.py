@@ -615,6 +615,16 @@ class _WindowRows:
         """(K,) waypoint times (s): a read-only view of the rows."""
         return self.rows[:, 0]
 
+    @property
+    def t0(self) -> float:
+        """Window start (s), as the Plan's ``t0``."""
+        return float(self.rows[0, 0])
+
+    @property
+    def t1(self) -> float:
+        """Window end (s), as the Plan's ``t1``."""
+        return float(self.rows[-1, 0])
+
 
 def _plan_of(p: Any) -> Any:
     """A Plan from a Plan or a :class:`_WindowRows`."""
@@ -756,7 +766,7 @@ class StepReport:
 
 
 def _all_culled(cert: Certificate) -> int | None:
-    """The number of pairs if every one of them was decided by the broad phase, else None.
+    """The number of pairs if every one of them was decided by the broad phase (0: no pair), else None.
 
     From the certificate's documented stats (``pairs``: the pair count; ``checker_mix``:
     ``{method: count}``), without building its :class:`PairResult` tuple (the engine builds
@@ -767,7 +777,8 @@ def _all_culled(cert: Certificate) -> int | None:
     stats = cert.stats
     n = stats.get("pairs")
     mix = stats.get("checker_mix")
-    if type(n) is int and n > 0 and type(mix) is dict and len(mix) == 1 and mix.get("culled") == n:
+    if type(n) is int and type(mix) is dict and (mix.get("culled") == n > 0 and len(mix) == 1
+                                                 or n == 0 and not mix):  # 0 pairs: nothing to build
         return n
     return None
 
@@ -1175,6 +1186,9 @@ class Gate:
         self._joint_hint = True  # try the joint window + tail call (see decide)
         self._joint_witness: Any = None  # the last failed joint call's witness inside the tail, or None
         self._plain: tuple[CertifyRequest, CertifyRequest] | None = None  # (request, its plain copy)
+        self._nothing_template: tuple[Any, ...] | None = None  # see _certify_nothing
+        self._static_keys: tuple[Any, dict[bytes, dict[int, bytes]]] | None = None  # see _certify_static
+        self._last_static: tuple[Any, dict[int, bytes]] | None = None  # (plan, keys): _split_reuse, all fixed
         self._call_request: CertifyRequest | None = None  # set during the joint call (see _certify)
         self._tail: tuple[Any, Certificate, np.ndarray] | None = None  # committed brake's certified tail
         self._log_accepted: int | None = None  # log index of the last accepted window (it commits a tail)
@@ -1195,7 +1209,7 @@ class Gate:
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
                       "tail_replay_differs": 0, "certify_us": 0.0, "reused_pairs": 0, "pairs": 0,
-                      "committed": 0, "joint": 0, "tail_refuted": 0}
+                      "committed": 0, "joint": 0, "tail_refuted": 0, "static_reused": 0}
         self._warned = False
         if _no_candidate_pairs(model, self._pairs):  # cheap (no shapes): the scene is built at first use
             self._warned_empty = True
@@ -1419,6 +1433,145 @@ class Gate:
         self.stats["pairs"] += _npairs(cert)
         return cert, us
 
+    def _certify_is_own(self) -> bool:
+        """Whether :meth:`_certify` is this module's own (not replaced on the instance or the class).
+
+        :meth:`_certify_nothing` and :meth:`_certify_static` stand for its result; a replaced
+        ``_certify`` (a test's stub checker or spy) is called as before.
+        """
+        return "_certify" not in self.__dict__ and type(self)._certify is _GATE_CERTIFY
+
+    def _rows_are_plan_qpos(self) -> bool:
+        """Whether a window's Plan has its rows' qpos bit for bit and no mocap pose.
+
+        True when the model has no ball / free joint (``nq == nv``: no quaternion the Plan
+        normalises) and no mocap body (no mocap pose it normalises and validates).
+        """
+        m = self.model
+        return m.nq == m.nv and not m.nmocap
+
+    def _certify_nothing(self, win: _WindowRows) -> tuple[Certificate, float] | None:
+        """:meth:`_certify` of the rollout's window when the scene has no candidate pair, without a Plan.
+
+        ``certify`` of such a scene checks its arguments and returns its "nothing to check"
+        certificate (``stats["nothing_checked"]``, 0 pairs, verdict ``"certified"``, the
+        request's ``method``); this makes the same certificate from the window's rows (to_dict
+        equal field for field but ``wall_seconds``; ``tests/test_gate_zero_pairs.py`` compares
+        them) and the same request, without building the window's Plan. The Plan is built
+        only when something reads it (a log, :attr:`StepReport.plan`).
+
+        The input checks of the Plan and of ``certify`` stay: the window's times and qpos
+        finite (their sum is: a NaN or inf entry makes it NaN or inf; a sum that overflows
+        is declined too) and the times strictly increasing (so ``t1 > t0``). Anything else (a
+        failed check, whose typed error and message the Plan gives; a model with ball / free
+        joints or mocap bodies, whose quaternion norms and mocap poses the Plan validates; the
+        joint call's request) returns None: the caller certifies the Plan as before. The scene
+        is the gate's own, synced by :meth:`decide`, and the rows come from the live model, so
+        ``certify``'s model checks hold by construction.
+        :meth:`decide` uses it only where :meth:`_certify_is_own`.
+
+        Args:
+            win: the window's rows (:meth:`Rollout._window`).
+
+        Returns:
+            (certificate, µs) or None.
+        """
+        t_start = time.perf_counter()
+        if not self._rows_are_plan_qpos() or self._call_request is not None:
+            return None  # quaternions or mocap poses to validate, or a joint call
+        rows = win.rows
+        if not math.isfinite(float(rows.sum())):  # a NaN / inf time or qpos (or a sum that overflows)
+            return None  # the Plan raises with its message
+        times = rows[:, 0].tolist()
+        if not all(a < b for a, b in zip(times, times[1:])):
+            return None  # not strictly increasing: the Plan raises with its message
+        req = self.request
+        allowed = self.scene.allowed_pairs
+        hit = self._nothing_template
+        if hit is None or hit[0] is not req or hit[1] is not allowed:
+            # built by the constructor once per (request, allowed pairs); each window gets a copy
+            template = Certificate("certified", (0.0, 0.0), req.margin, req.epsilon, req.method.value, None,
+                                   None, math.inf, (), {},
+                                   allowed if type(allowed) is tuple else tuple(allowed))
+            template.__dict__["request"] = req
+            hit = self._nothing_template = (req, allowed, template)
+        cert = object.__new__(Certificate)  # = copy.copy(template): a dataclass's state is its __dict__
+        state = cert.__dict__
+        state.update(hit[2].__dict__)
+        state["window"] = (times[0], times[-1])  # Python floats, as the Plan's t0 / t1
+        state["stats"] = {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
+                          "wall_seconds": time.perf_counter() - t_start, "checker_mix": {},
+                          "budget_exhausted": False, "nothing_checked": True}
+        return cert, (time.perf_counter() - t_start) * 1e6
+
+    def _certify_static(self, win: _WindowRows) -> tuple[Certificate, float] | None:
+        """:meth:`_certify` of a window in which no body moves, answered from the reuse cache without a Plan.
+
+        :meth:`_split_reuse` keys each fixed pair's cached result on the bytes of its two
+        bodies' poses at t0, computed by the window Plan's forward kinematics. Those poses
+        are a function of the Plan's qpos rows and the model's kinematic structure only (no
+        mocap body here; t0 is the first waypoint). So :meth:`_remember_static` keeps, for a
+        window of the gate's own rollout in which every pair was fixed, its keys under the
+        bytes of its qpos rows (on a model without ball / free joints and mocap bodies those
+        are the Plan's qpos, bit for bit), within one reuse context (settings, scene builds,
+        scene version; the Plan's structure fields are among the scene's watched fields,
+        ``tests/test_engine_entry.py``, so an edit of them bumps the version). A later window
+        with the same qpos bytes in the same context has the same keys: this looks them up
+        instead of building the Plan and its poses, then does what :meth:`_certify` does
+        when every pair is reused (the same cache reads, merged certificate, cache writes
+        and counters). Anything else returns None (the caller runs :meth:`_certify`): no
+        memo for these rows, another context (:meth:`_certify` empties the cache), or a
+        pair whose cached result does not match (it must be certified). :meth:`decide` uses
+        it only where :meth:`_certify_is_own`.
+
+        Args:
+            win: the window's rows (:meth:`Rollout._window`).
+
+        Returns:
+            (certificate, µs) or None.
+        """
+        t_start = time.perf_counter()
+        memo = self._static_keys
+        if memo is None or not self.reuse or self._call_request is not None:
+            return None
+        context = self._reuse_context()
+        if memo[0] != context or context != self._cache_context:
+            return None
+        keys = memo[1].get(win.rows[:, 1:].tobytes())
+        scene = self.scene
+        if keys is None or len(keys) != len(scene.candidate_pairs):
+            return None
+        cache = self._cache
+        reused = {}
+        for i, key in keys.items():
+            hit = cache.get(i)
+            if hit is None or hit[0] != key:
+                return None
+            reused[i] = hit[1]
+        cert = self._certify_subset(None, scene, win, [], reused)  # type: ignore[arg-type]  # nothing to certify
+        self._remember(cert, keys)
+        us = (time.perf_counter() - t_start) * 1e6
+        self.stats["reused_pairs"] += len(reused)
+        self.stats["pairs"] += _npairs(cert)
+        self.stats["static_reused"] += 1
+        return cert, us
+
+    def _remember_static(self, win: _WindowRows, plan: Any) -> None:
+        """After :meth:`_certify` of ``plan`` (``win.plan``): keep its pose keys for :meth:`_certify_static`.
+
+        Only when every pair was fixed in it (:meth:`_split_reuse` saw the same plan object)
+        and the model has no ball / free joint and no mocap body (the Plan's qpos are the
+        rows' own bytes).
+        """
+        last, self._last_static = self._last_static, None
+        if last is None or last[0] is not plan or not self._rows_are_plan_qpos():
+            return
+        context = self._cache_context
+        memo = self._static_keys
+        if memo is None or memo[0] != context or len(memo[1]) >= 64:
+            memo = self._static_keys = (context, {})
+        memo[1][win.rows[:, 1:].tobytes()] = last[1]
+
     def _certify_joint(self, plan: Any, window_rows: np.ndarray | None, tail_rows: np.ndarray,
                        mocap_pos: np.ndarray, mocap_quat: np.ndarray
                        ) -> tuple[Certificate, Certificate, float] | None:
@@ -1589,6 +1742,8 @@ class Gate:
             hit = cache.get(i)
             if hit is not None and hit[0] == key:
                 reused[i] = hit[1]
+        if len(fixed) == len(body_a):  # every pair fixed: _remember_static may keep these keys
+            self._last_static = (plan, keys)
         if not reused:
             return None, {}, keys
         todo = [i for i in range(len(body_a)) if i not in reused]
@@ -1787,7 +1942,9 @@ class Gate:
             cert, tail_cert, us = joint
             unsafe, brake_verdict = False, tail_cert.verdict  # "certified"
         else:  # today's two calls (also after a joint call that did not certify)
-            cert, us = self._certify(_plan_of(plan))
+            nothing = (self._certify_nothing(plan) if own_predictor and not self.scene.candidate_pairs
+                       and self._certify_is_own() else None)  # no pair: _certify's own trivial certificate
+            cert, us = nothing if nothing is not None else self._certify(_plan_of(plan))
             unsafe = self.is_unsafe(cert.verdict)
             brake_verdict = ""
             if tail is None:
@@ -1839,6 +1996,16 @@ class Gate:
                 fb_cert = covered
                 applied_plan = None
                 self.stats["tail_reused"] += 1
+            elif own_predictor and self._certify_is_own():
+                # the rows of predict(applied); the Plan built only when the cache cannot answer
+                win = _WindowRows(self._rollout._window(data, applied, n), self.model, data)
+                got = self._certify_static(win)  # a window with nothing moving: from the cache, no Plan
+                if got is None:
+                    got = self._certify(win.plan)
+                    self._remember_static(win, win.plan)
+                applied_plan = win
+                fb_cert, fb_us = got
+                us += fb_us
             else:
                 applied_plan = predict(applied)
                 fb_cert, fb_us = self._certify(applied_plan)
@@ -1984,7 +2151,8 @@ class Gate:
         if fb is None or not getattr(log, "logs_applied_motions", False):  # a log object of another kind
             log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why)
             if not r.fallback_certified and fb is not None:
-                log.write_window(r.time, applied_plan, fb, r.applied_ctrl, r.applied_ctrl, True, reason=why)
+                log.write_window(r.time, _plan_of(applied_plan), fb, r.applied_ctrl, r.applied_ctrl, True,
+                                 reason=why)
             return
         self._write_applied(log, r, applied_plan, why)
 
@@ -2039,5 +2207,8 @@ class Gate:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+
+_GATE_CERTIFY = Gate._certify
+"""The :meth:`Gate._certify` this module defines (see :meth:`Gate._certify_is_own`)."""
 
 __all__ = ["Gate", "StepReport", "Rollout", "hold_ctrl", "safety_info", "ON_VIOLATION", "UNSAFE"]
