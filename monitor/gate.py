@@ -1058,6 +1058,12 @@ def _model_name(model: mujoco.MjModel) -> str:
     return bytes(model.names).split(b"\0", 1)[0].decode(errors="replace")
 
 
+MAX_BRAKE_STEPS = 100_000
+"""Most substeps one braking tail may take (``brake_horizon / opt.timestep``); the tail's row buffers
+are sized by it, so a tiny timestep or a huge horizon gets an :class:`InvalidInputError` rather than
+an out-of-memory crash. 100 000 substeps is 200 s at MuJoCo's default 2 ms timestep."""
+
+
 class Gate:
     """Certify-then-step gate on a caller's ``MjModel`` / ``MjData`` (no gymnasium).
 
@@ -1269,7 +1275,13 @@ class Gate:
         dt = float(self.model.opt.timestep)
         if not (math.isfinite(dt) and dt > 0.0):
             raise InvalidInputError(f"model.opt.timestep must be a finite number > 0, got {dt!r}")
-        return max(1, int(math.ceil(self._brake_horizon / dt)))
+        steps = self._brake_horizon / dt
+        if not steps <= MAX_BRAKE_STEPS:  # the tail's buffers are sized by it (red team 5)
+            raise InvalidInputError(
+                f"brake_horizon {self._brake_horizon!r} s over model.opt.timestep {dt!r} s is {steps:.3g} "
+                f"substeps per braking tail, more than MAX_BRAKE_STEPS = {MAX_BRAKE_STEPS}: shorten "
+                "brake_horizon or raise monitor.gate.MAX_BRAKE_STEPS")
+        return max(1, int(math.ceil(steps)))
 
     # ----------------------------------------------------------------- settings the cache depends on
     @property

@@ -79,3 +79,22 @@ def test_horizon_stays_in_seconds_after_a_timestep_edit():
     model.opt.timestep = 0.0
     with pytest.raises(InvalidInputError, match="timestep"):
         _ = gate.brake_steps
+
+
+def test_a_tail_too_long_to_buffer_is_a_typed_error_not_an_allocation():
+    """brake_horizon / timestep beyond MAX_BRAKE_STEPS: the step raises InvalidInputError naming both
+    settings before any tail buffer is sized by it; the gate's state and a sane horizon still work."""
+    model = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    gate = Gate(model, margin=0.001)
+    gate.brake_horizon = 1e9  # 1e11 substeps at the scene's 10 ms... would be terabytes of rows
+    with pytest.raises(InvalidInputError, match="brake_horizon.*timestep.*MAX_BRAKE_STEPS"):
+        gate.step(data, np.array([1.0]))
+    model.opt.timestep = 1e-12  # the same through the timestep, with a reasonable horizon
+    gate.brake_horizon = 0.25
+    with pytest.raises(InvalidInputError, match="MAX_BRAKE_STEPS"):
+        _ = gate.brake_steps
+    model.opt.timestep = 0.01
+    gate.step(data, np.array([1.0]))  # a sane setting steps again
+    assert gate.stats["windows"] >= 1
