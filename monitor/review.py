@@ -727,7 +727,7 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
         return out
 
     def bad(rec: dict[str, Any], reason: str, index: Any) -> None:
-        find(CRITICAL if rec.get("verdict") == "certified" else UNVERIFIABLE, reason, index)
+        find(CRITICAL if rec.get("verdict") == Verdict.CERTIFIED else UNVERIFIABLE, reason, index)
 
     ok_records = set()
     for c in certs:
