@@ -31,10 +31,12 @@ from typing import Any
 
 import numpy as np
 
+from monitor.certify.types import Method, Verdict, as_verdict
 from monitor.log import topics
 from monitor.log.reader import LogContents
 
-VERDICTS = ("certified", "violation", "uncertain")
+VERDICTS: tuple[Verdict, ...] = tuple(Verdict)
+"""The three window verdicts (members equal their strings: ``"certified" in VERDICTS``)."""
 
 
 def _percentile(x: list[float], q: float) -> float | None:
@@ -50,18 +52,20 @@ def _checker_mix(cert: dict[str, Any]) -> Counter:
 
 def _violation_row(cert: dict[str, Any]) -> dict[str, Any]:
     wit = cert.get("witness")
-    bad = [p for p in cert.get("pairs", []) if p.get("verdict") != "certified"]
+    bad = [p for p in cert.get("pairs", []) if p.get("verdict") != Verdict.CERTIFIED]
     if wit:
         pair = next((p for p in bad if list(p.get("geoms", [])) == list(wit.get("geoms", []))), None)
         geoms = list(wit.get("geoms", []))
         bodies = list(pair.get("bodies") or []) if pair else []
-        return {"index": cert.get("index"), "sim_time": cert.get("sim_time"), "verdict": cert["verdict"],
+        return {"index": cert.get("index"), "sim_time": cert.get("sim_time"),
+                "verdict": as_verdict(cert["verdict"]),
                 "time": wit.get("time"), "geoms": geoms, "bodies": bodies, "point": wit.get("point"),
                 "distance": wit.get("distance"), "clearance": cert.get("clearance"),
                 "pairs": len(bad)}
     first = bad[0] if bad else {}
-    return {"index": cert.get("index"), "sim_time": cert.get("sim_time"), "verdict": cert["verdict"],
-            "time": cert.get("earliest_time"), "geoms": list(first.get("geoms", [])),
+    return {"index": cert.get("index"), "sim_time": cert.get("sim_time"),
+            "verdict": as_verdict(cert["verdict"]), "time": cert.get("earliest_time"),
+            "geoms": list(first.get("geoms", [])),
             "bodies": list(first.get("bodies") or []), "point": None, "distance": None,
             "clearance": cert.get("clearance"), "pairs": len(bad)}
 
@@ -210,7 +214,7 @@ def _integrity(contents: LogContents, certs: list[dict[str, Any]],
             out.append(f"certificate indices have {len(gaps)} gap(s) (first: {gaps[:5]}): certificates lost")
     if contents.seal_status == "mismatch":
         out.append(f"digest seal: {contents.seal_detail}")
-    flagged = Counter(c["index"] for c in certs if c["verdict"] != "certified")
+    flagged = Counter(c["index"] for c in certs if c["verdict"] != Verdict.CERTIFIED)
     viol = Counter(m["index"] for m in contents.topic(topics.VIOLATION) if _is_int(m.get("index")))
     if contents.stop_kind == "truncated" and have:  # a killed writer may have cut the last window short
         flagged.pop(max(have), None)
@@ -256,7 +260,7 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         v = c.get("verdict")
         if is_applied_record(c) and v in VERDICTS:  # the motion a replaced step ran: counted apart
             applied[v] += 1
-            if v != "certified":
+            if v != Verdict.CERTIFIED:
                 rows.append(_violation_row(c))
             continue
         if v not in VERDICTS:
@@ -269,14 +273,14 @@ def analyze(contents: LogContents) -> dict[str, Any]:
         if us is not None:
             lat.append(us)
         series["sim_time"].append(float(c["sim_time"]))
-        series["verdict"].append(v)
+        series["verdict"].append(as_verdict(v))
         cl = c.get("clearance")
         series["clearance"].append(float(cl) if isinstance(cl, (int, float)) else None)
         series["latency_us"].append(us)
         series["margin"].append(c.get("margin"))
         series["episode"].append(int(c.get("episode", 0)))
         series["index"].append(int(c.get("index", len(series["index"]))))
-        if v != "certified":
+        if v != Verdict.CERTIFIED:
             rows.append(_violation_row(c))
     actions = [a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))]
     integrity = _integrity(contents, certs, bad_messages)
@@ -336,7 +340,7 @@ def combine(summaries: list[dict[str, Any]]) -> dict[str, Any]:
 # --------------------------------------------------------------------------- verification
 
 
-METHODS = ("auto", "toleranced", "extrusion")
+METHODS: tuple[Method, ...] = tuple(Method)
 """Certificate-level methods :func:`monitor.certify` accepts."""
 
 CRITICAL = "critical"
@@ -723,7 +727,7 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
         return out
 
     def bad(rec: dict[str, Any], reason: str, index: Any) -> None:
-        find(CRITICAL if rec.get("verdict") == "certified" else UNVERIFIABLE, reason, index)
+        find(CRITICAL if rec.get("verdict") == Verdict.CERTIFIED else UNVERIFIABLE, reason, index)
 
     ok_records = set()
     for c in certs:
@@ -1270,12 +1274,13 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         out["checked"] += 1
         out["applied_checked"] += int(is_applied_record(c))
         if new.verdict != verdict:
-            critical = (new.verdict == "certified") != (verdict == "certified")
-            budget = bool((c.get("stats") or {}).get("budget_exhausted")) and verdict == "uncertain"
+            critical = (new.verdict == Verdict.CERTIFIED) != (verdict == Verdict.CERTIFIED)
+            budget = bool((c.get("stats") or {}).get("budget_exhausted")) and verdict == Verdict.UNCERTAIN
             if budget:  # the logged run ran out of its work budget: "uncertain" was the honest answer then
                 critical = False
             out["critical"] += int(critical)
-            out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": verdict,
+            logged = as_verdict(verdict) if verdict in VERDICTS else verdict  # unknown: already critical
+            out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": logged,
                                       "recomputed": new.verdict, "critical": critical,
                                       "logged_clearance": c.get("clearance"),
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
@@ -1384,8 +1389,8 @@ def render_text(result: dict[str, Any]) -> str:
     if tot and tot["logs"] > 1:
         v = tot["verdicts"]
         lines.append(f"== total over {tot['logs']} logs: windows {tot['windows']}: "
-                     f"certified {v['certified']}, violation {v['violation']}, "
-                     f"uncertain {v['uncertain']}; blocked {tot['blocked_actions']}")
+                     f"certified {v[Verdict.CERTIFIED]}, violation {v[Verdict.VIOLATION]}, "
+                     f"uncertain {v[Verdict.UNCERTAIN]}; blocked {tot['blocked_actions']}")
     if "exit_code" in result:
         lines.append(f"exit code {result['exit_code']}: {EXIT_MEANING.get(result['exit_code'], '?')}")
     return "\n".join(lines)
@@ -1429,8 +1434,8 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
         f"   mujoco {entry.get('versions', {}).get('mujoco', '?')}, margin {_fmt(run.get('margin'))}, "
         f"epsilon {_fmt(run.get('epsilon'))}, pairs {_fmt(run.get('pairs'))}, "
         f"predictor {_fmt(run.get('predictor'))}",
-        f"   windows {entry['windows']}: certified {v['certified']}, violation {v['violation']}, "
-        f"uncertain {v['uncertain']}",
+        f"   windows {entry['windows']}: certified {v[Verdict.CERTIFIED]}, violation {v[Verdict.VIOLATION]}, "
+        f"uncertain {v[Verdict.UNCERTAIN]}",
         f"   actions {entry['actions']}, blocked/replaced {entry['blocked_actions']}"
         + (f"; applied motions logged {entry['applied_motions']['records']} "
            f"({', '.join(f'{k} {n}' for k, n in sorted(entry['applied_motions']['verdicts'].items()))})"
@@ -1534,7 +1539,7 @@ def _plots(entry: dict[str, Any]) -> list[tuple[str, str]]:
     s = entry["series"]
     x, xlabel, starts = _x_axis(entry)
     out = []
-    colors = {"certified": "tab:green", "uncertain": "tab:orange", "violation": "tab:red"}
+    colors = {Verdict.CERTIFIED: "tab:green", Verdict.UNCERTAIN: "tab:orange", Verdict.VIOLATION: "tab:red"}
     blocked = entry.get("blocked", [])
     reasons = sorted({str(b.get("reason") or "replaced") for b in blocked})
     fig, axes = plt.subplots(2, 1, figsize=(17, 2.2 + 0.35 * max(len(reasons), 1) + 1.2), sharex=True,

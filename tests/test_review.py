@@ -15,6 +15,7 @@ from mcap_rewrite import rewrite
 
 import monitor.review as review
 from monitor.certify.certificate import Certificate, PairResult, Witness
+from monitor.certify.types import Verdict
 from monitor.cli import main
 from monitor.log import MonitorLog, read_log, topics
 
@@ -84,6 +85,23 @@ def test_analyze_counts_latency_mix_and_rows(hand_log):
     assert rows[0]["geoms"] == ["link1_geom", "table_top"] and rows[0]["point"] == [0.3, 0.0, 0.21]
     assert rows[0]["distance"] == -2e-3 and rows[0]["sim_time"] == pytest.approx(0.02)
     assert rows[1]["bodies"] == ["table", "link1"] and rows[1]["point"] is None
+
+
+def test_per_window_verdicts_are_verdict_members(hand_log, tmp_path, monkeypatch):
+    """Review hands back Verdict members (not the log's plain strings): series, rows, counts, mismatches."""
+    s = review.analyze(read_log(hand_log))
+    assert s["series"]["verdict"] == VERDICTS  # oracle: the verdicts written, as plain strings
+    assert all(type(v) is Verdict for v in s["series"]["verdict"])
+    assert all(type(r["verdict"]) is Verdict for r in s["violations"]) and len(s["violations"]) == 3
+    assert all(type(v) is Verdict for v in s["verdicts"])
+    monkeypatch.setattr(review, "_engine", lambda: (_FakeScene, _fake_certify))
+    model = mujoco.MjModel.from_xml_string(XML)
+    path, bad = tmp_path / "ok.mcap", tmp_path / "bad.mcap"
+    _consistent_log(path, model, [1.0, 0.1])
+    rewrite_plan(path, bad, 0, lambda o: o.update(qpos=[[0.05], [0.05]]))  # logged certified, collides
+    (m,) = review.verify(read_log(bad), progress=False)["mismatches"]
+    assert (m["logged"], m["recomputed"]) == ("certified", "violation")
+    assert type(m["logged"]) is Verdict and type(m["recomputed"]) is Verdict
 
 
 def test_cli_text_json_and_multiple_logs(hand_log, tmp_path, capsys):

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from monitor.certify.common import Outcome
 from monitor.certify.extrusion import TranslatingBody, TranslatingPair
 from monitor.geometry.polytope import box_polytope, halfspace_shape, sphere_shape
 
@@ -252,8 +253,8 @@ def report(benchmark: bool = True) -> dict[str, Any]:
                     "seconds": dt, "verdicts": verdicts,
                     "earliest": None if e is None else [e.info["geoms"], e.info["earliest_time"],
                                                         e.witness_time],
-                    "min_clearance": min((o.clearance for o in res.outcomes if o.verdict == "certified"),
-                                         default=None),
+                    "min_clearance": min((o.clearance for o in res.outcomes
+                                          if o.verdict == Outcome.CERTIFIED), default=None),
                     "lps": res.stats["lps"], "regions": res.stats["regions"],
                     "spans": [{k: v for k, v in s.items() if k != "sbound_regions"}
                               for s in res.stats["spans"]]}

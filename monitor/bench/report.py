@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from monitor._json import jsonable
+from monitor.certify.types import Verdict
 
 
 def machine_info() -> dict[str, Any]:
@@ -225,7 +226,7 @@ def plot_uncertain(path: Path, points: list[dict]) -> None:
         if not pp:
             continue
         x = np.array([p["clearance"] / p["epsilon"] for p in pp])
-        y = np.array([1.0 if p["verdict"] != "certified" else 0.0 for p in pp])
+        y = np.array([1.0 if p["verdict"] != Verdict.CERTIFIED else 0.0 for p in pp])
         edges = np.logspace(np.floor(np.log10(x.min())), np.ceil(np.log10(x.max())) + 1e-9, 12)
         idx = np.digitize(x, edges)
         xs, ys, ns = [], [], []

@@ -29,6 +29,7 @@ import numpy as np
 
 from monitor.bench import oracle, report
 from monitor.bench.cases import PairCase, ShapeSpec, make_cases
+from monitor.certify.types import Method, Verdict
 
 EPS_FULL = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 EPS_QUICK = (1e-1, 1e-3, 1e-5)
@@ -153,7 +154,7 @@ def run_ours(
         "clearance": cert.clearance,
         "earliest_time": cert.earliest_time,
         "exhausted": bool(budget_s)
-        and cert.verdict == "uncertain"
+        and cert.verdict == Verdict.UNCERTAIN
         and float(np.median(ts)) >= 0.95 * budget_s,
         "reps": len(ts),
     }
@@ -170,11 +171,11 @@ def _score(entries: list[dict[str, Any]]) -> dict[str, Any]:
         "collide_cases": len(col),
         "clear_cases": len(clr),
         "near_cases": sum(e["label"] == "near" for e in entries),
-        "false_negatives": sum(e["verdict"] == "certified" for e in col),
-        "false_violations": sum(e["verdict"] == "violation" for e in clr),
-        "uncertain_clear": sum(e["verdict"] == "uncertain" for e in clr),
-        "not_certified_clear": sum(e["verdict"] != "certified" for e in clr),
-        "uncertain_frac": (sum(e["verdict"] == "uncertain" for e in entries) / n) if n else None,
+        "false_negatives": sum(e["verdict"] == Verdict.CERTIFIED for e in col),
+        "false_violations": sum(e["verdict"] == Verdict.VIOLATION for e in clr),
+        "uncertain_clear": sum(e["verdict"] == Verdict.UNCERTAIN for e in clr),
+        "not_certified_clear": sum(e["verdict"] != Verdict.CERTIFIED for e in clr),
+        "uncertain_frac": (sum(e["verdict"] == Verdict.UNCERTAIN for e in entries) / n) if n else None,
         "errors": sum(e["verdict"] in ("error", "exception") for e in entries),
         "budget_exhausted": sum(bool(e.get("exhausted")) for e in entries),
         "us_median": _pct(us, 50),
@@ -242,7 +243,7 @@ def jit_warmup(cfg: BenchConfig) -> dict[str, Any]:
 
 # ------------------------------------------------------------------------------ suite 1
 # ------------------------------------------------------------------------------ cross-check (issue 14)
-XCHECK_METHODS = ("toleranced", "extrusion")
+XCHECK_METHODS = (Method.TOLERANCED, Method.EXTRUSION)
 XCHECK_BUDGET_TESTS = 200_000
 """Elementary-test budget per certify call in the cross-check (deterministic, unlike seconds)."""
 
@@ -295,7 +296,7 @@ def crosscheck_case(case: Any, epsilon: float = 1e-3, budget_tests: int | None =
                        "clearance": cert.clearance, "note": pr.note if pr else "",
                        "tests": pr.tests if pr else 0}
     vt, ve = out["toleranced"]["verdict"], out["extrusion"]["verdict"]
-    out["contradiction"] = {vt, ve} == {"certified", "violation"}
+    out["contradiction"] = {vt, ve} == {Verdict.CERTIFIED, Verdict.VIOLATION}
     out["disagreement"] = vt != ve
     out["oracle"], out["false_negative"], out["reason"] = None, False, ""
     if out["disagreement"]:
@@ -303,12 +304,12 @@ def crosscheck_case(case: Any, epsilon: float = 1e-3, budget_tests: int | None =
 
         lab = translating_label(case)
         out["oracle"] = lab.to_dict()
-        out["false_negative"] = lab.label == "collide" and "certified" in (vt, ve)
+        out["false_negative"] = lab.label == "collide" and Verdict.CERTIFIED in (vt, ve)
         if out["contradiction"]:
             out["reason"] = f"CONTRADICTION (oracle {lab.label})"
         else:
-            other = "toleranced" if vt != "uncertain" else "extrusion"
-            unsure = "extrusion" if other == "toleranced" else "toleranced"
+            other = Method.TOLERANCED if vt != Verdict.UNCERTAIN else Method.EXTRUSION
+            unsure = Method.EXTRUSION if other == Method.TOLERANCED else Method.TOLERANCED
             gap = lab.distance_upper - case.margin
             pm = out[unsure]["pair_method"]
             via = f" ({pm})" if pm not in (None, unsure) else ""
@@ -328,10 +329,10 @@ def crosscheck_summary(entries: list[dict[str, Any]]) -> dict[str, Any]:
         "contradictions": sum(e["contradiction"] for e in entries),
         "false_negatives": sum(e["false_negative"] for e in entries),
         "agree": sum(not e["disagreement"] for e in entries),
-        "tol_cert_ext_uncertain": pairs[("certified", "uncertain")],
-        "ext_cert_tol_uncertain": pairs[("uncertain", "certified")],
-        "tol_viol_ext_uncertain": pairs[("violation", "uncertain")],
-        "ext_viol_tol_uncertain": pairs[("uncertain", "violation")],
+        "tol_cert_ext_uncertain": pairs[(Verdict.CERTIFIED, Verdict.UNCERTAIN)],
+        "ext_cert_tol_uncertain": pairs[(Verdict.UNCERTAIN, Verdict.CERTIFIED)],
+        "tol_viol_ext_uncertain": pairs[(Verdict.VIOLATION, Verdict.UNCERTAIN)],
+        "ext_viol_tol_uncertain": pairs[(Verdict.UNCERTAIN, Verdict.VIOLATION)],
         "verdict_pairs": {f"{a}/{b}": n for (a, b), n in sorted(pairs.items())},
         "reasons": dict(reasons.most_common()),
         "intents": dict(Counter(e["intent"] for e in entries)),
@@ -340,21 +341,21 @@ def crosscheck_summary(entries: list[dict[str, Any]]) -> dict[str, Any]:
 
 def _same_case_crosscheck(per_case: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Toleranced (per epsilon) against extrusion verdicts on the accuracy suite's translating cases."""
-    ext = {e["case"]: e["verdict"] for e in per_case if e["checker"] == "extrusion"}
+    ext = {e["case"]: e["verdict"] for e in per_case if e["checker"] == Method.EXTRUSION}
     rows = []
-    for eps in sorted({e["epsilon"] for e in per_case if e["checker"] == "toleranced"}, reverse=True):
+    for eps in sorted({e["epsilon"] for e in per_case if e["checker"] == Method.TOLERANCED}, reverse=True):
         vv = [(e["verdict"], ext[e["case"]]) for e in per_case
-              if e["checker"] == "toleranced" and e["epsilon"] == eps and e["case"] in ext]
+              if e["checker"] == Method.TOLERANCED and e["epsilon"] == eps and e["case"] in ext]
         if not vv:
             continue
         rows.append({
             "epsilon": eps,
             "n": len(vv),
-            "contradictions": sum({a, b} == {"certified", "violation"} for a, b in vv),
+            "contradictions": sum({a, b} == {Verdict.CERTIFIED, Verdict.VIOLATION} for a, b in vv),
             "agree": sum(a == b for a, b in vv),
-            "ext_cert_tol_uncertain": sum((a, b) == ("uncertain", "certified") for a, b in vv),
-            "tol_cert_ext_uncertain": sum((a, b) == ("certified", "uncertain") for a, b in vv),
-            "other_disagreements": sum(a != b and "certified" not in (a, b) for a, b in vv),
+            "ext_cert_tol_uncertain": sum((a, b) == (Verdict.UNCERTAIN, Verdict.CERTIFIED) for a, b in vv),
+            "tol_cert_ext_uncertain": sum((a, b) == (Verdict.CERTIFIED, Verdict.UNCERTAIN) for a, b in vv),
+            "other_disagreements": sum(a != b and Verdict.CERTIFIED not in (a, b) for a, b in vv),
         })
     return rows
 
@@ -406,10 +407,10 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
     eps_list = (1e-3,) if cfg.smoke else EPS_QUICK if cfg.quick else EPS_FULL
     warm = jit_warmup(cfg)
     per_case: list[dict[str, Any]] = []
-    plans = [("toleranced", e) for e in eps_list] + [("extrusion", None), ("auto", 1e-3)]
+    plans = [(Method.TOLERANCED, e) for e in eps_list] + [(Method.EXTRUSION, None), (Method.AUTO, 1e-3)]
     for method, eps in plans:
         for case, lab in zip(cases, labels):
-            if method == "extrusion" and case.group != "translating":
+            if method == Method.EXTRUSION and case.group != "translating":
                 continue
             r = run_ours(case, method, eps if eps is not None else 1e-3, cfg.reps, budget_s=cfg.budget_s)
             cfg.shared.setdefault("ours", {})[(case.name, method, eps)] = r
@@ -449,7 +450,7 @@ def suite_accuracy(cfg: BenchConfig) -> dict[str, Any]:
         [
             dict(e, checker=f"{e['checker']}")
             for e in per_case
-            if e["label"] == "clear" and e["epsilon"] is not None and e["checker"] == "toleranced"
+            if e["label"] == "clear" and e["epsilon"] is not None and e["checker"] == Method.TOLERANCED
         ],
     )
     figs.append("uncertain_vs_clearance.png")
@@ -571,10 +572,10 @@ def _facet_sweep(cfg: BenchConfig) -> dict[str, Any]:
         return {"skipped": f"facet cases: {type(exc).__name__}: {exc}"}
     rows = []
     for facets in FACETS_QUICK if cfg.quick else FACETS_FULL:
-        for method in ("toleranced", "extrusion"):
+        for method in (Method.TOLERANCED, Method.EXTRUSION):
             ee = []
             for case, lab in fc:
-                if method == "extrusion" and case.group != "translating":
+                if method == Method.EXTRUSION and case.group != "translating":
                     continue
                 r = run_ours(case, method, 1e-4, cfg.reps, facets=facets, budget_s=cfg.budget_s)
                 approx = max(case.scene(facets).approximations.values(), default=0.0)
@@ -641,7 +642,7 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
         checkers.append(P.IpctkPeer())
     else:
         notes.append("ipctk not installed")
-    ours = [("ours/toleranced eps=1e-3", "toleranced", 1e-3), ("ours/auto eps=1e-3", "auto", 1e-3)]
+    ours = [("ours/toleranced eps=1e-3", Method.TOLERANCED, 1e-3), ("ours/auto eps=1e-3", Method.AUTO, 1e-3)]
     if no_engine:
         ours = []
         notes.append(f"ours not measured: {no_engine}")
@@ -705,9 +706,9 @@ def suite_peers(cfg: BenchConfig) -> dict[str, Any]:
             if any(x is None for x in cols):
                 v = "unsupported"
             elif all(cols):
-                v = "violation"
+                v = Verdict.VIOLATION
             elif not any(cols):
-                v = "certified"
+                v = Verdict.CERTIFIED
             else:  # repetitions disagree: reported, and counted as a miss on collide cases
                 v = "inconsistent"
             entries[c.name].append(
@@ -862,7 +863,7 @@ def suite_seeds(cfg: BenchConfig) -> dict[str, Any]:
     md, rows = [], []
     # Cameron sphere-cube
     case = cameron_sphere_cube()
-    for method in ("extrusion", "toleranced"):
+    for method in (Method.EXTRUSION, Method.TOLERANCED):
         run_ours(case, method, 1e-3, 1, budget_s=10 * cfg.budget_s)  # warm-up (JIT / caches), untimed
         r = run_ours(case, method, 1e-3, cfg.reps, budget_s=10 * cfg.budget_s)
         rows.append(
@@ -942,7 +943,7 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
             ts, cert = [], None
             for _ in range(max(1, cfg.reps)):
                 t = time.perf_counter()
-                cert = certify(scene, plan, method="auto")
+                cert = certify(scene, plan, method=Method.AUTO)
                 ts.append(time.perf_counter() - t)
                 if sum(ts) > 3.0:
                     break
@@ -960,7 +961,7 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
             rows.append(
                 {
                     "experiment": f"Cameron AGV {name}{' skewed' if skewed else ''}",
-                    "method": "auto",
+                    "method": Method.AUTO,
                     "verdict": cert.verdict,
                     "seconds": float(np.median(ts)),
                     "tests": cert.stats.get("tests"),
@@ -968,7 +969,7 @@ def _agv_rows(cfg: BenchConfig) -> list[dict[str, Any]]:
                     "expected": "violation, earliest 29/3 s (crate_top/plate1)"
                     if name == "straight"
                     else "certified (narrow miss)",
-                    "clearance": cert.clearance if cert.verdict == "certified" else cert.earliest_time,
+                    "clearance": cert.clearance if cert.verdict == Verdict.CERTIFIED else cert.earliest_time,
                     "pairs": len(scene.candidate_pairs),
                 }
             )
@@ -1477,12 +1478,13 @@ def _write_review_log(path: Path, n_windows: int, seed: int) -> None:
     with MonitorLog(path, model=model, metadata={"bench": "review"}) as log:
         for k in range(n_windows):
             t0 = 0.01 * (k % 500)
-            verdict = "violation" if k % 97 == 5 else "uncertain" if k % 89 == 3 else "certified"
-            ok = verdict == "certified"
-            w = Witness(t0, pair, np.array([0.5, 0.0, 0.2]), -1e-3) if verdict == "violation" else None
+            verdict = (Verdict.VIOLATION if k % 97 == 5 else Verdict.UNCERTAIN if k % 89 == 3
+                       else Verdict.CERTIFIED)
+            ok = verdict == Verdict.CERTIFIED
+            w = Witness(t0, pair, np.array([0.5, 0.0, 0.2]), -1e-3) if verdict == Verdict.VIOLATION else None
             clearance = 0.01 if ok else float("-inf")
             pr = PairResult(pair, bodies, verdict, "toleranced", 5, 2, (), clearance, w)
-            cert = Certificate(verdict, (t0, t0 + 0.01), 0.001, 1e-3, "auto", w, None if ok else t0,
+            cert = Certificate(verdict, (t0, t0 + 0.01), 0.001, 1e-3, Method.AUTO, w, None if ok else t0,
                                clearance, (pr,), {"wall_seconds": float(rng.uniform(1e-4, 1e-2))})
             plan = types.SimpleNamespace(times=np.array([t0, t0 + 0.01]),
                                          qpos=np.array([[0.001 * k], [0.001 * k + 0.01]]), model=model)
@@ -1580,9 +1582,9 @@ def _plot_time_vs_epsilon(cfg: Any, rows: list[dict], eps_list: Any, peer_lines:
     """
     report.plot_time_vs_epsilon(
         cfg.out / "time_vs_epsilon.png",
-        [r for r in rows if r["group"] != "all" and r["checker"] == "toleranced"]
+        [r for r in rows if r["group"] != "all" and r["checker"] == Method.TOLERANCED]
         + [dict(r, epsilon=e) for r in rows
-           if r["checker"] == "extrusion" and r["group"] == "translating" for e in eps_list],
+           if r["checker"] == Method.EXTRUSION and r["group"] == "translating" for e in eps_list],
         peer_lines,
     )
 

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from monitor.bench import report
+from monitor.certify.types import Method, Verdict
 
 
 @dataclass(frozen=True)
@@ -226,18 +227,19 @@ def _ours_per_case(cfg: Any, cases: list, labels: list) -> tuple[dict[str, dict]
     entries = {e["case"]: e for e in peers.get("entries", {}).get("ours/toleranced eps=1e-3", [])}
     out, sources = {}, Counter()
     for case, lab in zip(cases, labels):
-        r = full.get((case.name, "toleranced", 1e-3))
+        r = full.get((case.name, Method.TOLERANCED, 1e-3))
         e = entries.get(case.name)
         if e is not None:
             earliest = r.get("earliest_time") if r is not None else None
-            if r is None and lab.label == "collide" and e["verdict"] != "certified":
-                earliest = run_ours(case, "toleranced", 1e-3, 1, budget_s=cfg.budget_s).get("earliest_time")
+            if r is None and lab.label == "collide" and e["verdict"] != Verdict.CERTIFIED:
+                earliest = run_ours(case, Method.TOLERANCED, 1e-3, 1,
+                                    budget_s=cfg.budget_s).get("earliest_time")
             out[case.name] = {"verdict": e["verdict"], "us": e.get("us"), "earliest_time": earliest}
             sources["peers suite"] += 1
             continue
         if r is None:
-            r = run_ours(case, "toleranced", 1e-3, cfg.reps, budget_s=cfg.budget_s)
-            cfg.shared.setdefault("ours", {})[(case.name, "toleranced", 1e-3)] = r
+            r = run_ours(case, Method.TOLERANCED, 1e-3, cfg.reps, budget_s=cfg.budget_s)
+            cfg.shared.setdefault("ours", {})[(case.name, Method.TOLERANCED, 1e-3)] = r
             sources["measured here"] += 1
         else:
             sources["accuracy suite"] += 1
@@ -288,9 +290,9 @@ def pair_windows(cfg: Any) -> dict[str, Any]:
         if any(c is None for c in cols):
             fv = "unsupported"
         elif all(cols):
-            fv = "violation"
+            fv = Verdict.VIOLATION
         elif not any(cols):
-            fv = "certified"
+            fv = Verdict.CERTIFIED
         else:
             fv = "inconsistent"
         toc = [a[1] * case.duration for a in answers[i] if a[0]]
@@ -323,17 +325,18 @@ def pair_windows(cfg: Any) -> dict[str, Any]:
                 "ours_us_median": ours_us,
                 "fcl_us_median": fcl_us,
                 "ratio": ours_us / fcl_us if (ours_us and fcl_us) else None,
-                "ours_misses": sum(p["ours_verdict"] == "certified" for p in col),
+                "ours_misses": sum(p["ours_verdict"] == Verdict.CERTIFIED for p in col),
                 "ours_late": sum(
-                    p["ours_verdict"] != "certified" and _late(p["ours_earliest"], p["hit_time"], 1.0)
+                    p["ours_verdict"] != Verdict.CERTIFIED and _late(p["ours_earliest"], p["hit_time"], 1.0)
                     for p in col
                 ),
                 "ours_earliest_unknown": sum(
-                    p["ours_verdict"] != "certified" and p["ours_earliest"] is None for p in col
+                    p["ours_verdict"] != Verdict.CERTIFIED and p["ours_earliest"] is None for p in col
                 ),
-                "fcl_misses": sum(p["fcl_verdict"] in ("certified", "inconsistent") for p in col),
+                "fcl_misses": sum(p["fcl_verdict"] in (Verdict.CERTIFIED, "inconsistent") for p in col),
                 "fcl_late": sum(
-                    p["fcl_verdict"] == "violation" and _late(p["fcl_toc"], p["hit_time"], 1.0) for p in col
+                    p["fcl_verdict"] == Verdict.VIOLATION and _late(p["fcl_toc"], p["hit_time"], 1.0)
+                    for p in col
                 ),
                 "fcl_unsupported": sum(p["fcl_verdict"] == "unsupported" for p in pc),
             }

@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from monitor.certify.certificate import Certificate, PairResult, Witness, combine_verdicts
+from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError
 from monitor.geometry.shapes import ConvexShape
 
@@ -150,7 +151,7 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     Returns:
         the certificate with ongoing pairs re-judged (unchanged when there are none).
     """
-    if cert.verdict == "certified":
+    if cert.verdict == Verdict.CERTIFIED:
         # every pair is certified (any other pair verdict makes the combined verdict
         # "uncertain" or "violation"): no ongoing pair; cert.pairs need not be built here
         return cert
@@ -158,7 +159,7 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
     known = _start_lower(cert) if _START_BOUND else None
     if known is not None and all(lo > margin for lo in known.values()):
         return cert   # every pair the kernel did not cull is proven clear at t0: none is ongoing
-    cand = [k for k, p in enumerate(cert.pairs) if p.verdict != "certified"]
+    cand = [k for k, p in enumerate(cert.pairs) if p.verdict != Verdict.CERTIFIED]
     if not cand:
         return cert
     t0 = float(cert.window[0])
@@ -212,17 +213,17 @@ def deepen(certify_fn: Callable[..., Certificate], scene: Any, plan: Any, cert: 
             else:
                 head, bound = "ongoing contact: penetration", tol_txt
                 texts = ("< {b} certified", "exceeds {b}", "< {b} not proven")
-            which = {"certified": 0, "violation": 1}.get(str(r.verdict), 2)
+            which = {Verdict.CERTIFIED: 0, Verdict.VIOLATION: 1}.get(r.verdict, 2)
             note = f"{head} {texts[which].format(b=bound)}"
             w = r.witness
             if w is not None:
                 w = Witness(w.time, w.geoms, w.point, float(w.distance) - s)
             pairs[k] = replace(r, clearance=clear, witness=w, note=note)
-        elif r.verdict == "certified":
+        elif r.verdict == Verdict.CERTIFIED:
             pairs[k] = replace(r, clearance=clear,
                                note=f"ongoing contact: penetration < {s:g} m certified (polytope cores)")
         else:
-            pairs[k] = replace(r, verdict="uncertain", witness=None, clearance=-math.inf,
+            pairs[k] = replace(r, verdict=Verdict.UNCERTAIN, witness=None, clearance=-math.inf,
                                intervals=r.intervals or ((t0, float(cert.window[1])),),
                                note=f"{POLYTOPE_NOTE}: penetration < {tol_txt} cannot be certified "
                                     f"(only {s:g} m of radius to shrink)")
@@ -266,11 +267,11 @@ def _start_lower(cert: Certificate) -> dict[int, float] | None:
 
 def _recombine(cert: Certificate, pairs: list[PairResult], n_ongoing: int, tol: float) -> Certificate:
     verdict = combine_verdicts([p.verdict for p in pairs])
-    wits = [p.witness for p in pairs if p.verdict == "violation" and p.witness is not None]
+    wits = [p.witness for p in pairs if p.verdict == Verdict.VIOLATION and p.witness is not None]
     witness = min(wits, key=lambda w: w.time) if wits else None
     earliest = None
-    if verdict != "certified":
-        starts = [p.intervals[0][0] for p in pairs if p.verdict != "certified" and p.intervals]
+    if verdict != Verdict.CERTIFIED:
+        starts = [p.intervals[0][0] for p in pairs if p.verdict != Verdict.CERTIFIED and p.intervals]
         starts += [w.time for w in wits]
         earliest = float(min(starts)) if starts else float(cert.window[0])
     clears = [p.clearance for p in pairs if p.method != "culled" or math.isfinite(p.clearance)]

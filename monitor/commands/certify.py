@@ -44,6 +44,8 @@ from typing import Any
 
 import numpy as np
 
+from monitor.certify.types import Method, Verdict
+
 _PER_PLAN = re.compile(r"^plan(0|[1-9]\d{0,5})_(times|qpos|mocap_pos|mocap_quat)$")
 _STACKED = ("times", "qpos", "mocap_pos", "mocap_quat")
 
@@ -68,7 +70,7 @@ def add_parser(p: argparse.ArgumentParser) -> None:
                    help="candidate pairs: MuJoCo's contact filter (default) or every pair of bodies")
     p.add_argument("--margin", type=float, default=0.0, help="clearance (m) that counts as safe (default 0)")
     p.add_argument("--epsilon", type=float, default=1e-3, help="certification tolerance (m, default 1e-3)")
-    p.add_argument("--method", choices=("auto", "toleranced", "extrusion"), default="auto",
+    p.add_argument("--method", choices=[m.value for m in Method], default=Method.AUTO.value,
                    help="checker (default auto)")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
                    help="local processes or Ray tasks (Ray: existing ray.init() or a new local instance)")
@@ -427,7 +429,7 @@ def run(args: argparse.Namespace) -> int:
         except (MonitorError, OSError) as exc:
             print(f"error: cannot write log {args.log}: {exc}", file=sys.stderr)
             return 2
-    counts = {v: sum(c.verdict == v for c, _ in results) for v in ("certified", "violation", "uncertain")}
+    counts = {v: sum(c.verdict == v for c, _ in results) for v in Verdict}
     if args.json:
         out = {"model": str(model_path), "plans": [{"name": p["name"], "certify_us": us, **c.to_dict()}
                                                      for p, (c, us) in zip(plans, results)],
@@ -440,9 +442,10 @@ def run(args: argparse.Namespace) -> int:
               f"{'checkers':28} witness")
         for i, (p, (c, us)) in enumerate(zip(plans, results)):
             print(_line(i, p["name"], c, us))
-        print(f"certified {counts['certified']}, violation {counts['violation']}, "
-              f"uncertain {counts['uncertain']} in {wall:.2f} s" + (f"; log {args.log}" if args.log else ""))
-    return 0 if counts["certified"] == len(plans) else 1
+        print(f"certified {counts[Verdict.CERTIFIED]}, violation {counts[Verdict.VIOLATION]}, "
+              f"uncertain {counts[Verdict.UNCERTAIN]} in {wall:.2f} s"
+              + (f"; log {args.log}" if args.log else ""))
+    return 0 if counts[Verdict.CERTIFIED] == len(plans) else 1
 
 
 def _write_log(args: argparse.Namespace, model: Any, model_path: Path, plans: list[Any],

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from monitor.certify.types import Verdict
+
 # Joint targets (yaw, pitch, elbow) that point the stretched arm into an obstacle.
 _INTO_OBSTACLES = {
     "post_a": np.array([np.arctan2(0.25, 0.45), 0.0, 0.0]),
@@ -134,8 +136,8 @@ def run(args: argparse.Namespace) -> int:
 
     print(f"monitor demo: arm among obstacles, {args.steps} gated steps (seed {args.seed}, "
           f"margin {args.margin} m, {gated.gate.npairs} candidate pairs)")
-    print(f"  verdicts        certified {s['certified']}, violation {s['violation']}, "
-          f"uncertain {s['uncertain']}")
+    print(f"  verdicts        certified {s[Verdict.CERTIFIED]}, violation {s[Verdict.VIOLATION]}, "
+          f"uncertain {s[Verdict.UNCERTAIN]}")
     blocked_by = ", ".join(f"{k} {v}" for k, v in sorted(aims.items())) or "none"
     print(f"  blocked actions {s['replaced']} (policy aiming at: {blocked_by}); "
           f"uncertified fallbacks {s['fallback_uncertified']}")

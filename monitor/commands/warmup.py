@@ -20,7 +20,10 @@ from __future__ import annotations
 
 import argparse
 
-_EXPECTED = {"rotating clear": "certified", "colliding swing": "violation", "translating": "certified"}
+from monitor.certify.types import Verdict
+
+_EXPECTED = {"rotating clear": Verdict.CERTIFIED, "colliding swing": Verdict.VIOLATION,
+             "translating": Verdict.CERTIFIED}
 
 
 def _processes(text: str) -> int | str:

@@ -22,11 +22,12 @@ import json
 from importlib import resources
 from typing import Any
 
+from monitor.certify.types import Verdict
 from monitor.log import topics
 
 LAYOUT_FILE = "foxglove_layout.json"
 
-VERDICT_COLORS = {"certified": "#2ca02c", "uncertain": "#ff7f0e", "violation": "#d62728"}
+VERDICT_COLORS = {Verdict.CERTIFIED: "#2ca02c", Verdict.UNCERTAIN: "#ff7f0e", Verdict.VIOLATION: "#d62728"}
 
 
 def build_layout() -> Any:

@@ -42,6 +42,7 @@ from foxglove.messages import (
     Vector3,
 )
 
+from monitor.certify.types import Verdict
 from monitor.log import topics
 
 WORLD_FRAME = "world"
@@ -210,7 +211,7 @@ class FoxgloveScene:
     def witness_markers(t_ns: int, cert: dict[str, Any]) -> SceneUpdate | None:
         """Red sphere + label at the witness (violation) or amber label (uncertain)."""
         verdict = cert.get("verdict")
-        if verdict == "certified":
+        if verdict == Verdict.CERTIFIED:
             return None
         ts = _stamp(t_ns)
         wit = cert.get("witness")
