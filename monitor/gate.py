@@ -63,6 +63,7 @@ import numpy as np
 from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
 from monitor.certify.request import BudgetLimits, CertifyRequest
+from monitor.certify.types import Method, Verdict
 from monitor.errors import InvalidInputError
 from monitor.gate_policy import announce, applied_cost, block_reason, describe_gate, safety_keys
 from monitor.gate_settings import (
@@ -673,8 +674,9 @@ class StepReport:
             did not certify.
         certify_us: wall time (µs) spent certifying (proposal, brake tail, fallback).
         time: window start (s).
-        brake_verdict: verdict of the braking tail after the proposed window
-            (``""`` when not checked: brake check off, ``"warn"``, or proposal unsafe).
+        brake_verdict: verdict of the braking tail after the proposed window, a
+            :class:`monitor.Verdict` (``""`` when not checked: brake check off, ``"warn"``, or
+            proposal unsafe).
         plan: the proposed window's plan.
         stepped: True when :meth:`Gate.step` advanced the caller's data.
     """
@@ -1502,8 +1504,8 @@ class Gate:
         hit = self._nothing_template
         if hit is None or hit[0] is not req or hit[1] is not allowed:
             # built by the constructor once per (request, allowed pairs); each window gets a copy
-            template = Certificate("certified", (0.0, 0.0), req.margin, req.epsilon, req.method.value, None,
-                                   None, math.inf, (), {},
+            template = Certificate(Verdict.CERTIFIED, (0.0, 0.0), req.margin, req.epsilon, req.method.value,
+                                   None, None, math.inf, (), {},
                                    allowed if type(allowed) is tuple else tuple(allowed))
             template.__dict__["request"] = req
             hit = self._nothing_template = (req, allowed, template)
@@ -1649,7 +1651,7 @@ class Gate:
             self._call_request = None
         if not cert.certified or cert.stats.get("ongoing", 0):
             w = cert.witness
-            if (cert.verdict == "violation" and not cert.stats.get("ongoing", 0) and w is not None
+            if (cert.verdict == Verdict.VIOLATION and not cert.stats.get("ongoing", 0) and w is not None
                     and float(tail_rows[0, 0]) <= w.time <= float(rows[-1, 0])):
                 self._joint_witness = w  # a confirmed violation inside the tail (see _tail_refuted)
             return None
@@ -1802,7 +1804,7 @@ class Gate:
         stats["reused_pairs"] = len(reused)
         stats["pairs"] = len(pairs)
         if fresh is None:
-            merged = Certificate(verdict, (t0, t1), self.margin, self.epsilon, "auto", None, None,
+            merged = Certificate(verdict, (t0, t1), self.margin, self.epsilon, Method.AUTO, None, None,
                                  clearance, pairs, stats, scene.allowed_pairs)
         else:
             merged = Certificate(verdict, fresh.window, fresh.margin, fresh.epsilon, fresh.method,
@@ -1814,7 +1816,7 @@ class Gate:
     def _remember(self, cert: Certificate, keys: dict[int, bytes]) -> None:
         for i, key in keys.items():
             p = cert.pairs[i]
-            if p.verdict == "certified":
+            if p.verdict == Verdict.CERTIFIED:
                 self._cache[i] = (key, p)
             else:
                 self._cache.pop(i, None)
@@ -1823,8 +1825,8 @@ class Gate:
     def is_unsafe(self, verdict: str) -> bool:
         """Whether ``verdict`` counts as unsafe under the gate's ``unsafe=`` policy."""
         if self.unsafe == "violation":
-            return verdict == "violation"
-        return verdict != "certified"
+            return verdict == Verdict.VIOLATION
+        return verdict != Verdict.CERTIFIED
 
     def fallback_ctrl(self, data: mujoco.MjData) -> np.ndarray:
         """The fallback control for the current state (see ``fallback=``)."""
@@ -1964,7 +1966,7 @@ class Gate:
             if not unsafe and brake_on and not self.scene.candidate_pairs:
                 # No candidate pairs: every window (the tail's too) certifies trivially and
                 # no proposal can ever be rejected, so the tail and its brake are never used.
-                brake_verdict = "certified"
+                brake_verdict = Verdict.CERTIFIED
             elif not unsafe and brake_on:
                 if tail is None:  # raw rows kept: a committed tail is replayed against them (_tail_covers)
                     rows, brake_next = self._rollout.brake_rows(
@@ -1976,7 +1978,7 @@ class Gate:
                 if joint_witness is not None and self._tail_refuted(joint_witness, tail):
                     # the joint call confirmed a violation inside the tail (see _tail_refuted)
                     tail_cert = None
-                    brake_verdict = "violation"
+                    brake_verdict = Verdict.VIOLATION
                     self.stats["tail_refuted"] += 1
                 else:
                     tail_cert, tail_us = self._certify(tail.plan)
@@ -1989,7 +1991,7 @@ class Gate:
             # (both certified, no ongoing contact): a streak of rejected or in-contact windows
             # then costs two calls per step, not three.
             self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
-                                    and tail is not None and brake_verdict == "certified"
+                                    and tail is not None and brake_verdict == Verdict.CERTIFIED
                                     and not tail_cert.stats.get("ongoing", 0))
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
@@ -2023,7 +2025,7 @@ class Gate:
                 fb_cert, fb_us = self._certify(applied_plan)
                 us += fb_us
             applied_verdict = fb_cert.verdict
-            fb_ok = fb_cert.verdict == "certified"
+            fb_ok = fb_cert.verdict == Verdict.CERTIFIED
             if not fb_ok:
                 self.stats["fallback_uncertified"] += 1
                 (_LOG.debug if self._warned else _LOG.warning)(

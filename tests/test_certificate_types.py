@@ -201,3 +201,33 @@ def test_certify_rejects_unknown_method_with_the_old_message(scene_model):
     with pytest.raises(InvalidInputError,
                        match=r"^method must be one of \('auto', 'toleranced', 'extrusion'\), got 'fast'$"):
         certify(scene, _plan(model), method="fast")
+
+
+def test_gate_brake_verdicts_are_verdict_members():
+    """StepReport.brake_verdict is a Verdict whenever a braking tail was judged (it was a plain str on
+    the two-call path); "" only when no tail was checked."""
+    import mujoco
+
+    from monitor._paths import scene_path
+    from monitor.gate import Gate
+
+    model = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    gate = Gate(model, margin=0.001)
+    judged = []
+    for k in range(40):  # toward the wall and back: accepted steps, refused ones, braking tails
+        r = gate.step(data, np.array([6.0 if k < 25 else -6.0]))
+        assert r.brake_verdict == "" or type(r.brake_verdict) is Verdict, repr(r.brake_verdict)
+        judged += [r.brake_verdict] if r.brake_verdict else []
+    assert judged  # the loop judged some tails (the assertion above ran on them)
+
+    # a scene with no candidate pair: its tails are certified without a call
+    lone = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint name="x" type="slide" axis="1 0 0"/><geom size="0.1"/></body>'
+        '</worldbody><actuator><velocity joint="x" kv="10"/></actuator></mujoco>')
+    lone_data = mujoco.MjData(lone)
+    with pytest.warns(UserWarning):
+        lone_gate = Gate(lone)
+        r = lone_gate.step(lone_data, np.array([0.5]))
+    assert type(r.brake_verdict) is Verdict and r.brake_verdict == Verdict.CERTIFIED
