@@ -29,6 +29,8 @@ import warnings
 from collections import Counter
 from typing import Any
 
+from monitor.certify.types import Verdict
+
 _LOG = logging.getLogger("monitor.gate")
 
 SAFETY_INFO_VERSION = 2
@@ -65,9 +67,9 @@ def block_reason(report: Any) -> str:
     """Why a report's proposal was replaced (``""`` when it was not); see module docstring."""
     if not report.replaced:
         return ""
-    if report.verdict == "violation":
+    if report.verdict == Verdict.VIOLATION:
         why = ["proposal_violation"]
-    elif report.verdict != "certified":
+    elif report.verdict != Verdict.CERTIFIED:
         why = ["proposal_uncertain"]
     else:
         why = ["brake_tail_uncertified"]
@@ -78,14 +80,15 @@ def block_reason(report: Any) -> str:
 
 def applied_cost(report: Any) -> float:
     """1.0 when the applied window has a confirmed violation, else 0.0."""
-    return 1.0 if report.applied_verdict == "violation" else 0.0
+    return 1.0 if report.applied_verdict == Verdict.VIOLATION else 0.0
 
 
 def safety_keys(report: Any | None) -> dict[str, Any]:
     """The version-2 keys of ``info["safety"]`` (blank values for ``report=None``, e.g. reset)."""
     if report is None:
         return {"version": SAFETY_INFO_VERSION, "proposal_cost": 0.0, "intervened": False, "block_reason": ""}
-    return {"version": SAFETY_INFO_VERSION, "proposal_cost": 1.0 if report.verdict == "violation" else 0.0,
+    return {"version": SAFETY_INFO_VERSION,
+            "proposal_cost": 1.0 if report.verdict == Verdict.VIOLATION else 0.0,
             "intervened": bool(report.replaced), "block_reason": block_reason(report)}
 
 

@@ -55,9 +55,10 @@ from typing import Any
 
 import numpy as np
 
+from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError
 
-VERDICTS = ("certified", "violation", "uncertain")
+VERDICTS = tuple(Verdict)
 
 
 # --------------------------------------------------------------------------- policies

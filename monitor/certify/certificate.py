@@ -246,7 +246,7 @@ class Certificate:
     @property
     def certified(self) -> bool:
         """True only for the verdict ``"certified"``."""
-        return self.verdict == "certified"
+        return self.verdict == Verdict.CERTIFIED
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable form (``json.dumps`` works on it directly; plain strings, no enums)."""

@@ -61,6 +61,7 @@ from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
 from monitor._json import jsonable
+from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError, LogFormatError
 from monitor.log import topics
 from monitor.log.digest import METADATA_DIGEST, Digest
@@ -642,7 +643,7 @@ class MonitorLog:
         if not math.isfinite(wall) or wall < 0:
             raise InvalidInputError(f"wall_time must be finite Unix seconds >= 0, got {wall_time!r}")
         cert = certificate.to_dict() if hasattr(certificate, "to_dict") else dict(certificate)
-        if cert.get("verdict") not in ("certified", "violation", "uncertain"):
+        if cert.get("verdict") not in tuple(Verdict):
             raise InvalidInputError(f"certificate verdict must be certified/violation/uncertain, "
                                     f"got {cert.get('verdict')!r}")
         if plan is not None:
@@ -669,15 +670,15 @@ class MonitorLog:
         if plan is not None:
             self._put(topics.PLAN, log_ns, sim_ns, _dumps({**head, **plan_msg}))
         self._put(topics.CERTIFICATE, log_ns, sim_ns, _dumps({**head, **cert}))
-        if cert["verdict"] != "certified":
-            bad = [p for p in cert.get("pairs", []) if p.get("verdict") != "certified"]
+        if cert["verdict"] != Verdict.CERTIFIED:
+            bad = [p for p in cert.get("pairs", []) if p.get("verdict") != Verdict.CERTIFIED]
             self._put(topics.VIOLATION, log_ns, sim_ns, _dumps({
                 **head, "verdict": cert["verdict"], "window": cert.get("window"),
                 "margin": cert.get("margin"), "earliest_time": cert.get("earliest_time"),
                 "clearance": cert.get("clearance"),
                 "witness": cert.get("witness"), "pairs": bad, "replaced": bool(replaced)}))
         if replaced and reason is None:
-            reason = (cert["verdict"] if cert["verdict"] != "certified"
+            reason = (cert["verdict"] if cert["verdict"] != Verdict.CERTIFIED
                       else "replaced although the window is certified (e.g. its braking tail is not)")
         if proposed_action is not None or applied_action is not None or replaced:
             self._put(topics.ACTION, log_ns, sim_ns, _dumps({
@@ -686,7 +687,7 @@ class MonitorLog:
                 "applied": None if applied_action is None else np.ravel(applied_action),
                 "replaced": bool(replaced),
                 **({} if applied_window is None else {"applied_window": int(applied_window)})}))
-        if cert["verdict"] != "certified" or replaced:
+        if cert["verdict"] != Verdict.CERTIFIED or replaced:
             level, text = log_line(k, self._episode, t, cert, reason if replaced else None)
             self._put(topics.LOG, log_ns, sim_ns, _dumps({
                 "timestamp": {"sec": log_ns // 1_000_000_000, "nsec": log_ns % 1_000_000_000},
@@ -782,16 +783,16 @@ def log_line(index: int, episode: int, sim_time: float, cert: dict[str, Any],
     where = f"window {index} (episode {episode}, t={sim_time:.4f} s)"
     verdict = cert.get("verdict")
     wit = cert.get("witness")
-    if verdict == "violation" and wit:
+    if verdict == Verdict.VIOLATION and wit:
         ga, gb = wit.get("geoms", ["?", "?"])
         text = (f"{where}: violation {ga} / {gb} at t={_fmt(wit.get('time'), ' s')}, "
                 f"distance {_fmt(wit.get('distance'), ' m')} < margin {_fmt(cert.get('margin'), ' m')}")
         level = LOG_LEVEL_ERROR
-    elif verdict in ("violation", "uncertain"):
-        n = sum(1 for p in cert.get("pairs", []) if p.get("verdict") != "certified")
+    elif verdict in (Verdict.VIOLATION, Verdict.UNCERTAIN):
+        n = sum(1 for p in cert.get("pairs", []) if p.get("verdict") != Verdict.CERTIFIED)
         text = (f"{where}: {verdict} from t={_fmt(cert.get('earliest_time'), ' s')} "
                 f"({n} pair(s) not certified; clearance {_fmt(cert.get('clearance'), ' m')})")
-        level = LOG_LEVEL_ERROR if verdict == "violation" else LOG_LEVEL_WARNING
+        level = LOG_LEVEL_ERROR if verdict == Verdict.VIOLATION else LOG_LEVEL_WARNING
     else:
         text, level = f"{where}: certified", LOG_LEVEL_WARNING
     if replaced_reason is not None:
