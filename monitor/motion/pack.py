@@ -23,6 +23,7 @@ import sys
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.motion import _kinematics as K_
@@ -240,7 +241,7 @@ def _track_arrays(tracks: list, K: int) -> tuple[np.ndarray, ...]:
 
 def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
             tracks: list, tol: Tolerances) -> MotionPack:
-    """Derived arrays (flags, magnitudes: one compiled call; rounding scale: one more) and the pack.
+    """Derived arrays (flags, magnitudes, rounding scale: one compiled call) and the pack.
 
     ``tracks``: the trajectory's own ``QuatTrack`` per quaternion track (order of ``st.qt_adr``).
     """
@@ -249,24 +250,48 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
     if len(tracks) != st.qt_adr.shape[0]:
         raise InvalidInputError(f"{len(tracks)} quaternion tracks for {st.qt_adr.shape[0]} ball/free joints")
     target, half, phi, cum, same = _track_arrays(tracks, K)
-    moving = np.empty(nbody, dtype=np.int64)
-    rotating = np.empty(nbody, dtype=np.int64)
-    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, 0.0])
-    KN.derive(qpos, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
-              st.jnt_qposadr, moving, rotating, tol_arr)
-    tol_arr[KN.TOL_QMAG] += st.qpos0_mag
-    tol_arr[KN.TOL_PATHMAG] = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
-    # = MotionPack(times=..., ..., tol=tol_arr), positionally in field order (no keyword parsing)
-    mp = _new_pack(MotionPack, (
-        times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis, st.jnt_axis_norm,
-        st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos, body_quat, st.body_mocap,
-        moving, rotating, st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr))
-    if moving.any():
-        z = np.zeros(1)
-        tol_arr[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
+    pathmag = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
+    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, pathmag])
+    fields = (times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis,
+              st.jnt_axis_norm, st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos,
+              body_quat, st.body_mocap, np.empty(nbody, dtype=np.int64), np.empty(nbody, dtype=np.int64),
+              st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr)
+    _derive_and_scale(st.qpos0_mag, *fields)
+    return _new_pack(MotionPack, fields)  # = MotionPack(times=..., ..., tol=tol_arr), without keyword parsing
+
+
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
+def _derive_and_scale(qpos0_mag, times, qpos, qpos0, jnt_type, jnt_qposadr, jnt_pos, jnt_axis, jnt_axis_norm,
+                      jnt_track, body_parent, body_jntadr, body_jntnum, body_pos, body_quat, body_mocap,
+                      body_moving, body_rotating, ref_points, qt_adr, qt_target, qt_half, qt_phi, qt_cum,
+                      qt_same, tol) -> None:
+    """Fill a pack's derived arrays in place, in one compiled call (issue 12: was two, plus numpy).
+
+    Arguments: ``qpos0_mag`` (max |qpos0|) and the 25 :class:`MotionPack` arrays in field order
+    (passed one by one: a numba call unboxes separate arrays about 2 us faster than the
+    named tuple; the tuple is rebuilt here, the same arrays). Outputs: ``body_moving`` /
+    ``body_rotating`` (nbody,) and ``tol[4]`` (max |qpos|) by :func:`monitor.motion.kernel.derive`,
+    then ``tol[4] += qpos0_mag``, then, when some body moves, ``tol[3]`` (the rounding scale, m)
+    by ``batch(pack, BATCH_SCALE, ...)`` with (1, nbody, ...) scratch; else it stays 0.
+    ``tol[3]`` must be 0 and ``tol[5]`` (rotation path magnitude) set on entry. The same
+    compiled functions and float64 operations in the same order as the former Python sequence
+    (``derive``, ``+=``, ``moving.any()``, ``batch``): every byte of the pack is the same.
+    """
+    KN.derive(qpos, body_parent, body_mocap, body_jntadr, body_jntnum, jnt_type, jnt_qposadr, body_moving,
+              body_rotating, tol)
+    tol[KN.TOL_QMAG] += qpos0_mag
+    nbody = body_parent.shape[0]
+    for b in range(nbody):
+        if body_moving[b] != 0:
+            mp = MotionPack(times, qpos, qpos0, jnt_type, jnt_qposadr, jnt_pos, jnt_axis, jnt_axis_norm,
+                            jnt_track, body_parent, body_jntadr, body_jntnum, body_pos, body_quat,
+                            body_mocap, body_moving, body_rotating, ref_points, qt_adr, qt_target, qt_half,
+                            qt_phi, qt_cum, qt_same, tol)
+            z = np.zeros(1)
+            tol[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
                                          np.empty((1, nbody, 3, 3)), np.empty((1, nbody)),
-                                         np.empty((1, nbody)))  # the pack shares tol_arr
-    return mp
+                                         np.empty((1, nbody)))
+            return
 
 
 _new_pack = tuple.__new__
