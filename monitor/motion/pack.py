@@ -158,6 +158,9 @@ class _Static(NamedTuple):
     """Shapes of the :data:`STATIC_FIELDS` arrays, in order (part of :func:`static_key`)."""
     key_memo: list | None = None
     """[(tree bytes, key)] of the last :func:`static_key` computed from this tree (a cache)."""
+    keep_runs: tuple | None = None
+    """(start, stop) row ranges, in order, of the bodies that are not in ``mocap_rows`` (their union
+    is every other row; used by :func:`static_key` to compare a pack's pose rows without a copy)."""
 
 
 def _tree_buffer(fields: list[tuple[np.ndarray, type]]) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -217,7 +220,20 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
     tree, views = _tree_buffer([fields[name] for name in STATIC_FIELDS])
     v = dict(zip(STATIC_FIELDS, views, strict=True))
     return _Static(**v, mocapid=mid, qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=mocap_rows,
-                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None])
+                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None],
+                   keep_runs=_row_runs(mocap_rows, parent.shape[0]))
+
+
+def _row_runs(skip: np.ndarray, n: int) -> tuple[tuple[int, int], ...]:
+    """The (start, stop) ranges of rows 0..n-1 that are not in ``skip`` (sorted), in order."""
+    runs, start = [], 0
+    for r in skip.tolist():
+        if r > start:
+            runs.append((start, r))
+        start = r + 1
+    if start < n:
+        runs.append((start, n))
+    return tuple(runs)
 
 
 _NO_TRACKS: dict[int, tuple[np.ndarray, ...]] = {}
@@ -406,14 +422,16 @@ def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
                     same = False
                     break
                 a, b = arrs[k], mine[k]
-                if a.shape != b.shape or a.dtype != b.dtype:
+                if a.shape != b.shape or a.dtype != b.dtype or st.keep_runs is None:
                     same = False
                     break
-                if st.mocap_rows.size:      # mocap rows are >= 1 (the world has no mocap id)
-                    a = a.copy()
-                    a[st.mocap_rows] = 0.0
-                if a.tobytes() != b.tobytes():
-                    same = False
+                # equal to the tree's rows outside the mocap rows (>= 1: the world has no mocap
+                # id), compared run by run (basic slices: no copy of the pose arrays)
+                for i, j in st.keep_runs:
+                    if a[i:j].tobytes() != b[i:j].tobytes():
+                        same = False
+                        break
+                if not same:
                     break
         if same:
             tree = st.tree.tobytes()
@@ -506,11 +524,38 @@ def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
                 and (mp.qt_same != 0).tobytes() == join([tr.same.tobytes() for tr in tracks])):
             return False
     if st.nmocap:
+        run = _mocap_run(st)
+        if run is not None:     # rows r0..r1-1 hold mocap ids 0..M-1 in order: basic slices
+            r0, r1 = run
+            return (mp.body_pos[r0:r1].tobytes() == plan._mocap_pos.tobytes()
+                    and mp.body_quat[r0:r1].tobytes() == plan._mocap_quat.tobytes())
         rows, mid = st.mocap_rows, st.mocap_ids   # the structure's own (its key holds body_mocapid)
         if not (mp.body_pos[rows].tobytes() == plan._mocap_pos[mid].tobytes()
                 and mp.body_quat[rows].tobytes() == plan._mocap_quat[mid].tobytes()):
             return False
     return True
+
+
+def _mocap_run(st: object) -> tuple[int, int] | None:
+    """(r0, r1) when the structure's mocap rows are r0..r1-1 with mocap ids 0..M-1 in order, else None.
+
+    Then ``body_pos[rows]`` == ``body_pos[r0:r1]`` and ``mocap_pos[ids]`` == ``mocap_pos``
+    (all M rows), so :func:`plan_data_agrees` compares slices instead of fancy-indexed copies.
+    Cached on the structure (``_ModelStructure``), whose ``mocap_rows`` / ``mocap_ids`` are
+    read-only snapshots; the cache holds the two arrays it was derived from and is used only
+    while the structure still holds those very objects.
+    """
+    rows, mid = st.mocap_rows, st.mocap_ids
+    hit = getattr(st, "_pack_mocap_run", None)
+    if hit is not None and hit[0] is rows and hit[1] is mid:
+        return hit[2]
+    m = int(mid.shape[0])
+    run = None
+    if m and rows.shape == (m,) and np.array_equal(mid, np.arange(m)) \
+            and np.array_equal(rows, np.arange(int(rows[0]), int(rows[0]) + m)):
+        run = (int(rows[0]), int(rows[0]) + m)
+    st._pack_mocap_run = (rows, mid, run)
+    return run
 
 
 def pack_trajectory(traj: object) -> MotionPack:
