@@ -90,6 +90,7 @@ import weakref
 import numpy as np
 from numba import njit
 
+from monitor.errors import MonitorError as _MonitorError
 from monitor.geometry._gjk import (
     OUT_SIZE,
     _compact,
@@ -99,6 +100,7 @@ from monitor.geometry._gjk import (
     halfspace_distance,
     pose_relative,
 )
+from monitor.motion import pack as _pack  # read per call (_pack.f): tests replace its functions
 from monitor.motion.kernel import (
     _bounds_core,
     _search_right,
@@ -1550,19 +1552,17 @@ def _pack_agrees(traj, mp) -> bool:
     joint axis or parent is refused on its first use, also after a good pack of the same
     model was verified, and after an in-place edit of the shared tree arrays).
     """
-    from monitor.motion.pack import plan_data_agrees, static_key
-
     if _is_plain_body_motion(traj):
         return _body_motion_agrees(traj, mp)
     st = getattr(traj, "_st", None)
     skey = getattr(st, "key", None)
     if skey is None or not hasattr(traj, "_quat_tracks"):
         return _poses_match(traj, mp)
-    key = (skey, static_key(mp, _pack_static(traj)))
+    key = (skey, _pack.static_key(mp, _pack_static(traj)))
     state = _VERIFIED_TREES.get(key)
     if state is not True and not _tree_verified(traj, mp, key):   # True: verified (a dict hit)
         return False
-    if not plan_data_agrees(traj, mp):
+    if not _pack.plan_data_agrees(traj, mp):
         return False
     if state is None or state == "full":     # the key's first plan, or a key already caught once
         if not _poses_match(traj, mp):
@@ -1759,14 +1759,11 @@ def trajectory_pack_memo(traj) -> tuple:
         hit = None
     if hit is not None:
         return hit if hit[0] is not None else (None, None)
-    from monitor.errors import MonitorError
-    from monitor.motion.pack import pack_trajectory
-
     try:
-        mp = pack_trajectory(traj)
+        mp = _pack.pack_trajectory(traj)
         if not _pack_agrees(traj, mp):
             mp = None
-    except (MonitorError, TypeError, AttributeError, ValueError):
+    except (_MonitorError, TypeError, AttributeError, ValueError):
         mp = None
     entry = (mp, {})
     try:

@@ -23,6 +23,7 @@ import sys
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.motion import _kinematics as K_
@@ -157,6 +158,9 @@ class _Static(NamedTuple):
     """Shapes of the :data:`STATIC_FIELDS` arrays, in order (part of :func:`static_key`)."""
     key_memo: list | None = None
     """[(tree bytes, key)] of the last :func:`static_key` computed from this tree (a cache)."""
+    keep_runs: tuple | None = None
+    """(start, stop) row ranges, in order, of the bodies that are not in ``mocap_rows`` (their union
+    is every other row; used by :func:`static_key` to compare a pack's pose rows without a copy)."""
 
 
 def _tree_buffer(fields: list[tuple[np.ndarray, type]]) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -216,7 +220,20 @@ def _static(qpos0: object, jnt_type: object, jnt_qposadr: object, jnt_pos: objec
     tree, views = _tree_buffer([fields[name] for name in STATIC_FIELDS])
     v = dict(zip(STATIC_FIELDS, views, strict=True))
     return _Static(**v, mocapid=mid, qpos0_mag=float(np.max(np.abs(q0), initial=0.0)), mocap_rows=mocap_rows,
-                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None])
+                   quat_j=quat_j, tree=tree, shapes=tuple(a.shape for a in views), key_memo=[None],
+                   keep_runs=_row_runs(mocap_rows, parent.shape[0]))
+
+
+def _row_runs(skip: np.ndarray, n: int) -> tuple[tuple[int, int], ...]:
+    """The (start, stop) ranges of rows 0..n-1 that are not in ``skip`` (sorted), in order."""
+    runs, start = [], 0
+    for r in skip.tolist():
+        if r > start:
+            runs.append((start, r))
+        start = r + 1
+    if start < n:
+        runs.append((start, n))
+    return tuple(runs)
 
 
 _NO_TRACKS: dict[int, tuple[np.ndarray, ...]] = {}
@@ -240,7 +257,7 @@ def _track_arrays(tracks: list, K: int) -> tuple[np.ndarray, ...]:
 
 def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarray, body_quat: np.ndarray,
             tracks: list, tol: Tolerances) -> MotionPack:
-    """Derived arrays (flags, magnitudes: one compiled call; rounding scale: one more) and the pack.
+    """Derived arrays (flags, magnitudes, rounding scale: one compiled call) and the pack.
 
     ``tracks``: the trajectory's own ``QuatTrack`` per quaternion track (order of ``st.qt_adr``).
     """
@@ -249,24 +266,48 @@ def _finish(st: _Static, times: np.ndarray, qpos: np.ndarray, body_pos: np.ndarr
     if len(tracks) != st.qt_adr.shape[0]:
         raise InvalidInputError(f"{len(tracks)} quaternion tracks for {st.qt_adr.shape[0]} ball/free joints")
     target, half, phi, cum, same = _track_arrays(tracks, K)
-    moving = np.empty(nbody, dtype=np.int64)
-    rotating = np.empty(nbody, dtype=np.int64)
-    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, 0.0])
-    KN.derive(qpos, st.body_parent, st.body_mocap, st.body_jntadr, st.body_jntnum, st.jnt_type,
-              st.jnt_qposadr, moving, rotating, tol_arr)
-    tol_arr[KN.TOL_QMAG] += st.qpos0_mag
-    tol_arr[KN.TOL_PATHMAG] = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
-    # = MotionPack(times=..., ..., tol=tol_arr), positionally in field order (no keyword parsing)
-    mp = _new_pack(MotionPack, (
-        times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis, st.jnt_axis_norm,
-        st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos, body_quat, st.body_mocap,
-        moving, rotating, st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr))
-    if moving.any():
-        z = np.zeros(1)
-        tol_arr[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
+    pathmag = float(np.max(cum[:, -1], initial=0.0)) if cum.shape[0] else 0.0
+    tol_arr = np.array([tol.rel_pad, tol.abs_pad, tol.scale_pad, 0.0, 0.0, pathmag])
+    fields = (times, qpos, st.qpos0, st.jnt_type, st.jnt_qposadr, st.jnt_pos, st.jnt_axis,
+              st.jnt_axis_norm, st.jnt_track, st.body_parent, st.body_jntadr, st.body_jntnum, body_pos,
+              body_quat, st.body_mocap, np.empty(nbody, dtype=np.int64), np.empty(nbody, dtype=np.int64),
+              st.ref_points, st.qt_adr, target, half, phi, cum, same, tol_arr)
+    _derive_and_scale(st.qpos0_mag, *fields)
+    return _new_pack(MotionPack, fields)  # = MotionPack(times=..., ..., tol=tol_arr), without keyword parsing
+
+
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
+def _derive_and_scale(qpos0_mag, times, qpos, qpos0, jnt_type, jnt_qposadr, jnt_pos, jnt_axis, jnt_axis_norm,
+                      jnt_track, body_parent, body_jntadr, body_jntnum, body_pos, body_quat, body_mocap,
+                      body_moving, body_rotating, ref_points, qt_adr, qt_target, qt_half, qt_phi, qt_cum,
+                      qt_same, tol) -> None:
+    """Fill a pack's derived arrays in place, in one compiled call (issue 12: was two, plus numpy).
+
+    Arguments: ``qpos0_mag`` (max |qpos0|) and the 25 :class:`MotionPack` arrays in field order
+    (passed one by one: a numba call unboxes separate arrays about 2 us faster than the
+    named tuple; the tuple is rebuilt here, the same arrays). Outputs: ``body_moving`` /
+    ``body_rotating`` (nbody,) and ``tol[4]`` (max |qpos|) by :func:`monitor.motion.kernel.derive`,
+    then ``tol[4] += qpos0_mag``, then, when some body moves, ``tol[3]`` (the rounding scale, m)
+    by ``batch(pack, BATCH_SCALE, ...)`` with (1, nbody, ...) scratch; else it stays 0.
+    ``tol[3]`` must be 0 and ``tol[5]`` (rotation path magnitude) set on entry. The same
+    compiled functions and float64 operations in the same order as the former Python sequence
+    (``derive``, ``+=``, ``moving.any()``, ``batch``): every byte of the pack is the same.
+    """
+    KN.derive(qpos, body_parent, body_mocap, body_jntadr, body_jntnum, jnt_type, jnt_qposadr, body_moving,
+              body_rotating, tol)
+    tol[KN.TOL_QMAG] += qpos0_mag
+    nbody = body_parent.shape[0]
+    for b in range(nbody):
+        if body_moving[b] != 0:
+            mp = MotionPack(times, qpos, qpos0, jnt_type, jnt_qposadr, jnt_pos, jnt_axis, jnt_axis_norm,
+                            jnt_track, body_parent, body_jntadr, body_jntnum, body_pos, body_quat,
+                            body_mocap, body_moving, body_rotating, ref_points, qt_adr, qt_target, qt_half,
+                            qt_phi, qt_cum, qt_same, tol)
+            z = np.zeros(1)
+            tol[KN.TOL_SCALE] = KN.batch(mp, KN.BATCH_SCALE, z, z, np.empty((1, nbody, 3)),
                                          np.empty((1, nbody, 3, 3)), np.empty((1, nbody)),
-                                         np.empty((1, nbody)))  # the pack shares tol_arr
-    return mp
+                                         np.empty((1, nbody)))
+            return
 
 
 _new_pack = tuple.__new__
@@ -381,14 +422,16 @@ def static_key(mp: MotionPack, st: _Static | None = None) -> bytes:
                     same = False
                     break
                 a, b = arrs[k], mine[k]
-                if a.shape != b.shape or a.dtype != b.dtype:
+                if a.shape != b.shape or a.dtype != b.dtype or st.keep_runs is None:
                     same = False
                     break
-                if st.mocap_rows.size:      # mocap rows are >= 1 (the world has no mocap id)
-                    a = a.copy()
-                    a[st.mocap_rows] = 0.0
-                if a.tobytes() != b.tobytes():
-                    same = False
+                # equal to the tree's rows outside the mocap rows (>= 1: the world has no mocap
+                # id), compared run by run (basic slices: no copy of the pose arrays)
+                for i, j in st.keep_runs:
+                    if a[i:j].tobytes() != b[i:j].tobytes():
+                        same = False
+                        break
+                if not same:
                     break
         if same:
             tree = st.tree.tobytes()
@@ -481,11 +524,38 @@ def plan_data_agrees(plan: object, mp: MotionPack) -> bool:
                 and (mp.qt_same != 0).tobytes() == join([tr.same.tobytes() for tr in tracks])):
             return False
     if st.nmocap:
+        run = _mocap_run(st)
+        if run is not None:     # rows r0..r1-1 hold mocap ids 0..M-1 in order: basic slices
+            r0, r1 = run
+            return (mp.body_pos[r0:r1].tobytes() == plan._mocap_pos.tobytes()
+                    and mp.body_quat[r0:r1].tobytes() == plan._mocap_quat.tobytes())
         rows, mid = st.mocap_rows, st.mocap_ids   # the structure's own (its key holds body_mocapid)
         if not (mp.body_pos[rows].tobytes() == plan._mocap_pos[mid].tobytes()
                 and mp.body_quat[rows].tobytes() == plan._mocap_quat[mid].tobytes()):
             return False
     return True
+
+
+def _mocap_run(st: object) -> tuple[int, int] | None:
+    """(r0, r1) when the structure's mocap rows are r0..r1-1 with mocap ids 0..M-1 in order, else None.
+
+    Then ``body_pos[rows]`` == ``body_pos[r0:r1]`` and ``mocap_pos[ids]`` == ``mocap_pos``
+    (all M rows), so :func:`plan_data_agrees` compares slices instead of fancy-indexed copies.
+    Cached on the structure (``_ModelStructure``), whose ``mocap_rows`` / ``mocap_ids`` are
+    read-only snapshots; the cache holds the two arrays it was derived from and is used only
+    while the structure still holds those very objects.
+    """
+    rows, mid = st.mocap_rows, st.mocap_ids
+    hit = getattr(st, "_pack_mocap_run", None)
+    if hit is not None and hit[0] is rows and hit[1] is mid:
+        return hit[2]
+    m = int(mid.shape[0])
+    run = None
+    if m and rows.shape == (m,) and np.array_equal(mid, np.arange(m)) \
+            and np.array_equal(rows, np.arange(int(rows[0]), int(rows[0]) + m)):
+        run = (int(rows[0]), int(rows[0]) + m)
+    st._pack_mocap_run = (rows, mid, run)
+    return run
 
 
 def pack_trajectory(traj: object) -> MotionPack:
