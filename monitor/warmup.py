@@ -176,7 +176,8 @@ def serialise_cache_saves() -> bool:
 
 # Child tasks of the parallel warm-up, longest first. They compile disjoint sets of functions, in
 # an order that keeps both cores busy (docs/notes/issue-12-suite-time.md, cold CPU seconds):
-#   motion:   derive + batch (~12 s) | signal | certify cases: window_kernel with the callees it
+#   motion:   pack._derive_and_scale = derive + batch (~12 s) | signal | certify cases: window_kernel with
+#             the callees it
 #             shares with pair_window (~27 s) | core_distance_batch (~1 s)
 #   geometry: Scene build: core_distance (~11 s) | signal | null-set LP kernels (~12 s) | signal |
 #             fat-feature kernels (~11 s) | pair_window on the cached callees (~12 s)
@@ -307,7 +308,7 @@ def _child_task(task: str, shared: str | None = None) -> dict[str, str | None]:
         from monitor.certify import kernels
 
         plans = {name: Plan(np.array([0.0, 0.1]), q0 + np.array(q), model) for name, q in _CASES.items()}
-        kernels.trajectory_pack(plans["rotating clear"])  # derive, batch
+        kernels.trajectory_pack(plans["rotating clear"])  # pack._derive_and_scale (derive, batch)
         signal(_BATCH_READY)
         _wait_for(signal_file(_SCENE_READY), parent)
         scene = Scene.from_model(model, pairs="all")
@@ -386,9 +387,11 @@ def _children_cached() -> bool:
         from monitor.certify import extrusion_kernels, extrusion_null, fat_kernels, kernels
         from monitor.geometry import _gjk
         from monitor.motion import kernel as motion_kernel
+        from monitor.motion import pack as motion_pack
 
         entry_points = (_gjk.core_distance, _gjk.core_distance_batch, _gjk.halfspace_distance,
-                        motion_kernel.batch, motion_kernel.derive, kernels.pair_window, kernels.window_kernel,
+                        motion_kernel.batch, motion_kernel.derive, motion_pack._derive_and_scale,
+                        kernels.pair_window, kernels.window_kernel,
                         extrusion_null._dual_simplex_kernel, extrusion_kernels.min_norm_kernel,
                         extrusion_kernels.first_time_kernel,
                         fat_kernels.fat_level, fat_kernels.traj_balls, fat_kernels.screw_poses_bounds)
