@@ -176,9 +176,8 @@ def serialise_cache_saves() -> bool:
 
 # Child tasks of the parallel warm-up, longest first. They compile disjoint sets of functions, in
 # an order that keeps both cores busy (docs/notes/issue-12-suite-time.md, cold CPU seconds):
-#   motion:   pack._derive_and_scale = derive + batch (~12 s) | signal | certify cases: window_kernel with
-#             the callees it
-#             shares with pair_window (~27 s) | core_distance_batch (~1 s)
+#   motion:   pack._derive_and_scale = derive + batch (~12 s) | signal | certify cases: window_kernel
+#             with the callees it shares with pair_window (~27 s) | core_distance_batch (~1 s)
 #   geometry: Scene build: core_distance (~11 s) | signal | null-set LP kernels (~12 s) | signal |
 #             fat-feature kernels (~11 s) | pair_window on the cached callees (~12 s)
 # Each task waits, before a step that calls into another task's functions, for that task's
