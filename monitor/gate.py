@@ -1548,6 +1548,7 @@ class Gate:
         memo = self._static_keys
         if memo is None or not self.reuse or self._call_request is not None:
             return None
+        self._sync_scene()  # a fallback callable may have edited the model since decide's sync (red team 6)
         context = self._reuse_context()
         if memo[0] != context or context != self._cache_context:
             return None
@@ -1738,6 +1739,12 @@ class Gate:
         either |= moving[body_b]
         if either.all():  # every pair has a moving body (the common gated step): nothing to reuse
             return None, {}, {}  # (the cache is neither read nor written: its context is checked below)
+        # User code (a fallback, cast or predict callable) may have edited the model since decide's
+        # sync: the context must name the live geometry, and the pairs above the live pairs (red team 6).
+        version = getattr(scene, "version", 0)
+        self._sync_scene()
+        if getattr(scene, "version", 0) != version:
+            return self._split_reuse(scene, plan)  # rebuilt: split again over the new pairs
         context = self._reuse_context()
         if context != self._cache_context:  # before any read or write of the cache
             self._cache.clear()
@@ -1861,7 +1868,10 @@ class Gate:
         the scene version). It leaves the scratch holding the applied window, so the
         caller commits it instead of stepping again. Else None.
         """
-        if self._tail is None or self._tail_context != self._reuse_context():
+        if self._tail is None:
+            return None
+        self._sync_scene()  # the context compared below must name the live geometry (red team 6)
+        if self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
         tail, cert, qvel = self._tail
         plan = tail.plan  # built now, on the rare path that reads it
