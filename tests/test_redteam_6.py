@@ -182,3 +182,35 @@ def test_a_geom_on_the_inertial_frame_is_where_mujoco_puts_it():
         dist = _ran_distances(m, before, d, r.applied_ctrl, gate.frame_skip)
         false += r.applied_verdict == Verdict.CERTIFIED and min(dist) <= MARGIN
     assert false == 0
+
+
+def test_a_fallback_that_removes_a_pair_splits_the_reuse_over_the_live_pairs():
+    """Finding 1, pair list: a fallback callable drops the first pair; the fallback's certificate is
+    about the live pairs (da1cfd7: it still named the dropped pair, answered from the cache under
+    the old scene). Also guards the fix's re-split in ``_split_reuse`` (a split over the old pair
+    list wrote its keys against the new certificate's pairs: IndexError). General path."""
+    xml = _XML.replace('<body name="wall">', '<body name="back" pos="-0.3 0 0"><geom name="back" type="box" '
+                       'size="0.005 0.2 0.2"/></body>\n    <body name="wall">', 1)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    d.qpos[0] = -0.05
+    back = m.geom("back").id
+    calls = [0]
+
+    def fallback(data: mujoco.MjData) -> np.ndarray:
+        calls[0] += 1
+        if calls[0] == 2:
+            m.geom_contype[back] = m.geom_conaffinity[back] = 0  # the pair (back, ball) leaves
+        return np.zeros(1)
+
+    gate = Gate(m, pairs="mujoco", margin=MARGIN, allowed=None, ongoing="violation", fallback=fallback)
+    wall = m.geom("wall").id
+    m.geom_contype[wall] = m.geom_conaffinity[wall] = 1  # a "mujoco" pair here (the ball rests 3.5 cm off)
+    own = gate._certify
+    gate._certify = lambda plan: own(plan)
+    names = []
+    for _ in range(3):
+        r = gate.step(d, np.array([6.0]))
+        names.append([p.geoms for p in r.fallback_certificate.pairs])
+        assert r.applied_verdict == Verdict.CERTIFIED
+    assert names == [[("back", "ball"), ("wall", "ball")], [("wall", "ball")], [("wall", "ball")]]
