@@ -214,3 +214,35 @@ def test_a_fallback_that_removes_a_pair_splits_the_reuse_over_the_live_pairs():
         names.append([p.geoms for p in r.fallback_certificate.pairs])
         assert r.applied_verdict == Verdict.CERTIFIED
     assert names == [[("back", "ball"), ("wall", "ball")], [("wall", "ball")], [("wall", "ball")]]
+
+
+@pytest.mark.parametrize("wall_x", [-0.05, 0.5])  # onto the ball / away from it
+def test_a_fallback_callable_edit_is_logged_at_the_fallbacks_window(tmp_path, wall_x):
+    """Finding 1, log: the edit a fallback callable makes is noted before the fallback's record (the
+    window certified on it), not before the proposal's (certified before it) nor a step late. Review
+    re-derives every window on the model it was certified on: no CRITICAL (on da1cfd7 the edit was
+    noted a step late, so the falsely certified fallback re-derived on the old model and agreed;
+    noted at the proposal, moving the wall away made review report a false verdict flip)."""
+    from monitor import review
+    from monitor.log import read_log
+
+    m = mujoco.MjModel.from_xml_string(_XML)
+    d = mujoco.MjData(m)
+    d.qpos[0] = -0.05
+    calls = [0]
+
+    def fallback(data: mujoco.MjData) -> np.ndarray:
+        calls[0] += 1
+        if calls[0] == 3:
+            m.body_pos[m.body("wall").id, 0] = wall_x
+        return np.zeros(1)
+
+    path = tmp_path / "edit.mcap"
+    with Gate(m, pairs="all", margin=MARGIN, allowed=None, ongoing="violation", fallback=fallback,
+              log=str(path)) as gate:
+        verdicts = [str(gate.step(d, np.array([6.0])).applied_verdict) for _ in range(4)]
+    assert verdicts[:2] == ["certified", "certified"]
+    assert verdicts[2] == ("violation" if wall_x < 0 else "certified")
+    ver = review.verify(read_log(path))
+    assert ver["critical"] == 0, ver
+    assert any("first at window 5" in str(n) for n in ver["notes"]), ver["notes"]  # step 2's fallback
