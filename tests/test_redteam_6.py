@@ -77,11 +77,11 @@ def _edit(model: mujoco.MjModel, what: str) -> None:
         model.geom_size[0, 0] = 0.05
 
 
-def _false_certificates(general: bool, what: str, steps: int = 3) -> tuple[list[str], int]:
-    """Gate.step with a fallback callable that edits the model on its 2nd call.
+def _scene_and_editing_fallback(edit, at_call: int):
+    """(model, data with the ball at rest 3.5 cm from the wall, fallback callable).
 
-    Returns (applied verdicts, number of steps whose applied window was certified although an
-    exact distance of the motion that ran is <= margin).
+    The fallback returns zero velocity and calls ``edit(model)`` on its ``at_call``-th call (user
+    code inside ``decide``, after its scene sync).
     """
     m = mujoco.MjModel.from_xml_string(_XML)
     d = mujoco.MjData(m)
@@ -90,9 +90,20 @@ def _false_certificates(general: bool, what: str, steps: int = 3) -> tuple[list[
 
     def fallback(data: mujoco.MjData) -> np.ndarray:
         calls[0] += 1
-        if calls[0] == 2:  # user code inside decide, after its scene sync
-            _edit(m, what)
+        if calls[0] == at_call:
+            edit(m)
         return np.zeros(1)
+
+    return m, d, fallback
+
+
+def _false_certificates(general: bool, what: str, steps: int = 3) -> tuple[list[str], int]:
+    """Gate.step with a fallback callable that edits the model on its 2nd call.
+
+    Returns (applied verdicts, number of steps whose applied window was certified although an
+    exact distance of the motion that ran is <= margin).
+    """
+    m, d, fallback = _scene_and_editing_fallback(lambda model: _edit(model, what), 2)
 
     gate = Gate(m, pairs="all", margin=MARGIN, allowed=None, ongoing="violation", fallback=fallback)
     if general:
@@ -226,16 +237,10 @@ def test_a_fallback_callable_edit_is_logged_at_the_fallbacks_window(tmp_path, wa
     from monitor import review
     from monitor.log import read_log
 
-    m = mujoco.MjModel.from_xml_string(_XML)
-    d = mujoco.MjData(m)
-    d.qpos[0] = -0.05
-    calls = [0]
+    def move_wall(model: mujoco.MjModel) -> None:
+        model.body_pos[model.body("wall").id, 0] = wall_x
 
-    def fallback(data: mujoco.MjData) -> np.ndarray:
-        calls[0] += 1
-        if calls[0] == 3:
-            m.body_pos[m.body("wall").id, 0] = wall_x
-        return np.zeros(1)
+    m, d, fallback = _scene_and_editing_fallback(move_wall, 3)
 
     path = tmp_path / "edit.mcap"
     with Gate(m, pairs="all", margin=MARGIN, allowed=None, ongoing="violation", fallback=fallback,
