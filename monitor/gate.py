@@ -1548,6 +1548,7 @@ class Gate:
         memo = self._static_keys
         if memo is None or not self.reuse or self._call_request is not None:
             return None
+        self._sync_scene()  # a fallback callable may have edited the model since decide's sync (red team 6)
         context = self._reuse_context()
         if memo[0] != context or context != self._cache_context:
             return None
@@ -1738,6 +1739,12 @@ class Gate:
         either |= moving[body_b]
         if either.all():  # every pair has a moving body (the common gated step): nothing to reuse
             return None, {}, {}  # (the cache is neither read nor written: its context is checked below)
+        # User code (a fallback, cast or predict callable) may have edited the model since decide's
+        # sync: the context must name the live geometry, and the pairs above the live pairs (red team 6).
+        version = getattr(scene, "version", 0)
+        self._sync_scene()
+        if getattr(scene, "version", 0) != version:
+            return self._split_reuse(scene, plan)  # rebuilt: split again over the new pairs
         context = self._reuse_context()
         if context != self._cache_context:  # before any read or write of the cache
             self._cache.clear()
@@ -1861,7 +1868,10 @@ class Gate:
         the scene version). It leaves the scratch holding the applied window, so the
         caller commits it instead of stepping again. Else None.
         """
-        if self._tail is None or self._tail_context != self._reuse_context():
+        if self._tail is None:
+            return None
+        self._sync_scene()  # the context compared below must name the live geometry (red team 6)
+        if self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
         tail, cert, qvel = self._tail
         plan = tail.plan  # built now, on the rare path that reads it
@@ -1993,6 +2003,7 @@ class Gate:
             self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
                                     and tail is not None and brake_verdict == Verdict.CERTIFIED
                                     and not tail_cert.stats.get("ongoing", 0))
+        self._note_model()  # the model the proposal was certified on, before a fallback callable runs
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
@@ -2146,16 +2157,27 @@ class Gate:
                 "allowed_mode": mode,
                 "reference_qpos": None if ref is None else np.asarray(ref, float).tolist()}
 
-    def _write_log(self, r: StepReport, applied_plan: Any) -> None:
+    def _note_model(self) -> None:
+        """Log the model as the next window was certified on: an in-place edit since the last note.
+
+        Called by :meth:`decide` once the proposal is certified (the first window, or the scene was
+        rebuilt after a model edit) and again before a fallback's record, which a fallback callable
+        may have edited the model for (red team 6): review re-derives each window on its own model.
+        """
         log = self._open_log()
         if log is None:
             return
         version = getattr(self._scene, "version", 0)
-        if version != self._noted_version:  # the first window, or the scene was rebuilt after a model edit
+        if version != self._noted_version:
             self._noted_version = version
             note = getattr(log, "note_model", None)
             if callable(note):  # the log records what changed, so review re-derives on the model as certified
                 note(self.model)
+
+    def _write_log(self, r: StepReport, applied_plan: Any) -> None:
+        log = self._open_log()
+        if log is None:
+            return
         why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
         if not r.replaced:  # the window that ran is this one; it may commit a braking tail
             self._log_accepted = log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl,
@@ -2165,6 +2187,7 @@ class Gate:
         if fb is None or not getattr(log, "logs_applied_motions", False):  # a log object of another kind
             log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why)
             if not r.fallback_certified and fb is not None:
+                self._note_model()
                 log.write_window(r.time, _plan_of(applied_plan), fb, r.applied_ctrl, r.applied_ctrl, True,
                                  reason=why)
             return
@@ -2196,6 +2219,7 @@ class Gate:
             applied = {"kind": "fallback", "covered_by": nxt + 1}
         log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why,
                          applied_window=nxt + 1)
+        self._note_model()  # the fallback's model (an edit by a fallback callable)
         log.write_window(r.time, _plan_of(applied_plan), fb, applied=applied)
 
     def close(self) -> None:
