@@ -118,7 +118,7 @@ SYNC_FIELDS: tuple[str, ...] = (
     "jnt_type", "jnt_qposadr", "jnt_bodyid", "jnt_pos", "jnt_axis", "qpos0", "body_pos", "body_quat",
     "body_jntadr", "body_jntnum", "body_ipos", "geom_rbound",
     # where MuJoCo puts a geom whose frame is its body's inertial frame (geom_frame)
-    "body_iquat", "geom_sameframe",
+    "body_iquat", "geom_sameframe", "body_sameframe",
 )
 """``MjModel`` arrays that :meth:`Scene.sync` watches for in-place edits."""
 _RUN_GAP = 1024
@@ -278,12 +278,34 @@ def geom_frame(model: Any, g: int) -> tuple[np.ndarray, np.ndarray]:
     if sf == _SAME.mjSAMEFRAME_BODY:
         return np.eye(3), np.zeros(3)
     if sf == _SAME.mjSAMEFRAME_INERTIA:
-        return _quat_to_mat(model.body_iquat[b]), np.array(model.body_ipos[b], dtype=np.float64)
+        return _inertial_frame(model, b)
     if sf == _SAME.mjSAMEFRAME_BODYROT:
         R = np.eye(3)
+    elif sf == _SAME.mjSAMEFRAME_INERTIAROT:
+        R = _inertial_frame(model, b)[0]
     else:
-        R = _quat_to_mat(model.body_iquat[b] if sf == _SAME.mjSAMEFRAME_INERTIAROT else model.geom_quat[g])
+        R = _quat_to_mat(model.geom_quat[g])
     return R, np.array(model.geom_pos[g], dtype=np.float64)
+
+
+def _inertial_frame(model: Any, b: int) -> tuple[np.ndarray, np.ndarray]:
+    """(R_BI (3, 3), p_BI (3,)): body ``b``'s inertial frame in its body frame, as ``mj_kinematics`` puts it.
+
+    MuJoCo places it by ``body_sameframe`` (red team 6): BODY -> the body frame itself
+    (``body_ipos`` / ``body_iquat`` ignored), BODYROT -> the body's rotation at ``body_ipos``, NONE ->
+    ``body_iquat`` at ``body_ipos``. The compiler sets no other value for a body; one edited in is
+    refused rather than guessed.
+    """
+    sf = int(model.body_sameframe[b])
+    if sf == _SAME.mjSAMEFRAME_BODY:
+        return np.eye(3), np.zeros(3)
+    if sf == _SAME.mjSAMEFRAME_BODYROT:
+        return np.eye(3), np.array(model.body_ipos[b], dtype=np.float64)
+    if sf != _SAME.mjSAMEFRAME_NONE:
+        raise UnsupportedGeometryError(
+            f"body {b}: body_sameframe {sf} ({_SAME(sf).name}): MuJoCo's compiler never sets it for a body, "
+            "so where mj_kinematics puts the body's inertial frame is not defined here")
+    return _quat_to_mat(model.body_iquat[b]), np.array(model.body_ipos[b], dtype=np.float64)
 
 
 def _to_body(shape_G: ConvexShape, R_BG: np.ndarray, p_BG: np.ndarray) -> ConvexShape:

@@ -172,11 +172,9 @@ def test_a_pair_added_between_steps_ends_the_zero_pair_certificate():
     assert not (r1.applied_verdict == Verdict.CERTIFIED and min(dist) <= MARGIN)
 
 
-@pytest.mark.xfail(strict=True, reason="scene.geom_frame reads body_ipos for geom_sameframe INERTIA while "
-                   "MuJoCo's xipos ignores it when body_sameframe is BODY (monitor/scene.py; note redteam-6)")
 def test_a_geom_on_the_inertial_frame_is_where_mujoco_puts_it():
-    """Finding 2 (not fixed: monitor/scene.py): ``geom_sameframe`` edited to INERTIA on a body whose
-    ``body_sameframe`` is BODY, then ``body_ipos`` moved away: MuJoCo keeps the wall at the body
+    """Finding 2 (fixed in ``scene.geom_frame`` by the lead): ``geom_sameframe`` edited to INERTIA on a
+    body whose ``body_sameframe`` is BODY, then ``body_ipos`` moved away: MuJoCo keeps the wall at the body
     origin (``xipos = xpos``), the scene moves it with ``body_ipos``; the gate certifies the ball
     through the wall. Fails on da1cfd7 too."""
     m = mujoco.MjModel.from_xml_string(_XML)
@@ -251,3 +249,40 @@ def test_a_fallback_callable_edit_is_logged_at_the_fallbacks_window(tmp_path, wa
     ver = review.verify(read_log(path))
     assert ver["critical"] == 0, ver
     assert any("first at window 5" in str(n) for n in ver["notes"]), ver["notes"]  # step 2's fallback
+
+
+_SAMEFRAME_XML = """<mujoco><worldbody><body name="b" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2">
+<joint type="hinge" axis="0 1 0"/><inertial pos="0.05 -0.02 0.01" quat="0.8 0.2 -0.1 0.3" mass="1"
+ diaginertia="1 2 3"/><geom type="box" size=".1 .1 .1" pos="-.03 .04 .02" quat="0.7 0.1 0.5 -0.2"/>
+</body></worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("body_sf", [0, 1, 3])  # the values MuJoCo's compiler sets for a body
+def test_geom_frame_matches_mj_kinematics_for_every_sameframe_combination(body_sf):
+    """Oracle: MuJoCo's own geom_xpos / geom_xmat after mj_kinematics, for each geom_sameframe 0..4 on a
+    rotated hinged body with an offset, rotated inertial frame (4 of these 15 combinations were wrong)."""
+    from monitor.scene import geom_frame
+
+    m = mujoco.MjModel.from_xml_string(_SAMEFRAME_XML)
+    d = mujoco.MjData(m)
+    d.qpos[0] = 0.4
+    m.body_sameframe[1] = body_sf
+    for geom_sf in range(5):
+        m.geom_sameframe[0] = geom_sf
+        mujoco.mj_kinematics(m, d)
+        R_WB, p_WB = d.xmat[1].reshape(3, 3), d.xpos[1]
+        R_BG, p_BG = geom_frame(m, 0)
+        np.testing.assert_allclose(R_WB @ R_BG, d.geom_xmat[0].reshape(3, 3), atol=1e-12,
+                                   err_msg=str(geom_sf))
+        np.testing.assert_allclose(p_WB + R_WB @ p_BG, d.geom_xpos[0], atol=1e-12, err_msg=str(geom_sf))
+
+
+def test_a_body_sameframe_the_compiler_never_sets_is_refused_by_name():
+    from monitor.errors import UnsupportedGeometryError
+    from monitor.scene import geom_frame
+
+    m = mujoco.MjModel.from_xml_string(_SAMEFRAME_XML)
+    m.body_sameframe[1] = mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA
+    m.geom_sameframe[0] = mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA
+    with pytest.raises(UnsupportedGeometryError, match="body_sameframe"):
+        geom_frame(m, 0)
