@@ -44,6 +44,19 @@ re-optimises and re-emits the whole linked callee tree at every level). Do not i
 small helpers: numba inlines per call site at the untyped-IR stage, which costs far more
 compile time than a separate compile (measured 1.66x slower), and LLVM inlines them anyway.
 
+Reference counting (issue 12, pair-window floor): :func:`_bounds_core` and
+:func:`_pair_bound_core` (the per-test motion bound of the window kernel's search) are
+compiled with ``_nrt=False``: numba emits no NRT incref/decref in them. With it, every array
+taken from the pack, a workspace tuple or a row view costs an out-of-line atomic
+incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and 1.1 of 1.7 us per
+``pair_bound`` call on a two-body, two-waypoint motion (docs/notes/issue-12-pairwindow-5.md).
+This is sound because neither function allocates, returns or stores an array: they only read
+and write arrays their caller owns (and views of them) for the duration of the call, so no
+reference they would count can be the last one. Their callees are ordinary (NRT) functions:
+an array a callee allocates (``_qpos_at``'s scratch) is created and freed inside it, and the
+views they make take and drop their own references. Keep it that way: an allocation in these
+two functions would not compile (no NRT), and returning a new array from them is not possible.
+
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
 
@@ -641,7 +654,7 @@ def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: 
         Th2 += rel * (4.0 * h * wrot_sum + mag * L)
     return T2, Th2
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray, ws) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
@@ -652,6 +665,8 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     the arrays that must start at zero are zeroed here), so a caller that evaluates many
     sub-intervals allocates them once (issue 12, long windows: the ~20 allocations were
     about half of a bound's cost). The results are the same numbers as with fresh arrays.
+
+    Compiled without numba's reference counting (module docstring, "Reference counting").
     """
     rel = mp.tol[TOL_REL]
     abs_pad = mp.tol[TOL_ABS]
@@ -870,7 +885,15 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
     Same numbers as two :func:`body_bound` calls: in :func:`_bounds_core` a body's pose and
     bound depend only on its own ancestors (FK root first, the chain terms, the parent's
     bound), never on which other bodies are in ``need``; the union is closed under ancestors.
+    The work is :func:`_pair_bound_core` (no reference counting: module docstring).
     """
+    return _pair_bound_core(mp, ba, bb, ta, tb, pA_out, RA_out, pB_out, RB_out, pws)
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+def _pair_bound_core(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
+                     pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
+    """:func:`pair_bound`'s body (the same statements, moved here unchanged; see there)."""
     need, xpos, xmat, trans, angle, ws = pws
     need[:] = 0
     for body in (ba, bb):
