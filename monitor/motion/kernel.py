@@ -53,9 +53,10 @@ incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and 1.1 of 1.7
 This is sound because neither function allocates, returns or stores an array: they only read
 and write arrays their caller owns (and views of them) for the duration of the call, so no
 reference they would count can be the last one. Their callees are ordinary (NRT) functions:
-an array a callee allocates (``_qpos_at``'s scratch) is created and freed inside it, and the
-views they make take and drop their own references. Keep it that way: an allocation in these
+the views they make take and drop their own references. Keep it that way: an allocation in these
 two functions would not compile (no NRT), and returning a new array from them is not possible.
+Nor in their callees: numba types a callee compiled on first use inside a no-NRT compile with
+the caller's flags, so ``np.empty`` there fails to compile (``_qpos_at`` no longer allocates).
 
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
@@ -257,42 +258,44 @@ def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
-           qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
-    """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
+           qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray, off: int) -> None:
+    """Slerped quaternion of track k (not normalised) into out[off:off + 4], as ``QuatTrack.interp``.
+
+    Reads only ``qpos`` and the track arrays (``out`` may be the qpos vector being filled).
+    """
     adr = qt_adr[k]
     q = qpos
     if at_end:
         last = q.shape[0] - 1
         for c in range(4):
-            out[c] = q[last, adr + c]
+            out[off + c] = q[last, adr + c]
         return
     if qt_same[k, i] != 0 or s == 0.0:
         for c in range(4):
-            out[c] = q[i, adr + c]
+            out[off + c] = q[i, adr + c]
         return
     h = qt_half[k, i]
     den = _sinc(h)
     c0 = (1.0 - s) * _sinc((1.0 - s) * h) / den
     c1 = s * _sinc(s * h) / den
     for c in range(4):
-        out[c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
+        out[off + c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
              qt_target: np.ndarray, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
-    """Interpolated qpos (nq,) at (segment i, parameter s)."""
+    """Interpolated qpos (nq,) at (segment i, parameter s).
+
+    Allocates nothing (it is called from :func:`_bounds_core`, compiled without NRT: module
+    docstring): each track's slerp is written straight into its four columns of ``out``
+    (the same numbers the former scratch copy wrote there).
+    """
     nq = qpos.shape[1]
     for c in range(nq):
         out[c] = _lerp_col(qpos, c, i, s, at_end)
-    if qt_adr.shape[0] == 0:   # no quaternion track: no scratch (an allocation is ~0.1 us per call)
-        return
-    tmp = np.empty(4)
     for k in range(qt_adr.shape[0]):
-        _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, tmp)
-        adr = qt_adr[k]
-        for c in range(4):
-            out[adr + c] = tmp[c]
+        _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, out, qt_adr[k])
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
