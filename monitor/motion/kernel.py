@@ -45,18 +45,17 @@ small helpers: numba inlines per call site at the untyped-IR stage, which costs 
 compile time than a separate compile (measured 1.66x slower), and LLVM inlines them anyway.
 
 Reference counting (issue 12, pair-window floor): :func:`_bounds_core` and
-:func:`_pair_bound_core` (the per-test motion bound of the window kernel's search) are
-compiled with ``_nrt=False``: numba emits no NRT incref/decref in them. With it, every array
-taken from the pack, a workspace tuple or a row view costs an out-of-line atomic
-incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and 1.1 of 1.7 us per
-``pair_bound`` call on a two-body, two-waypoint motion (docs/notes/issue-12-pairwindow-5.md).
-This is sound because neither function allocates, returns or stores an array: they only read
-and write arrays their caller owns (and views of them) for the duration of the call, so no
-reference they would count can be the last one. Their callees are ordinary (NRT) functions:
-the views they make take and drop their own references. Keep it that way: an allocation in these
-two functions would not compile (no NRT), and returning a new array from them is not possible.
-Nor in their callees: numba types a callee compiled on first use inside a no-NRT compile with
-the caller's flags, so ``np.empty`` there fails to compile (``_qpos_at`` no longer allocates).
+:func:`_pair_bound_core` (the motion bound of every test of the window kernel's search, and
+of its broad phase) are compiled with ``_nrt=False``: numba emits no NRT incref/decref in
+them. With it, every array taken from the pack or a workspace tuple and every row view cost
+an out-of-line atomic incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and
+1.1 of 1.7 us per ``pair_bound`` call on a two-body, two-waypoint motion
+(docs/notes/issue-12-pairwindow-5.md). The arithmetic is unchanged (the same numbers, bit for
+bit). Sound because neither function nor anything it calls allocates, returns or keeps an
+array: they read and write arrays their caller owns, and views of them, during the call,
+so no reference they would count can be the last one. Keep it that way: numba types the
+callees a no-NRT function compiles on first use with its flags, so an allocation anywhere
+below these two fails to compile (``_qpos_at`` therefore slerps straight into its output).
 
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
