@@ -36,6 +36,7 @@ sb = G.separated_beyond if hasattr(G, "separated_beyond") else K.separated_beyon
 
 @njit
 def drive(n, what, gp, mp, ga, gb, t0, t1, rel_pad):
+    """Calls variant ``what`` n x 64 times (see ``labels``)."""
     pws = pair_workspace(mp)
     pA, pB, RA, RB = np.empty(3), np.empty(3), np.empty((3, 3)), np.empty((3, 3))
     levers = np.zeros(2)
@@ -68,19 +69,21 @@ def drive(n, what, gp, mp, ga, gb, t0, t1, rel_pad):
             a = t0 + (t1 - t0) * j / 64.0
             b = a + (t1 - t0) / 64.0
             if what == 0:
-                acc += K.interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)
+                acc += K.interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws,
+                                        dref)
             elif what == 1:
                 acc += ib_nonrt(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)
             elif what == 2 or what == 3:
-                bound = K.interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref)
+                bound = K.interval_bound(gp, mp, ga, gb, a, b, pA, RA, pB, RB, levers, stats, rel_pad, pws,
+                                         dref)
                 target = rsum + bound
                 X[4, 2] = 0.0
                 if what == 2:
                     acc += sb(gp, ga, RA, pA, gb, RB, pB, target * 1.5, target, rel_pad, 0.0, VA, VB, W4,
                               IA, IB, lam, v, vn, X)
                 else:
-                    acc += sb_nonrt(gp, ga, RA, pA, gb, RB, pB, target * 1.5, target, rel_pad, 0.0, VA, VB, W4,
-                                    IA, IB, lam, v, vn, X)
+                    acc += sb_nonrt(gp, ga, RA, pA, gb, RB, pB, target * 1.5, target, rel_pad, 0.0, VA, VB,
+                                    W4, IA, IB, lam, v, vn, X)
     return acc
 
 

@@ -24,6 +24,7 @@ orig = E._window_kernel
 
 
 def wk(*a):
+    """Records the arguments of the stage-0 window_kernel call."""
     if a[7] == 0:
         rec.append([x.copy() if isinstance(x, np.ndarray) else x for x in a])
     return orig(*a)
@@ -34,6 +35,7 @@ wkk = K.window_kernel
 
 @njit
 def drive(n, gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr, info):
+    """Calls window_kernel n times with the recorded arguments."""
     for _ in range(n):
         wkk(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr, info)
 
