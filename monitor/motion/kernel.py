@@ -45,7 +45,7 @@ small helpers: numba inlines per call site at the untyped-IR stage, which costs 
 compile time than a separate compile (measured 1.66x slower), and LLVM inlines them anyway.
 
 Reference counting (issue 12, pair-window floor): :func:`_bounds_core` and
-:func:`_pair_bound_core` (the motion bound of every test of the window kernel's search, and
+:func:`pair_bound` (the motion bound of every test of the window kernel's search, and
 of its broad phase) are compiled with ``_nrt=False``: numba emits no NRT incref/decref in
 them. With it, every array taken from the pack or a workspace tuple and every row view cost
 an out-of-line atomic incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and
@@ -874,7 +874,7 @@ def pair_workspace(mp):
             np.zeros(nbody), bounds_workspace(mp))
 
 
-@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, _nrt=False)
 def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
                pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
     """:func:`body_bound` of two bodies in ONE pass over the union of their chains.
@@ -887,15 +887,12 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
     Same numbers as two :func:`body_bound` calls: in :func:`_bounds_core` a body's pose and
     bound depend only on its own ancestors (FK root first, the chain terms, the parent's
     bound), never on which other bodies are in ``need``; the union is closed under ancestors.
-    The work is :func:`_pair_bound_core` (no reference counting: module docstring).
+
+    Compiled without reference counting (module docstring) and NOT inlined into its callers:
+    numba's IR inlining binds the inlined parameters to new variables, and in a caller with
+    reference counting each binding of ``mp`` and ``pws`` (25 arrays each) costs an
+    incref/decref pair per array, about 0.5 us per call at K = 2; a plain call borrows them.
     """
-    return _pair_bound_core(mp, ba, bb, ta, tb, pA_out, RA_out, pB_out, RB_out, pws)
-
-
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
-def _pair_bound_core(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
-                     pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
-    """:func:`pair_bound`'s body (the same statements, moved here unchanged; see there)."""
     need, xpos, xmat, trans, angle, ws = pws
     need[:] = 0
     for body in (ba, bb):
