@@ -3,7 +3,7 @@
 Usage: PYTHONPATH=<tree> python bc_parts.py [case name]
 Each variant is driven in an njit loop over 64 sub-intervals of the window with the arguments
 _bounds_core passes it (same workspace); best of 7 batches of 100 x 64 calls. The "copy" rows compile
-the tree's own source of _bounds_core / pair_bound's body again, with numba's reference counting (NRT)
+the tree's own source of _bounds_core and pair_bound again, with numba's reference counting (NRT)
 and with ``_nrt=False``: same arithmetic, only the incref/decref differ.
 """
 import inspect
@@ -19,45 +19,18 @@ import monitor.motion.kernel as MK
 from monitor.bench.cases import make_cases
 from monitor.motion.kernel import pair_bound, pair_workspace
 
-_PB_BODY = '''
-def PB_NAME(mp, ba, bb, ta, tb, pA_out, RA_out, pB_out, RB_out, pws):
-    need, xpos, xmat, trans, angle, ws = pws
-    need[:] = 0
-    for body in (ba, bb):
-        if body >= 0:
-            c = body
-            while True:
-                need[c] = 1
-                if c == 0:
-                    break
-                c = mp.body_parent[c]
-    BC_NAME(mp, ta, tb, need, xpos, xmat, trans, angle, ws)
-    TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
-    if ba >= 0:
-        TA, angA = trans[ba], angle[ba]
-        for r in range(3):
-            pA_out[r] = xpos[ba, r]
-            for c in range(3):
-                RA_out[r, c] = xmat[ba, r, c]
-    if bb >= 0:
-        TB, angB = trans[bb], angle[bb]
-        for r in range(3):
-            pB_out[r] = xpos[bb, r]
-            for c in range(3):
-                RB_out[r, c] = xmat[bb, r, c]
-    return TA, angA, TB, angB
-'''
-
 
 def _compile(name, nrt):
-    """Copies of _bounds_core and pair_bound's body (names bc_<name>, pb_<name>) with NRT on or off."""
+    """Copies of _bounds_core and pair_bound (bc_<name>; pb_<name> calls bc_<name>), NRT on or off."""
     ns = dict(MK.__dict__)
     src = inspect.getsource(MK._bounds_core.py_func)
     exec(src[src.index("def "):].replace("def _bounds_core(", f"def bc_{name}("), ns)
     flags = dict(error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=nrt)
     bc = njit(**flags)(ns[f"bc_{name}"])
     ns[f"bc_{name}"] = bc
-    exec(_PB_BODY.replace("PB_NAME", f"pb_{name}").replace("BC_NAME", f"bc_{name}"), ns)
+    src = inspect.getsource(MK.pair_bound.py_func)
+    exec(src[src.index("def "):].replace("def pair_bound(", f"def pb_{name}(")
+         .replace("    _bounds_core(", f"    bc_{name}("), ns)
     return bc, njit(**flags)(ns[f"pb_{name}"])
 
 
@@ -126,9 +99,9 @@ def drive(n, what, mp, ba, bb, t0, t1):
     return acc
 
 
-LABELS = ["pair_bound (inlined, as the kernel calls it)", "_bounds_core", "copy of _bounds_core, NRT",
-          "copy of _bounds_core, _nrt=False", "pair_bound body + copy, NRT",
-          "pair_bound body + copy, _nrt=False",
+LABELS = ["pair_bound (as the tree compiles it)", "_bounds_core", "copy of _bounds_core, NRT",
+          "copy of _bounds_core, _nrt=False", "pair_bound copy + copy, NRT",
+          "pair_bound copy + copy, _nrt=False",
           "_qpos_at (after a _locate)", "_fk", "3 _locate + 2 searches + _rot_dev + _vec_dev",
           "_velocity_bound (L = 2)"]
 nm = sys.argv[1] if len(sys.argv) > 1 else "rot-hull-box-near-1e-02"
