@@ -44,6 +44,19 @@ re-optimises and re-emits the whole linked callee tree at every level). Do not i
 small helpers: numba inlines per call site at the untyped-IR stage, which costs far more
 compile time than a separate compile (measured 1.66x slower), and LLVM inlines them anyway.
 
+Reference counting (issue 12, pair-window floor): :func:`_bounds_core` and
+:func:`pair_bound` (the motion bound of every test of the window kernel's search, and
+of its broad phase) are compiled with ``_nrt=False``: numba emits no NRT incref/decref in
+them. With it, every array taken from the pack or a workspace tuple and every row view cost
+an out-of-line atomic incref/decref pair: about 0.7 of 1.2 us per ``_bounds_core`` call and
+1.1 of 1.7 us per ``pair_bound`` call on a two-body, two-waypoint motion
+(docs/notes/issue-12-pairwindow-5.md). The arithmetic is unchanged (the same numbers, bit for
+bit). Sound because neither function nor anything it calls allocates, returns or keeps an
+array: they read and write arrays their caller owns, and views of them, during the call,
+so no reference they would count can be the last one. Keep it that way: numba types the
+callees a no-NRT function compiles on first use with its flags, so an allocation anywhere
+below these two fails to compile (``_qpos_at`` therefore slerps straight into its output).
+
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
 
@@ -244,42 +257,44 @@ def _lerp_col(qpos: np.ndarray, c: int, i: int, s: float, at_end: bool) -> float
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _slerp(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
-           qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
-    """Slerped quaternion of track k (not normalised), as ``QuatTrack.interp``."""
+           qt_target: np.ndarray, k: int, i: int, s: float, at_end: bool, out: np.ndarray, off: int) -> None:
+    """Slerped quaternion of track k (not normalised) into out[off:off + 4], as ``QuatTrack.interp``.
+
+    Reads only ``qpos`` and the track arrays (``out`` may be the qpos vector being filled).
+    """
     adr = qt_adr[k]
     q = qpos
     if at_end:
         last = q.shape[0] - 1
         for c in range(4):
-            out[c] = q[last, adr + c]
+            out[off + c] = q[last, adr + c]
         return
     if qt_same[k, i] != 0 or s == 0.0:
         for c in range(4):
-            out[c] = q[i, adr + c]
+            out[off + c] = q[i, adr + c]
         return
     h = qt_half[k, i]
     den = _sinc(h)
     c0 = (1.0 - s) * _sinc((1.0 - s) * h) / den
     c1 = s * _sinc(s * h) / den
     for c in range(4):
-        out[c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
+        out[off + c] = c0 * q[i, adr + c] + c1 * qt_target[k, i, c]
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _qpos_at(qpos: np.ndarray, qt_adr: np.ndarray, qt_same: np.ndarray, qt_half: np.ndarray,
              qt_target: np.ndarray, i: int, s: float, at_end: bool, out: np.ndarray) -> None:
-    """Interpolated qpos (nq,) at (segment i, parameter s)."""
+    """Interpolated qpos (nq,) at (segment i, parameter s).
+
+    Allocates nothing (it is called from :func:`_bounds_core`, compiled without NRT: module
+    docstring): each track's slerp is written straight into its four columns of ``out``
+    (the same numbers the former scratch copy wrote there).
+    """
     nq = qpos.shape[1]
     for c in range(nq):
         out[c] = _lerp_col(qpos, c, i, s, at_end)
-    if qt_adr.shape[0] == 0:   # no quaternion track: no scratch (an allocation is ~0.1 us per call)
-        return
-    tmp = np.empty(4)
     for k in range(qt_adr.shape[0]):
-        _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, tmp)
-        adr = qt_adr[k]
-        for c in range(4):
-            out[adr + c] = tmp[c]
+        _slerp(qpos, qt_adr, qt_same, qt_half, qt_target, k, i, s, at_end, out, qt_adr[k])
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -641,7 +656,7 @@ def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: 
         Th2 += rel * (4.0 * h * wrot_sum + mag * L)
     return T2, Th2
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray, ws) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
@@ -652,6 +667,8 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     the arrays that must start at zero are zeroed here), so a caller that evaluates many
     sub-intervals allocates them once (issue 12, long windows: the ~20 allocations were
     about half of a bound's cost). The results are the same numbers as with fresh arrays.
+
+    Compiled without numba's reference counting (module docstring, "Reference counting").
     """
     rel = mp.tol[TOL_REL]
     abs_pad = mp.tol[TOL_ABS]
@@ -857,7 +874,7 @@ def pair_workspace(mp):
             np.zeros(nbody), bounds_workspace(mp))
 
 
-@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, _nrt=False)
 def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
                pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
     """:func:`body_bound` of two bodies in ONE pass over the union of their chains.
@@ -870,6 +887,11 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
     Same numbers as two :func:`body_bound` calls: in :func:`_bounds_core` a body's pose and
     bound depend only on its own ancestors (FK root first, the chain terms, the parent's
     bound), never on which other bodies are in ``need``; the union is closed under ancestors.
+
+    Compiled without reference counting (module docstring) and NOT inlined into its callers:
+    numba's IR inlining binds the inlined parameters to new variables, and in a caller with
+    reference counting each binding of ``mp`` and ``pws`` (25 arrays each) costs an
+    incref/decref pair per array, about 0.5 us per call at K = 2; a plain call borrows them.
     """
     need, xpos, xmat, trans, angle, ws = pws
     need[:] = 0
