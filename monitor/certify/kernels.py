@@ -295,7 +295,7 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     return val
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v,
                      vn, X):
     """The best separating-axis lower bound on ``dist(core_a, core_b)`` found (early-exit GJK), or -inf.
@@ -498,12 +498,17 @@ def _rel_terms(P, dP, TA, chA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
     return acc
 
 
-# Compile structure (issue 12 item 7, docs/notes/issue-12-coldstart.md): interval_bound and pair_window
-# have one compiled caller each on the certify path, so numba inlines them there (inline="always"):
-# a separate compile re-optimises and re-emits their whole linked callee tree once more. Python
-# callers still get a compiled pair_window. Small helpers stay separate functions (inlining them
-# per call site costs more compile time), and nothing Python never calls gets a CPython wrapper.
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
+# Compile structure (issue 12 item 7, docs/notes/issue-12-coldstart.md): pair_window has one
+# compiled caller on the certify path, so numba inlines it there (inline="always"): a separate
+# compile re-optimises and re-emits its whole linked callee tree once more. interval_bound is NOT
+# inlined: it is called per test, and inlined numba re-counted the references of every array it
+# borrows (gp, mp, the workspaces) on each call; as a plain call compiled without reference counting
+# (_nrt=False, like separated_beyond and the motion bound: monitor/motion/kernel.py, "Reference
+# counting") it borrows them for free (docs/notes/issue-12-pairwindow-5.md: the window kernel 0.52x
+# with the motion bound's change, bit-identical, and ~1.5 s less cold compile CPU). Python callers
+# still get a compiled pair_window. Small helpers stay separate functions (inlining them per call
+# site costs more compile time), and nothing Python never calls gets a CPython wrapper.
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
 def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 
@@ -523,6 +528,11 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     every time (lerp of equal values and slerp of bit-identical quaternions return them
     exactly), which is what ``body_bound`` would return; its pose is then not recomputed:
     the caller must have written it into (pA, RA) / (pB, RB) (:func:`pair_window` does).
+
+    Compiled without numba's reference counting and not inlined (issue 12, pair-window floor;
+    :mod:`monitor.motion.kernel`, "Reference counting"): it allocates, returns and keeps no
+    array, and a plain call borrows ``gp``, ``mp`` and the workspaces, where ``inline="always"``
+    re-counted every array of them per call.
     """
     ba, bb = gp.body[ga], gp.body[gb]
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
