@@ -900,15 +900,13 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if charged:
         bud.charge(int(charged))
     if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
-        return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
-                           margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
-                           allowed=allowed, sc=sc, sr=sr, KS=KS)
+        return _all_culled(sel, pid, code, gap, surv, res, info, scene.geoms, t0, t1, margin, epsilon, method,
+                           bud, wall0, allowed, sc, sr, KS)
     if route_all and done_to == S:
         # every survivor went through the whole-shape stage in this one call: when the kernel
         # decided them all, the certificate is the general tail's (see _kernel_decided)
-        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, geoms=scene.geoms, t0=t0, t1=t1,
-                               margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
-                               allowed=allowed, sc=sc, sr=sr, KS=KS)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
+                               method, bud, wall0, allowed, sc, sr, KS)
         if cert is not None:
             return cert
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
@@ -1067,7 +1065,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
 
 
 def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
-                res: np.ndarray, info: np.ndarray, *, geoms: tuple, t0: float, t1: float, margin: float,
+                res: np.ndarray, info: np.ndarray, geoms: tuple, t0: float, t1: float, margin: float,
                 epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple, sc: np.ndarray,
                 sr: np.ndarray, KS: Any) -> Certificate:
     """The certificate :func:`_certify_fast` builds when stage 0 culled every selected pair.
@@ -1078,7 +1076,7 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
     the pairs stay arrays (:class:`_WindowPairs`).
     """
     P = len(sel)
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], np.zeros(P, bool), {}, geoms, (t0, t1),
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], _none_unfinished(P), {}, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     best_cull = info.item(KS.WI_BEST)
     clearance = float(best_cull) if best_cull < float("inf") else float("inf")
@@ -1089,8 +1087,26 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
                                 clearance, lazy, stats, allowed)
 
 
+_NONE_UNFINISHED: dict[int, np.ndarray] = {}
+
+
+def _none_unfinished(P: int) -> np.ndarray:
+    """(P,) read-only all-False bool mask: no pair left unfinished (shared per P; bounded cache).
+
+    :class:`_WindowPairs` only reads its ``unfin`` mask; the read-only flag makes a write raise.
+    """
+    hit = _NONE_UNFINISHED.get(P)
+    if hit is None:
+        hit = np.zeros(P, bool)
+        hit.setflags(write=False)
+        if len(_NONE_UNFINISHED) >= 16:
+            _NONE_UNFINISHED.clear()
+        _NONE_UNFINISHED[P] = hit
+    return hit
+
+
 def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
-                    res: np.ndarray, info: np.ndarray, S: int, *, geoms: tuple, t0: float, t1: float,
+                    res: np.ndarray, info: np.ndarray, S: int, geoms: tuple, t0: float, t1: float,
                     margin: float, epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
                     sc: np.ndarray, sr: np.ndarray, KS: Any) -> Certificate | None:
     """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
@@ -1107,8 +1123,8 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
     Issue 12 (pair-window floor): the general tail's survivor lists cost ~20 us per call.
     """
     if S == 1:      # the bench's and a lone pair's case, without the lists below
-        k = int(surv[0])
-        c = int(code[k])
+        k = surv.item(0)
+        c = code.item(k)
         if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
             return None
         ks, cs = (k,), (c,)
@@ -1138,7 +1154,7 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
             if int(row[KS.R_DEPTH]) > depth:
                 depth = int(row[KS.R_DEPTH])
         if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
-            key = (row[KS.R_WTIME], int(sel[k]))
+            key = (row[KS.R_WTIME], sel.item(k))
             if best_v is None or key < best_v[:2]:
                 best_v = (key[0], key[1], k, s)
             starts.append(row[KS.R_WTIME])
@@ -1149,7 +1165,7 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         mix["static"] = n_static
     if S - n_static:
         mix["toleranced/whole-shape"] = S - n_static
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], np.zeros(P, bool), {}, geoms, (t0, t1),
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], _none_unfinished(P), {}, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     witness = earliest = None
     if best_v is not None:
@@ -1158,13 +1174,12 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         clears.append(float("-inf"))
     verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
     return _window_certificate(verdict, witness, earliest, clears, lazy, info, P, S, tests, depth, mix, {},
-                               t0=t0, t1=t1, margin=margin, epsilon=epsilon, method=method, bud=bud,
-                               wall0=wall0, allowed=allowed, KS=KS)
+                               t0, t1, margin, epsilon, method, bud, wall0, allowed, KS)
 
 
 def _window_certificate(verdict: Verdict, witness: Witness | None, earliest: float | None,
                         clears: list[float], lazy: _WindowPairs, info: np.ndarray, P: int, S: int, tests: int,
-                        depth: int, mix: dict, extra: dict, *, t0: float, t1: float, margin: float,
+                        depth: int, mix: dict, extra: dict, t0: float, t1: float, margin: float,
                         epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
                         KS: Any) -> Certificate:
     """The certificate of a window whose S survivors were all decided, the general tail's values.
