@@ -114,3 +114,20 @@ def test_plan_of_another_equal_model_is_not_memoised():
         pass
     else:
         raise AssertionError("a plan of an edited other model was certified")
+
+
+def test_request_memo_follows_the_budget_limits():
+    """The same keyword objects with a Budget: the request (and its limits) follow the Budget of each call."""
+    from monitor.certify.common import Budget
+
+    m, scene = _wall()
+    motion = _slide_motion()
+    eps = 1e-3
+    seen = []
+    for seconds, tests in ((1.0, None), (1.0, None), (2.0, None), (2.0, 10**6), (1.0, None)):
+        budget = Budget(seconds=seconds, tests=tests)
+        cert = monitor.certify(scene, motion, margin=0.0, epsilon=eps, budget=budget)
+        seen.append((cert.request.budget.seconds, cert.request.budget.tests))
+    assert seen == [(1.0, None), (1.0, None), (2.0, None), (2.0, 10**6), (1.0, None)]
+    default = monitor.certify(scene, motion, margin=0.0, epsilon=eps)
+    assert default.request.budget.seconds == engine.DEFAULT_BUDGET_SECONDS

@@ -256,7 +256,7 @@ _REQUESTS: dict[tuple, CertifyRequest] = {}
 """Memo of the requests :func:`_request_of` built from plain keyword values (bounded; see there)."""
 _NO_KEY = object()
 _LAST_REQUEST: list[tuple | None] = [None]
-"""The argument objects of the last memoised keyword call with ``budget=None`` and its request."""
+"""The argument objects of the last memoised keyword call, its budget key and its request."""
 
 
 def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any, tolerances: Any,
@@ -274,13 +274,15 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
     a loop certifying many windows with the same settings validates them once.
     """
     last = _LAST_REQUEST[0]
-    if (budget is None and last is not None and last[0] is margin and last[1] is epsilon
+    if (last is not None and last[0] is margin and last[1] is epsilon
             and last[2] is method and last[3] is window and last[4] is tolerances and last[5] is pairs
             and last[6] is ongoing and last[7] is penetration_tol
-            and last[8] == DEFAULT_BUDGET_SECONDS):
+            and (last[8] == DEFAULT_BUDGET_SECONDS if budget is None
+                 else type(budget) is Budget and last[8] == (budget.seconds, budget.tests))):
         # the very objects of the previous call (a loop certifying window after window): immutable
         # values (floats, strings, a frozen Tolerances, a tuple of floats or None) that were
-        # validated into last[9]; a mutable Budget never takes this path
+        # validated into last[9], and the budget key (the engine's default seconds read now, or
+        # a Budget's limits read now: a Budget object is mutable) that keyed it in _REQUESTS
         return last[9]
     if budget is None:  # the engine's default seconds, read now (tests patch it)
         bkey: Any = DEFAULT_BUDGET_SECONDS
@@ -299,9 +301,8 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         except TypeError:  # an unhashable method / ongoing: validation names it below
             hit, key = None, None
         if hit is not None and hit.tolerances is tolerances:
-            if budget is None:
-                _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
-                                    penetration_tol, bkey, hit)
+            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
+                                penetration_tol, bkey, hit)
             return hit
     try:
         req = CertifyRequest(margin=margin, epsilon=epsilon, method=method, window=window,
@@ -313,9 +314,8 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         raise InvalidInputError(msg[len("CertifyRequest."):] if msg.startswith("CertifyRequest.")
                                 else msg) from None
     if key is not None:
-        if budget is None:
-            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
-                                bkey, req)
+        _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
+                            bkey, req)
         if len(_REQUESTS) >= 64:
             _REQUESTS.clear()
         _REQUESTS[key] = req
@@ -896,7 +896,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, info))
     done_to = min(first, S)
-    charged = info[KS.WI_TESTS]
+    charged = info.item(KS.WI_TESTS)
     if charged:
         bud.charge(int(charged))
     if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
