@@ -94,18 +94,20 @@ def _finite(name: str, x: Any) -> float:
     return v
 
 
-def _check_model(scene: Any, plan: Any) -> Any:
+def _check_model(scene: Any, plan: Any, synced: bool = False) -> Any:
     """Sync the scene with its (possibly edited) model and return the plan to certify.
 
-    ``scene.sync()`` rebuilds shapes and pairs after an in-place model edit. A plan whose
+    ``scene.sync()`` rebuilds shapes and pairs after an in-place model edit (``synced``: the
+    caller has just called it). A plan whose
     frozen joint frames no longer match its live model (built before the edit) is
     replaced by the same waypoints rebuilt on the live model: the certificate is about
     the motion the simulation will now produce. The ``plan.model is scene.model`` fast
     path skips only the hash comparison, never these checks.
     """
-    sync = getattr(scene, "sync", None)
-    if sync is not None:
-        sync()
+    if not synced:
+        sync = getattr(scene, "sync", None)
+        if sync is not None:
+            sync()
     hot = _hot(scene)
     if hot is not None and type(plan) is _plan_class():
         memo = hot.get("plan_current")
@@ -254,7 +256,7 @@ _REQUESTS: dict[tuple, CertifyRequest] = {}
 """Memo of the requests :func:`_request_of` built from plain keyword values (bounded; see there)."""
 _NO_KEY = object()
 _LAST_REQUEST: list[tuple | None] = [None]
-"""The argument objects of the last memoised keyword call with ``budget=None`` and its request."""
+"""The argument objects of the last memoised keyword call, its budget key and its request."""
 
 
 def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any, tolerances: Any,
@@ -272,13 +274,15 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
     a loop certifying many windows with the same settings validates them once.
     """
     last = _LAST_REQUEST[0]
-    if (budget is None and last is not None and last[0] is margin and last[1] is epsilon
+    if (last is not None and last[0] is margin and last[1] is epsilon
             and last[2] is method and last[3] is window and last[4] is tolerances and last[5] is pairs
             and last[6] is ongoing and last[7] is penetration_tol
-            and last[8] == DEFAULT_BUDGET_SECONDS):
+            and (last[8] == DEFAULT_BUDGET_SECONDS if budget is None
+                 else type(budget) is Budget and last[8] == (budget.seconds, budget.tests))):
         # the very objects of the previous call (a loop certifying window after window): immutable
         # values (floats, strings, a frozen Tolerances, a tuple of floats or None) that were
-        # validated into last[9]; a mutable Budget never takes this path
+        # validated into last[9], and the budget key (the engine's default seconds read now, or
+        # a Budget's limits read now: a Budget object is mutable) that keyed it in _REQUESTS
         return last[9]
     if budget is None:  # the engine's default seconds, read now (tests patch it)
         bkey: Any = DEFAULT_BUDGET_SECONDS
@@ -297,9 +301,8 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         except TypeError:  # an unhashable method / ongoing: validation names it below
             hit, key = None, None
         if hit is not None and hit.tolerances is tolerances:
-            if budget is None:
-                _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
-                                    penetration_tol, bkey, hit)
+            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing,
+                                penetration_tol, bkey, hit)
             return hit
     try:
         req = CertifyRequest(margin=margin, epsilon=epsilon, method=method, window=window,
@@ -311,9 +314,8 @@ def _request_of(margin: Any, epsilon: Any, method: Any, window: Any, budget: Any
         raise InvalidInputError(msg[len("CertifyRequest."):] if msg.startswith("CertifyRequest.")
                                 else msg) from None
     if key is not None:
-        if budget is None:
-            _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
-                                bkey, req)
+        _LAST_REQUEST[0] = (margin, epsilon, method, window, tolerances, pairs, ongoing, penetration_tol,
+                            bkey, req)
         if len(_REQUESTS) >= 64:
             _REQUESTS.clear()
         _REQUESTS[key] = req
@@ -416,34 +418,46 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
         bud = req.new_budget()
     margin, epsilon, method, tol = req.margin, req.epsilon, req.method.value, req.tolerances
     ongoing, pen_tol = req.ongoing, req.penetration_tol
-    plan = _check_model(scene, plan)
-    pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
-    if req.window is None:
-        t0, t1 = pt0, pt1
-    else:
-        t0, t1 = req.window
-        if t0 < pt0 or t1 > pt1:
-            raise InvalidInputError(f"window ({t0}, {t1}) is not inside the plan span ({pt0}, {pt1})")
-    if not t1 > t0:
-        raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
+    sync = getattr(scene, "sync", None)
+    if sync is not None:
+        sync()      # every call: it guards in-place model edits (the memo below is valid only after it)
     allowed = getattr(scene, "allowed_pairs", ())
     if type(allowed) is not tuple:
         allowed = tuple(allowed)
-    sel = _select(scene, req.pairs)
-    if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
-        cert = Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
-                           (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
-                                "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
-                                "budget_exhausted": False, "nothing_checked": True}, allowed)
-        cert.__dict__["request"] = req
-        return cert
-    fast = _fast_inputs(scene, plan)
+    hit = _call_memo(scene, plan, req)
+    if hit is not None:   # the same scene state, plan and request as the call that stored it
+        plan, t0, t1, sel, fast, prep = hit
+    else:
+        plan_given = plan
+        plan = _check_model(scene, plan, synced=True)
+        pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
+        if req.window is None:
+            t0, t1 = pt0, pt1
+        else:
+            t0, t1 = req.window
+            if t0 < pt0 or t1 > pt1:
+                raise InvalidInputError(f"window ({t0}, {t1}) is not inside the plan span ({pt0}, {pt1})")
+        if not t1 > t0:
+            raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
+        sel = _select(scene, req.pairs)
+        if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
+            cert = Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
+                               (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
+                                    "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
+                                    "budget_exhausted": False, "nothing_checked": True}, allowed)
+            cert.__dict__["request"] = req
+            return cert
+        fast = _fast_inputs(scene, plan)
+        prep = None
+        if fast is not None:
+            prep = _fast_prep(scene, plan, sel, fast, t0, t1, margin, epsilon, method, tol)
+            _remember_call(scene, plan_given, plan, req, t0, t1, sel, fast, prep)
     # the compiled path builds no PairResult objects (cert.pairs is built on first read)
     stage = _stage_budget(bud, len(sel) if fast is None else 0)
     with active_budget(stage):
         if fast is not None and not stage.exhausted:
             cert = _certify_fast(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0,
-                                 allowed, fast)
+                                 allowed, fast, prep)
         else:
             cert = _certify(scene, plan, margin, epsilon, method, t0, t1, stage, tol, sel, wall0, allowed)
     # issue 13: contacts present at t0 (monitor/certify/ongoing.py); deepen returns a
@@ -574,6 +588,78 @@ def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     if int(plan.nbody) != mp.nbody:
         return None
     return sp, mp, memo
+
+
+def _fast_prep(scene: Any, plan: Any, sel: np.ndarray, fast: tuple, t0: float, t1: float, margin: float,
+               epsilon: float, method: str, tol: Tolerances) -> tuple:
+    """(pid, moving, fixed, mov, prm, narrow): the inputs :func:`_certify_fast` derives per call.
+
+    ``pid`` (S, 2) int64 read-only geom pairs of the selection, ``moving`` / ``fixed`` / ``mov`` /
+    ``prm`` from :func:`_plan_inputs`, ``narrow`` whether the compiled whole-shape stage runs.
+    Read-only for the kernel; kept by :func:`_remember_call` for the next identical call.
+    """
+    KS = _kernels()
+    sp, _mp, memo = fast
+    pid = sp.pair_ids if len(sel) == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
+    if pid.flags.writeable:
+        # always a read-only array (a subset copy, a pack built writable): window_kernel keeps
+        # ONE specialisation (numba types the readonly flag: a second ~20 s compile otherwise)
+        pid = pid.view()
+        pid.flags.writeable = False
+    moving, fixed, mov, prm = _plan_inputs(scene, plan, memo, t0, t1, margin, epsilon, tol, KS)
+    # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
+    # every surviving pair takes the Python route, which calls the replacement
+    narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
+    return pid, moving, fixed, mov, prm, narrow
+
+
+def _call_memo(scene: Any, plan: Any, req: CertifyRequest) -> tuple | None:
+    """(plan, t0, t1, sel, fast, prep) kept by :func:`_remember_call` for this scene, plan, request; or None.
+
+    Call right after ``scene.sync()``. A hit needs the very plan and request objects of the
+    stored call (both immutable: an exact Plan / BodyMotion, a frozen CertifyRequest), the
+    scene's snapshot, geoms, pair_ids and body_static objects of that call (``Scene.sync``
+    replaces them, and empties ``Scene._hot``, when the model was edited) and the same
+    replaceable engine functions (tests monkeypatch them). Everything stored was derived
+    from those alone, so a hit holds what the validation and packing would recompute:
+    the checks ran on the stored call and their inputs are unchanged.
+    """
+    hot = getattr(scene, "_hot", None)
+    if not hot:
+        return None
+    m = hot.get("call")
+    if m is None or m[0] is not plan or m[1] is not req:
+        return None
+    KS = _KS[0]
+    if (m[2] is not scene._snapshot or m[3] is not scene.geoms or m[4] is not scene.pair_ids
+            or m[5] is not scene.body_static or m[6] is not _fast_inputs or m[7] is not KS.scene_pack
+            or m[8] is not KS.trajectory_pack_memo or m[9] is not KS.whole_shape_stage):
+        return None
+    return m[10]
+
+
+def _remember_call(scene: Any, plan_given: Any, plan: Any, req: CertifyRequest, t0: float, t1: float,
+                   sel: np.ndarray, fast: tuple, prep: tuple) -> None:
+    """Keep this call's validated inputs in ``Scene._hot["call"]`` for :func:`_call_memo` (one entry).
+
+    Only when they depend on nothing but the objects :func:`_call_memo` compares: a
+    :class:`monitor.Scene` (snapshot and cache), an exact Plan / BodyMotion used as given
+    (not refreshed) whose model is none or the scene's own (a plan of another, equal-hash
+    model is re-hashed on every call: that model may be edited in place). A Plan of the
+    scene's model stays current while ``sync`` finds the model unchanged (see
+    :func:`_remember_current`).
+    """
+    hot = getattr(scene, "_hot", None)
+    snap = getattr(scene, "_snapshot", None)
+    if hot is None or snap is None or plan is not plan_given or type(plan) not in _known_trajectories():
+        return
+    pm = getattr(plan, "model", None)
+    if pm is not None and pm is not scene.model:
+        return
+    KS = _kernels()
+    hot["call"] = (plan, req, snap, scene.geoms, scene.pair_ids, scene.body_static, _fast_inputs,
+                   KS.scene_pack, KS.trajectory_pack_memo, KS.whole_shape_stage,
+                   (plan, t0, t1, sel, fast, prep))
 
 
 _new = object.__new__
@@ -778,7 +864,7 @@ _ENTRY_POINTS: dict[int, tuple] = {}
 
 def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
                   bud: Budget, tol: Tolerances, sel: np.ndarray, wall0: float, allowed: tuple,
-                  fast: tuple) -> Certificate:
+                  fast: tuple, prep: tuple) -> Certificate:
     """The pipeline of :func:`certify` with stages 1-4 in :func:`monitor.certify.kernels.window_kernel`.
 
     One compiled call culls every selected pair (static-static, swept spheres), tests the
@@ -794,16 +880,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
 
     sp, mp, memo = fast
     P = len(sel)
-    pid = sp.pair_ids if P == len(sp.pair_ids) else np.ascontiguousarray(sp.pair_ids[sel])
-    if pid.flags.writeable:
-        # always a read-only array (a subset copy, a pack built writable): window_kernel keeps
-        # ONE specialisation (numba types the readonly flag: a second ~20 s compile otherwise)
-        pid = pid.view()
-        pid.flags.writeable = False
-    moving, fixed, mov, prm = _plan_inputs(scene, plan, memo, t0, t1, margin, epsilon, tol, KS)
-    # the compiled stage can be switched off (tests monkeypatch kernels.whole_shape_stage): then
-    # every surviving pair takes the Python route, which calls the replacement
-    narrow = bool(getattr(KS.whole_shape_stage, "_compiled_stage", False)) and method != "extrusion"
+    pid, moving, fixed, mov, prm, narrow = prep
     route_all = narrow and method == "toleranced"
     code = np.empty(P, np.int64)
     gap = np.empty(P)
@@ -819,19 +896,17 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, info))
     done_to = min(first, S)
-    charged = info[KS.WI_TESTS]
+    charged = info.item(KS.WI_TESTS)
     if charged:
         bud.charge(int(charged))
     if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
-        return _all_culled(sel, pid, code, gap, surv, res, info, geoms=scene.geoms, t0=t0, t1=t1,
-                           margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
-                           allowed=allowed, sc=sc, sr=sr, KS=KS)
+        return _all_culled(sel, pid, code, gap, surv, res, info, scene.geoms, t0, t1, margin, epsilon, method,
+                           bud, wall0, allowed, sc, sr, KS)
     if route_all and done_to == S:
         # every survivor went through the whole-shape stage in this one call: when the kernel
         # decided them all, the certificate is the general tail's (see _kernel_decided)
-        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, geoms=scene.geoms, t0=t0, t1=t1,
-                               margin=margin, epsilon=epsilon, method=method, bud=bud, wall0=wall0,
-                               allowed=allowed, sc=sc, sr=sr, KS=KS)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
+                               method, bud, wall0, allowed, sc, sr, KS)
         if cert is not None:
             return cert
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
@@ -990,7 +1065,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
 
 
 def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
-                res: np.ndarray, info: np.ndarray, *, geoms: tuple, t0: float, t1: float, margin: float,
+                res: np.ndarray, info: np.ndarray, geoms: tuple, t0: float, t1: float, margin: float,
                 epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple, sc: np.ndarray,
                 sr: np.ndarray, KS: Any) -> Certificate:
     """The certificate :func:`_certify_fast` builds when stage 0 culled every selected pair.
@@ -1001,7 +1076,7 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
     the pairs stay arrays (:class:`_WindowPairs`).
     """
     P = len(sel)
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], np.zeros(P, bool), {}, geoms, (t0, t1),
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:0], res[:0], _none_unfinished(P), {}, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     best_cull = info.item(KS.WI_BEST)
     clearance = float(best_cull) if best_cull < float("inf") else float("inf")
@@ -1012,8 +1087,26 @@ def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndar
                                 clearance, lazy, stats, allowed)
 
 
+_NONE_UNFINISHED: dict[int, np.ndarray] = {}
+
+
+def _none_unfinished(P: int) -> np.ndarray:
+    """(P,) read-only all-False bool mask: no pair left unfinished (shared per P; bounded cache).
+
+    :class:`_WindowPairs` only reads its ``unfin`` mask; the read-only flag makes a write raise.
+    """
+    hit = _NONE_UNFINISHED.get(P)
+    if hit is None:
+        hit = np.zeros(P, bool)
+        hit.setflags(write=False)
+        if len(_NONE_UNFINISHED) >= 16:
+            _NONE_UNFINISHED.clear()
+        _NONE_UNFINISHED[P] = hit
+    return hit
+
+
 def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
-                    res: np.ndarray, info: np.ndarray, S: int, *, geoms: tuple, t0: float, t1: float,
+                    res: np.ndarray, info: np.ndarray, S: int, geoms: tuple, t0: float, t1: float,
                     margin: float, epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
                     sc: np.ndarray, sr: np.ndarray, KS: Any) -> Certificate | None:
     """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
@@ -1030,8 +1123,8 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
     Issue 12 (pair-window floor): the general tail's survivor lists cost ~20 us per call.
     """
     if S == 1:      # the bench's and a lone pair's case, without the lists below
-        k = int(surv[0])
-        c = int(code[k])
+        k = surv.item(0)
+        c = code.item(k)
         if c == KS.WK_PYTHON or c == KS.WK_OPEN or c == KS.WK_UNRES:
             return None
         ks, cs = (k,), (c,)
@@ -1061,7 +1154,7 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
             if int(row[KS.R_DEPTH]) > depth:
                 depth = int(row[KS.R_DEPTH])
         if c == KS.WK_STATIC_VIOL or c == KS.WK_VIOL:
-            key = (row[KS.R_WTIME], int(sel[k]))
+            key = (row[KS.R_WTIME], sel.item(k))
             if best_v is None or key < best_v[:2]:
                 best_v = (key[0], key[1], k, s)
             starts.append(row[KS.R_WTIME])
@@ -1072,7 +1165,7 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         mix["static"] = n_static
     if S - n_static:
         mix["toleranced/whole-shape"] = S - n_static
-    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], np.zeros(P, bool), {}, geoms, (t0, t1),
+    lazy = _WindowPairs(sel, pid, code, gap, surv[:S], res[:S], _none_unfinished(P), {}, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     witness = earliest = None
     if best_v is not None:
@@ -1081,13 +1174,12 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
         clears.append(float("-inf"))
     verdict = Verdict.VIOLATION if best_v is not None else Verdict.CERTIFIED
     return _window_certificate(verdict, witness, earliest, clears, lazy, info, P, S, tests, depth, mix, {},
-                               t0=t0, t1=t1, margin=margin, epsilon=epsilon, method=method, bud=bud,
-                               wall0=wall0, allowed=allowed, KS=KS)
+                               t0, t1, margin, epsilon, method, bud, wall0, allowed, KS)
 
 
 def _window_certificate(verdict: Verdict, witness: Witness | None, earliest: float | None,
                         clears: list[float], lazy: _WindowPairs, info: np.ndarray, P: int, S: int, tests: int,
-                        depth: int, mix: dict, extra: dict, *, t0: float, t1: float, margin: float,
+                        depth: int, mix: dict, extra: dict, t0: float, t1: float, margin: float,
                         epsilon: float, method: str, bud: Budget, wall0: float, allowed: tuple,
                         KS: Any) -> Certificate:
     """The certificate of a window whose S survivors were all decided, the general tail's values.
