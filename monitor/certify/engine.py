@@ -50,6 +50,7 @@ from monitor.certify.common import (
     DEFAULT_BUDGET_SECONDS,
     Budget,
     BudgetExhausted,
+    Outcome,
     PairOutcome,
     active_budget,
 )
@@ -59,7 +60,7 @@ from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
 from monitor.tolerances import DEFAULT, Tolerances
 
-_METHODS = ("auto", "toleranced", "extrusion")
+_METHODS = tuple(m.value for m in Method)  # ("auto", "toleranced", "extrusion")
 _MAX_WITNESS_INTERVALS = 64
 """Intervals per pair searched for a witness (in time order); the rest stay uncertain."""
 _FINALISE_SECONDS_PER_PAIR = [8e-6]
@@ -441,7 +442,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
             raise InvalidInputError(f"empty window: t1 = {t1} must be > t0 = {t0}")
         sel = _select(scene, req.pairs)
         if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
-            cert = Certificate("certified", (t0, t1), margin, epsilon, method, None, None, float("inf"),
+            cert = Certificate(Verdict.CERTIFIED, (t0, t1), margin, epsilon, method, None, None, float("inf"),
                                (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
                                     "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
                                     "budget_exhausted": False, "nothing_checked": True}, allowed)
@@ -530,12 +531,12 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
                              pid[:, 0].tolist(), pid[:, 1].tolist(),
                              results, names, bnames)
     checked_r = [results[i] for i in sorted(results)]
-    verdict = combine_verdicts([r.verdict for r in checked_r] + (["uncertain"] if n_unfin else []))
-    witnesses = [r.witness for r in checked_r if r.verdict == "violation" and r.witness is not None]
+    verdict = combine_verdicts([r.verdict for r in checked_r] + ([Verdict.UNCERTAIN] if n_unfin else []))
+    witnesses = [r.witness for r in checked_r if r.verdict == Verdict.VIOLATION and r.witness is not None]
     witness = min(witnesses, key=lambda w: w.time) if witnesses else None
     earliest = None
-    if verdict != "certified":
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+    if verdict != Verdict.CERTIFIED:
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
         starts += [w.time for w in witnesses] + ([t0] if n_unfin else [])
         earliest = float(min(starts)) if starts else t0
     finite_cull = cull_clear[np.isfinite(cull_clear)]
@@ -731,15 +732,15 @@ class _WindowPairs:
         row = self.res[s]
         c = int(self.code[k])
         if c == KS.WK_STATIC_CERT:
-            return PairResult(geoms, bodies, "certified", "static", clearance=float(row[KS.R_CLEAR]))
+            return PairResult(geoms, bodies, Verdict.CERTIFIED, "static", clearance=float(row[KS.R_CLEAR]))
         if c == KS.WK_CERT:
-            return PairResult(geoms, bodies, "certified", "toleranced", int(row[KS.R_TESTS]),
+            return PairResult(geoms, bodies, Verdict.CERTIFIED, "toleranced", int(row[KS.R_TESTS]),
                               int(row[KS.R_DEPTH]), (), float(row[KS.R_CLEAR]))
         w = self.kernel_witness(k, s)
         if c == KS.WK_STATIC_VIOL:
             t0 = float(self.window[0])
-            return PairResult(geoms, bodies, "violation", "static", intervals=((t0, t0),), witness=w)
-        return PairResult(geoms, bodies, "violation", "toleranced", int(row[KS.R_TESTS]),
+            return PairResult(geoms, bodies, Verdict.VIOLATION, "static", intervals=((t0, t0),), witness=w)
+        return PairResult(geoms, bodies, Verdict.VIOLATION, "toleranced", int(row[KS.R_TESTS]),
                           int(row[KS.R_DEPTH]), ((float(row[KS.R_FIRST_UNRES]), w.time),), float("-inf"), w)
 
     def methods(self) -> np.ndarray:
@@ -1025,15 +1026,15 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         tests_total += int(rows[s][KS.R_TESTS])
         depth_max = max(depth_max, int(rows[s][KS.R_DEPTH]))
     checked_r = [results[i] for i in sorted(results)] if results else []
-    has_viol = bool(vslots) or any(r.verdict == "violation" for r in checked_r)
-    has_unc = n_unfin > 0 or any(r.verdict == "uncertain" for r in checked_r)
-    verdict = "violation" if has_viol else "uncertain" if has_unc else "certified"
+    has_viol = bool(vslots) or any(r.verdict == Verdict.VIOLATION for r in checked_r)
+    has_unc = n_unfin > 0 or any(r.verdict == Verdict.UNCERTAIN for r in checked_r)
+    verdict = Verdict.VIOLATION if has_viol else Verdict.UNCERTAIN if has_unc else Verdict.CERTIFIED
     # views, not copies: code / gap / surv / res are this call's own arrays, not written after here
     lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to], res[:done_to], unfin, results,
                         geoms, (t0, t1), sc, sr, info.item(KS.WI_PAD))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
-            if r.verdict == "violation" and r.witness is not None]
+            if r.verdict == Verdict.VIOLATION and r.witness is not None]
     for s in vslots:
         k = svl[s]
         cand.append((rows[s][KS.R_WTIME], int(sel[k]), None, k, s))
@@ -1042,8 +1043,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         best = cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1]))
         witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
-    if verdict != "certified":
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+    if verdict != Verdict.CERTIFIED:
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
         starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
         for s in vslots:
             starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else rows[s][KS.R_FIRST_UNRES])
@@ -1262,7 +1263,7 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         outs = _run_extrusion(plan, items, margin, tol, bud, t0, t1)
         ext_stats = extrusion_stats(outs)
     except BudgetExhausted:
-        outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in items]
+        outs = [PairOutcome(Outcome.UNRESOLVED, intervals=[(t0, t1)]) for _ in items]
     P = len(sel)
     mix: dict[str, int] = {}
     if P - S:
@@ -1275,19 +1276,19 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         r = results[i] = _checked_result(plan, "extrusion", o, ga, gb, False, t0, t1, margin, tol, bud)
         mix[r.method] = mix.get(r.method, 0) + 1
     checked_r = [results[i] for i in sorted(results)]
-    has_viol = any(r.verdict == "violation" for r in checked_r)
-    verdict = ("violation" if has_viol else "uncertain" if any(r.verdict == "uncertain" for r in checked_r)
-               else "certified")
+    has_viol = any(r.verdict == Verdict.VIOLATION for r in checked_r)
+    has_unc = any(r.verdict == Verdict.UNCERTAIN for r in checked_r)
+    verdict = Verdict.VIOLATION if has_viol else Verdict.UNCERTAIN if has_unc else Verdict.CERTIFIED
     lazy = _WindowPairs(sel, pid, code, gap, sv, res[:S], np.zeros(P, bool), results, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
-            if r.verdict == "violation" and r.witness is not None]
+            if r.verdict == Verdict.VIOLATION and r.witness is not None]
     witness = None
     if cand:
         witness = (cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1])))[2]
     earliest = None
-    if verdict != "certified":
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != "certified" and r.intervals]
+    if verdict != Verdict.CERTIFIED:
+        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
         starts += [c[0] for c in cand]
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
@@ -1519,7 +1520,7 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
             if d.upper + _approx(ga, gb) < margin:
                 w = Witness(t0, (ga.name, gb.name), 0.5 * (d.p_a + d.p_b),
                             float(d.upper + _approx(ga, gb)))
-                done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "violation", "static",
+                done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), Verdict.VIOLATION, "static",
                                    intervals=((t0, t0),), witness=w))
                 continue
             cores_apart = d.lower + ga.shape.radius + gb.shape.radius > 0
@@ -1527,10 +1528,10 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
                 start_unproven.add(i)
             if not moving[ga.body_id] and not moving[gb.body_id]:
                 if d.lower > margin:
-                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "certified", "static",
+                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), Verdict.CERTIFIED, "static",
                                        clearance=float(d.lower)))
                 else:
-                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), "uncertain", "static",
+                    done(i, PairResult((ga.name, gb.name), (ga.body, gb.body), Verdict.UNCERTAIN, "static",
                                        intervals=((t0, t1),)))
                 continue
             checked.append((i, ga, gb))
@@ -1567,7 +1568,7 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
             outs = _run_extrusion(plan, ext_items, margin, tol, bud, t0, t1)
             ext_stats = extrusion_stats(outs)
         except BudgetExhausted:
-            outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in ext_items]
+            outs = [PairOutcome(Outcome.UNRESOLVED, intervals=[(t0, t1)]) for _ in ext_items]
         for (i, _ga, _gb, _), o in zip(ext_items, outs):
             outcomes[i] = ("extrusion", o)
     if tol_items and whole_shape:  # issue 12: the compiled whole-shape stage first; what it certifies is done
@@ -1579,7 +1580,7 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
             pre = [None] * len(tol_items)
         for k, ((i, ga, gb), r) in enumerate(zip(tol_items, pre)):
             w = None
-            if r is not None and r["verdict"] == "violation":  # re-confirmed by the engine's own rule
+            if r is not None and r["verdict"] == Verdict.VIOLATION:  # re-confirmed by the engine's own rule
                 try:
                     w = _find_witness(plan, ga, gb, np.array([r["witness_time"]]), margin, tol)
                 except BudgetExhausted:
@@ -1601,7 +1602,7 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
             outs = toleranced.check_pairs(plan, items, (t0, t1), margin, epsilon, tol, bud,
                                           static=~moving, check_start=False)
         except BudgetExhausted:
-            outs = [PairOutcome("unresolved", intervals=[(t0, t1)]) for _ in tol_items]
+            outs = [PairOutcome(Outcome.UNRESOLVED, intervals=[(t0, t1)]) for _ in tol_items]
         for (i, _ga, _gb), o in zip(tol_items, outs):
             outcomes[i] = ("toleranced", o)
     # -- 5. witnesses ---------------------------------------------------------------------
@@ -1612,7 +1613,7 @@ def _python_stages(scene: Any, plan: Any, margin: float, epsilon: float, method:
         tests_total += int(o.tests)
         depth_max = max(depth_max, int(o.max_depth))
         r = _checked_result(plan, meth, o, ga, gb, i in start_unproven, t0, t1, margin, tol, bud)
-        if r.verdict == "certified" and meth == "toleranced":
+        if r.verdict == Verdict.CERTIFIED and meth == "toleranced":
             refine.append(i)
         done(i, r)
     cl = []
@@ -1643,16 +1644,16 @@ def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unpr
     else "uncertain" (also when the budget runs out here).
     """
     names, bodies = (ga.name, gb.name), (ga.body, gb.body)
-    if o.verdict == "certified" and (meth == "extrusion" or not unproven):
+    if o.verdict == Outcome.CERTIFIED and (meth == "extrusion" or not unproven):
         clear = o.clearance if np.isfinite(o.clearance) else margin
         if meth == "toleranced":
             clear = max(clear, margin)
-        return PairResult(names, bodies, "certified", meth, o.tests, o.max_depth, (), float(clear))
+        return PairResult(names, bodies, Verdict.CERTIFIED, meth, o.tests, o.max_depth, (), float(clear))
     intervals = list(o.intervals)
-    if o.verdict == "certified":  # start pose not proven clear
+    if o.verdict == Outcome.CERTIFIED:  # start pose not proven clear
         intervals = [(t0, t0)]
     cands: list[float] = []
-    if o.verdict == "violation" and o.witness_time is not None:
+    if o.verdict == Outcome.VIOLATION and o.witness_time is not None:
         cands.append(float(o.witness_time))
         if not intervals:
             intervals = [(float(o.witness_time), float(o.witness_time))]
@@ -1666,9 +1667,9 @@ def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unpr
         except BudgetExhausted:
             w = None
     if w is not None:
-        return PairResult(names, bodies, "violation", meth, o.tests, o.max_depth, tuple(intervals),
+        return PairResult(names, bodies, Verdict.VIOLATION, meth, o.tests, o.max_depth, tuple(intervals),
                           float("-inf"), w)
-    return PairResult(names, bodies, "uncertain", meth, o.tests, o.max_depth,
+    return PairResult(names, bodies, Verdict.UNCERTAIN, meth, o.tests, o.max_depth,
                       tuple(intervals) if intervals else ((t0, t1),), float("-inf"))
 
 
@@ -1808,21 +1809,21 @@ def _run_extrusion_python(eps_pairs: list, margin: float, ext_margin: float, tol
     # for a witness deep enough to confirm (with margin > 0 the checker caps its depth
     # at the margin it is given); "certified" there means the sub-slack band: unresolved.
     outs = extrusion.check_pairs(eps_pairs, (t0, t1), ext_margin, tol, bud, nary=True)
-    redo = [k for k, o in enumerate(outs) if o.verdict != "certified"]
+    redo = [k for k, o in enumerate(outs) if o.verdict != Outcome.CERTIFIED]
     if redo and not bud.exhausted:
         again = extrusion.check_pairs([eps_pairs[k] for k in redo], (t0, t1), margin, tol, bud, nary=True)
         for k, o2 in zip(redo, again):
-            if o2.verdict == "violation":
+            if o2.verdict == Outcome.VIOLATION:
                 o2.tests += outs[k].tests
                 o2.info["first_pass_stats"] = outs[k].info.get("stats")
                 outs[k] = o2
-            elif outs[k].verdict == "violation":  # band case: never a confirmed witness time
+            elif outs[k].verdict == Outcome.VIOLATION:  # band case: never a confirmed witness time
                 o1 = outs[k]
-                o1.verdict, o1.witness_time = "unresolved", None
+                o1.verdict, o1.witness_time = Outcome.UNRESOLVED, None
     else:
         for k in redo:
-            if outs[k].verdict == "violation":  # not re-run: never a confirmed witness time
-                outs[k].verdict, outs[k].witness_time = "unresolved", None
+            if outs[k].verdict == Outcome.VIOLATION:  # not re-run: never a confirmed witness time
+                outs[k].verdict, outs[k].witness_time = Outcome.UNRESOLVED, None
     return outs
 
 
