@@ -60,7 +60,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from monitor.certify.certificate import Certificate, PairResult, combine_verdicts
+from monitor.certify.certificate import Certificate, PairResult, combine_verdicts, nothing_checked_stats
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, check_rule
 from monitor.certify.request import BudgetLimits, CertifyRequest
 from monitor.certify.types import Method, Verdict
@@ -1513,9 +1513,7 @@ class Gate:
         state = cert.__dict__
         state.update(hit[2].__dict__)
         state["window"] = (times[0], times[-1])  # Python floats, as the Plan's t0 / t1
-        state["stats"] = {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
-                          "wall_seconds": time.perf_counter() - t_start, "checker_mix": {},
-                          "budget_exhausted": False, "nothing_checked": True}
+        state["stats"] = nothing_checked_stats(time.perf_counter() - t_start)
         return cert, (time.perf_counter() - t_start) * 1e6
 
     def _certify_static(self, win: _WindowRows) -> tuple[Certificate, float] | None:

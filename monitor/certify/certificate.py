@@ -291,4 +291,16 @@ def _jsonable(x: Any) -> Any:
     return jsonable(x, "clamp")
 
 
-__all__ = ["Certificate", "Method", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts"]
+def nothing_checked_stats(wall_seconds: float) -> dict[str, Any]:
+    """``Certificate.stats`` of a window with no candidate pair to check (verdict ``certified``).
+
+    :func:`monitor.certify` returns it for an empty selection; ``Gate._certify_nothing`` builds the same
+    certificate without a Plan (``tests/test_gate_zero_pairs.py`` compares the two).
+    """
+    return {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0, "wall_seconds": wall_seconds,
+            "checker_mix": {}, "budget_exhausted": False, "nothing_checked": True}
+
+
+__all__ = ["Certificate", "Method", "PairResult", "Witness", "Verdict", "VERDICTS", "combine_verdicts",
+           "nothing_checked_stats"]
+

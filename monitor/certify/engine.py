@@ -45,7 +45,14 @@ from typing import Any
 import numpy as np
 
 from monitor.certify.broadphase import halfspace_gaps, sphere_pair_gaps, swept_geom_spheres
-from monitor.certify.certificate import Certificate, PairResult, Verdict, Witness, combine_verdicts
+from monitor.certify.certificate import (
+    Certificate,
+    PairResult,
+    Verdict,
+    Witness,
+    combine_verdicts,
+    nothing_checked_stats,
+)
 from monitor.certify.common import (
     DEFAULT_BUDGET_SECONDS,
     Budget,
@@ -443,9 +450,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
         sel = _select(scene, req.pairs)
         if len(sel) == 0:  # nothing to check (e.g. Reacher's pairs="mujoco"): the gate's hot path
             cert = Certificate(Verdict.CERTIFIED, (t0, t1), margin, epsilon, method, None, None, float("inf"),
-                               (), {"pairs": 0, "pairs_culled": 0, "tests": 0, "max_depth": 0,
-                                    "wall_seconds": time.perf_counter() - wall0, "checker_mix": {},
-                                    "budget_exhausted": False, "nothing_checked": True}, allowed)
+                               (), nothing_checked_stats(time.perf_counter() - wall0), allowed)
             cert.__dict__["request"] = req
             return cert
         fast = _fast_inputs(scene, plan)
