@@ -32,8 +32,8 @@ lo, hi, sc2, sr2, pad = sp.swept_boxes(gp, mp, prm, T)
 thr = margin + pad + 1e-9
 fns = {
     "whole certify (epsilon 1e-3)": lambda: monitor.certify(scene, bm, epsilon=1e-3),
-    "current cull (stage 0, k1 = 0)": lambda: KS.window_kernel(gp, mp, pairs, fixed, moving, none, 0, 0, 0, prm,
-                                                              code, gap, surv, res, sc, sr2, info),
+    "current cull (stage 0, k1 = 0)": lambda: KS.window_kernel(gp, mp, pairs, fixed, moving, none, 0, 0, 0,
+                                                              prm, code, gap, surv, res, sc, rest[10], info),
     "proto: swept_boxes only": lambda: sp.swept_boxes(gp, mp, prm, T),
     "proto: sweep_pairs only": lambda: sp.sweep_pairs(lo, hi, thr, *pol),
     "proto: proto_cull (all of it)": lambda: sp.proto_cull(gp, mp, prm, T, margin, *pol),

@@ -1,6 +1,7 @@
 """First vs repeated certify on a fresh scaling scene (the bench times ONE call at >= 1000 bodies).
 
-Usage: PYTHONPATH=<tree> python docs/notes/issue-12-sweep/first_call.py N [sparse|dense] [translating|rotating]
+Usage: PYTHONPATH=<tree> python docs/notes/issue-12-sweep/first_call.py N [sparse|dense]
+[translating|rotating]
 """
 import sys
 import time
@@ -11,9 +12,8 @@ from monitor.bench.suites import scaling_scene
 n = int(sys.argv[1])
 density = sys.argv[2] if len(sys.argv) > 2 else "sparse"
 motion = sys.argv[3] if len(sys.argv) > 3 else "translating"
-monitor.certify(*scaling_scene(3, density, motion)[::-1][::-1] and
-                (monitor.Scene.from_model(scaling_scene(3, density, motion)[0], pairs="all"),
-                 scaling_scene(3, density, motion)[1]), epsilon=1e-3)   # kernels loaded
+model3, bm3 = scaling_scene(3, density, motion)
+monitor.certify(monitor.Scene.from_model(model3, pairs="all"), bm3, epsilon=1e-3)   # kernels loaded
 model, bm = scaling_scene(n, density, motion)
 t = time.perf_counter()
 scene = monitor.Scene.from_model(model, pairs="all")

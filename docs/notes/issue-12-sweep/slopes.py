@@ -19,7 +19,7 @@ for (motion, density), r in rows.items():
     n = np.array([x[0] for x in r], float)
     for j, name in ((1, "current cull"), (2, "prototype")):
         t = np.array([x[j] for x in r])
-        fit = lambda m: np.polyfit(np.log(n[m]), np.log(t[m]), 1)[0]  # noqa: E731
-        loc = lambda a, b: np.log(t[n == b][0] / t[n == a][0]) / np.log(b / a)  # noqa: E731
+        fit = lambda m, n=n, t=t: np.polyfit(np.log(n[m]), np.log(t[m]), 1)[0]  # noqa: E731
+        loc = lambda a, b, n=n, t=t: np.log(t[n == b][0] / t[n == a][0]) / np.log(b / a)  # noqa: E731
         print(f"| {motion} | {density} | {name} | {fit(n <= 1000):.2f} | {fit(n <= 3000):.2f} | "
               f"{loc(100, 1000):.2f} | {loc(1000, 3000):.2f} |")

@@ -145,8 +145,7 @@ def sweep_pairs(lo, hi, thr, planeish, gweld, gwparent, exc_ptr, exc_idx):
     for i in range(nb):
         key[i] = lo[bounded[i], 0]
     order = bounded[np.argsort(key)]
-    cap = 4 * G + 16
-    out = np.empty((cap, 2), np.int64)
+    out = np.empty((4 * G + 16, 2), np.int64)
     K = 0
     for i in range(nb):
         a = order[i]
@@ -161,13 +160,7 @@ def sweep_pairs(lo, hi, thr, planeish, gweld, gwparent, exc_ptr, exc_idx):
                 continue
             if not _policy_all(a, b, planeish, gweld, gwparent, exc_ptr, exc_idx):
                 continue
-            if K == cap:
-                cap *= 2
-                o2 = np.empty((cap, 2), np.int64)
-                o2[:K] = out[:K]
-                out = o2
-            out[K, 0] = min(a, b)
-            out[K, 1] = max(a, b)
+            out = _push(out, K, a, b)
             K += 1
     for u in range(nu):
         a = unb[u]
@@ -176,19 +169,25 @@ def sweep_pairs(lo, hi, thr, planeish, gweld, gwparent, exc_ptr, exc_idx):
                 continue         # each unbounded-unbounded pair once
             if not _policy_all(a, b, planeish, gweld, gwparent, exc_ptr, exc_idx):
                 continue
-            if K == cap:
-                cap *= 2
-                o2 = np.empty((cap, 2), np.int64)
-                o2[:K] = out[:K]
-                out = o2
-            out[K, 0] = min(a, b)
-            out[K, 1] = max(a, b)
+            out = _push(out, K, a, b)
             K += 1
     out = out[:K]
     # lexicographic order (the kernel's pair order; certificates list pairs in that order)
     if K > 1:
         code = out[:, 0] * G + out[:, 1]
         out = out[np.argsort(code)]
+    return out
+
+
+@njit(cache=True)
+def _push(out, K, a, b):
+    """Row K of ``out`` := (min, max) of (a, b), doubling ``out`` when full; returns the array."""
+    if K == out.shape[0]:
+        o2 = np.empty((2 * out.shape[0], 2), np.int64)
+        o2[:K] = out[:K]
+        out = o2
+    out[K, 0] = min(a, b)
+    out[K, 1] = max(a, b)
     return out
 
 
