@@ -102,20 +102,16 @@ def _finite(name: str, x: Any) -> float:
     return v
 
 
-def _check_model(scene: Any, plan: Any, synced: bool = False) -> Any:
-    """Sync the scene with its (possibly edited) model and return the plan to certify.
+def _check_model(scene: Any, plan: Any) -> Any:
+    """The plan to certify, on a scene the caller has just synced with its (possibly edited) model.
 
-    ``scene.sync()`` rebuilds shapes and pairs after an in-place model edit (``synced``: the
-    caller has just called it). A plan whose
+    ``scene.sync()`` (run by :func:`certify` on every call) rebuilds shapes and pairs after an
+    in-place model edit. A plan whose
     frozen joint frames no longer match its live model (built before the edit) is
     replaced by the same waypoints rebuilt on the live model: the certificate is about
     the motion the simulation will now produce. The ``plan.model is scene.model`` fast
     path skips only the hash comparison, never these checks.
     """
-    if not synced:
-        sync = getattr(scene, "sync", None)
-        if sync is not None:
-            sync()
     hot = _hot(scene)
     if hot is not None and type(plan) is _plan_class():
         memo = hot.get("plan_current")
@@ -437,7 +433,7 @@ def certify(scene: Any, plan: Any, margin: float = 0.0, epsilon: float = DEFAULT
         plan, t0, t1, sel, fast, prep = hit
     else:
         plan_given = plan
-        plan = _check_model(scene, plan, synced=True)
+        plan = _check_model(scene, plan)
         pt0, pt1 = _finite("plan.t0", plan.t0), _finite("plan.t1", plan.t1)
         if req.window is None:
             t0, t1 = pt0, pt1
