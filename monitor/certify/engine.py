@@ -537,7 +537,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     witness = min(witnesses, key=lambda w: w.time) if witnesses else None
     earliest = None
     if verdict != Verdict.CERTIFIED:
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
+        starts = _open_starts(checked_r)
         starts += [w.time for w in witnesses] + ([t0] if n_unfin else [])
         earliest = float(min(starts)) if starts else t0
     finite_cull = cull_clear[np.isfinite(cull_clear)]
@@ -1026,16 +1026,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     for s in wslots:
         tests_total += int(rows[s][KS.R_TESTS])
         depth_max = max(depth_max, int(rows[s][KS.R_DEPTH]))
-    checked_r = [results[i] for i in sorted(results)] if results else []
-    has_viol = bool(vslots) or any(r.verdict == Verdict.VIOLATION for r in checked_r)
-    has_unc = n_unfin > 0 or any(r.verdict == Verdict.UNCERTAIN for r in checked_r)
+    checked_r, has_viol, has_unc, cand = _python_decided(results)
+    has_viol = has_viol or bool(vslots)
+    has_unc = has_unc or n_unfin > 0
     verdict = Verdict.VIOLATION if has_viol else Verdict.UNCERTAIN if has_unc else Verdict.CERTIFIED
     # views, not copies: code / gap / surv / res are this call's own arrays, not written after here
     lazy = _WindowPairs(sel, pid, code, gap, surv[:done_to], res[:done_to], unfin, results,
                         geoms, (t0, t1), sc, sr, info.item(KS.WI_PAD))
     # earliest witness: ties go to the first pair in selection order (as min() over pairs does)
-    cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
-            if r.verdict == Verdict.VIOLATION and r.witness is not None]
     for s in vslots:
         k = svl[s]
         cand.append((rows[s][KS.R_WTIME], int(sel[k]), None, k, s))
@@ -1045,7 +1043,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         witness = best[2] if best[2] is not None else lazy.kernel_witness(best[3], best[4])
     earliest = None
     if verdict != Verdict.CERTIFIED:
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
+        starts = _open_starts(checked_r)
         starts += [c[0] for c in cand] + ([t0] if n_unfin else [])
         for s in vslots:
             starts.append(t0 if codes[s] == KS.WK_STATIC_VIOL else rows[s][KS.R_FIRST_UNRES])
@@ -1064,6 +1062,29 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
                                 earliest, clearance, lazy, stats, allowed)
+
+
+def _python_decided(results: dict[int, PairResult]) -> tuple[list[PairResult], bool, bool, list[tuple]]:
+    """The pairs of a window decided as :class:`PairResult` objects, in selection order.
+
+    Returns (checked (R,), any violation, any uncertain, witness candidates): a candidate is
+    ``(witness time, pair index, Witness)`` per violation with a witness, in pair order (so a
+    ``min`` over ``(time, pair)`` gives ties to the first pair, as ``min`` over pairs does).
+    """
+    if not results:
+        return [], False, False, []
+    ids = sorted(results)
+    checked = [results[i] for i in ids]
+    cand = [(r.witness.time, i, r.witness) for i, r in zip(ids, checked)
+            if r.verdict == Verdict.VIOLATION and r.witness is not None]
+    has_viol = any(r.verdict == Verdict.VIOLATION for r in checked)
+    has_unc = any(r.verdict == Verdict.UNCERTAIN for r in checked)
+    return checked, has_viol, has_unc, cand
+
+
+def _open_starts(checked: list[PairResult]) -> list[float]:
+    """Start (s) of the first interval left open by each pair of ``checked`` not certified."""
+    return [r.intervals[0][0] for r in checked if r.verdict != Verdict.CERTIFIED and r.intervals]
 
 
 def _all_culled(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.ndarray, surv: np.ndarray,
@@ -1276,21 +1297,16 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         depth = max(depth, int(o.max_depth))
         r = results[i] = _checked_result(plan, "extrusion", o, ga, gb, False, t0, t1, margin, tol, bud)
         mix[r.method] = mix.get(r.method, 0) + 1
-    checked_r = [results[i] for i in sorted(results)]
-    has_viol = any(r.verdict == Verdict.VIOLATION for r in checked_r)
-    has_unc = any(r.verdict == Verdict.UNCERTAIN for r in checked_r)
+    checked_r, has_viol, has_unc, cand = _python_decided(results)
     verdict = Verdict.VIOLATION if has_viol else Verdict.UNCERTAIN if has_unc else Verdict.CERTIFIED
     lazy = _WindowPairs(sel, pid, code, gap, sv, res[:S], np.zeros(P, bool), results, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
-    cand = [(r.witness.time, i, r.witness) for i, r in zip(sorted(results), checked_r)
-            if r.verdict == Verdict.VIOLATION and r.witness is not None]
     witness = None
     if cand:
         witness = (cand[0] if len(cand) == 1 else min(cand, key=lambda c: (c[0], c[1])))[2]
     earliest = None
     if verdict != Verdict.CERTIFIED:
-        starts = [r.intervals[0][0] for r in checked_r if r.verdict != Verdict.CERTIFIED and r.intervals]
-        starts += [c[0] for c in cand]
+        starts = _open_starts(checked_r) + [c[0] for c in cand]
         earliest = float(min(starts)) if starts else t0
     clears = [r.clearance for r in checked_r]
     return _window_certificate(_VERDICT_OF[verdict], witness, earliest, clears, lazy, info, P, S, tests,
