@@ -1451,9 +1451,13 @@ class Gate:
         """Whether :meth:`_certify` is this module's own (not replaced on the instance or the class).
 
         :meth:`_certify_nothing` and :meth:`_certify_static` stand for its result; a replaced
-        ``_certify`` (a test's stub checker or spy) is called as before.
+        ``_certify`` (a test's stub checker or spy), or a replaced
+        ``monitor.certify.engine.certify`` (which :meth:`_certify` calls), is called as before.
         """
-        return "_certify" not in self.__dict__ and type(self)._certify is _GATE_CERTIFY
+        from monitor.certify import engine
+
+        return ("_certify" not in self.__dict__ and type(self)._certify is _GATE_CERTIFY
+                and engine.certify is engine._OWN_CERTIFY)
 
     def _rows_are_plan_qpos(self) -> bool:
         """Whether a window's Plan has its rows' qpos bit for bit and no mocap pose.

@@ -131,3 +131,25 @@ def test_request_memo_follows_the_budget_limits():
     assert seen == [(1.0, None), (1.0, None), (2.0, None), (2.0, 10**6), (1.0, None)]
     default = monitor.certify(scene, motion, margin=0.0, epsilon=eps)
     assert default.request.budget.seconds == engine.DEFAULT_BUDGET_SECONDS
+
+
+def test_waypoints_cannot_be_made_writable_after_a_certify():
+    """The memos trust a trajectory's waypoints: the arrays a Plan / BodyMotion / BezierMotion
+    exposes refuse ``setflags(write=True)``, so no edit can follow a cached call."""
+    import pytest
+
+    m, scene = _wall()
+    plan = monitor.Plan([0, 0.1], [[-0.2], [0.2]], m)
+    monitor.certify(scene, plan)
+    motion = _slide_motion()
+    for arr in (plan.times, plan.qpos, motion.times, motion.pos, motion.quat):
+        with pytest.raises(ValueError):
+            arr.setflags(write=True)
+    # a trusted (gate-made) Plan whose rows are views of a caller's writable buffer: copied
+    rows = np.array([[0.0, -0.2], [0.1, 0.2]])
+    trusted = monitor.Plan._trusted(rows[:, 0], rows[:, 1:], m, mocap_pos=np.zeros((0, 3)),
+                                    mocap_quat=np.zeros((0, 4)))
+    rows[1, 1] = 5.0
+    assert trusted.qpos[1, 0] == 0.2
+    with pytest.raises(ValueError):
+        trusted.qpos.setflags(write=True)

@@ -59,9 +59,12 @@ def test_zero_pair_certificates_are_certifys_own(brake, monkeypatch):
     rng = np.random.default_rng(5)
     calls = []
     real = engine.certify
-    monkeypatch.setattr(engine, "certify", lambda *a, **k: calls.append(a) or real(*a, **k))
+    check = engine._check_model  # every certify of a zero-pair scene calls it (no memo there)
+    # a spy on engine.certify itself would switch the shortcut off (see the last test)
+    monkeypatch.setattr(engine, "_check_model", lambda *a: calls.append(a) or check(*a))
     for _ in range(12):
         r = gate.step(d, rng.uniform(-1.0, 1.0, m.nu))
+        assert calls == []  # the trivial certificate: no certify call (the oracle's below are not counted)
         assert r.__dict__["_plan_store"]._plan is None  # the window's rows; no Plan built yet
         cert = r.certificate
         oracle = real(gate.scene, r.plan, request=gate.request)
@@ -69,7 +72,7 @@ def test_zero_pair_certificates_are_certifys_own(brake, monkeypatch):
         assert cert.request is gate.request and cert.stats["nothing_checked"] is True
         assert str(cert.method) == "auto" and cert.pairs == () and cert.certified
         assert r.info()["monitored_pairs"] == 0 and r.info()["checker_mix"] == ""
-    assert calls == []  # the trivial certificate: no certify call
+        calls.clear()
     assert gate.stats["windows"] == 12 and gate.stats["pairs"] == 0
 
 
@@ -170,5 +173,23 @@ def test_a_replaced_certify_is_still_called_on_a_zero_pair_gate():
         return Certificate("violation", plan.window, 0.0, 1e-3, "auto", None, plan.t0, -np.inf), 1.0
 
     gate._certify = stub
+    r = gate.step(mujoco.MjData(m), np.zeros(m.nu))
+    assert seen and r.verdict == "violation" and r.replaced
+
+
+def test_a_replaced_engine_certify_is_still_called_on_a_zero_pair_gate(monkeypatch):
+    """``monitor.certify.engine.certify`` replaced (``Gate._certify`` calls it): the zero-pair
+    shortcut stands only for the engine's own certify, so the replacement's verdict is used."""
+    from monitor.certify import engine
+    from monitor.certify.certificate import Certificate
+
+    m, gate = _gate()
+    seen = []
+
+    def stub(scene, plan, **kw):
+        seen.append(plan.t0)
+        return Certificate("violation", plan.window, 0.0, 1e-3, "auto", None, plan.t0, -np.inf)
+
+    monkeypatch.setattr(engine, "certify", stub)
     r = gate.step(mujoco.MjData(m), np.zeros(m.nu))
     assert seen and r.verdict == "violation" and r.replaced

@@ -95,6 +95,26 @@ class Trajectory(Protocol):
         """
 
 
+def sealed(arr: np.ndarray) -> np.ndarray:
+    """``arr`` read-only for good: a read-only view of a read-only array that only it refers to.
+
+    numpy turns ``WRITEABLE`` back on only for an array whose base is writable, so a view of a
+    read-only owner stays read-only: the waypoints a trajectory exposes (``times``, ``qpos``,
+    ``pos``, ...) cannot be edited after the engine cached what it derived from them (the motion
+    pack, the per-scene call memo). An array that is itself a view is copied first: its base
+    may be a caller's writable buffer.
+
+    Args:
+        arr: any ndarray (the trajectory's own, just validated).
+
+    Returns:
+        a read-only view, same dtype, shape and values.
+    """
+    owner = arr if arr.base is None else arr.copy()
+    owner.setflags(write=False)
+    return owner.view()
+
+
 class WindowTimes:
     """Mixin for trajectories whose waypoint times are stored in ``self._times`` (K,) seconds."""
 

@@ -45,7 +45,7 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, WindowTimes
+from monitor.motion.base import MotionBounds, WindowTimes, sealed
 from monitor.tolerances import DEFAULT, Tolerances
 
 
@@ -193,12 +193,11 @@ class RigidBezier:
         if not (W > 0).all():
             raise InvalidInputError(
                 f"quat_ctrl: the weights |Q|^2 have a non-positive Bernstein coefficient: {W}")
+        Q, T, W = sealed(Q), sealed(T), sealed(W)   # read-only for good (the memos trust them)
         self._Q = Q
         self._T = T
-        self._M = np.moveaxis(M, -1, 0)         # (2m+1, 3, 3)
+        self._M = sealed(np.moveaxis(M, -1, 0))  # (2m+1, 3, 3)
         self._W = W
-        for a in (Q, T, self._M, W):
-            a.setflags(write=False)
 
     @property
     def quat_ctrl(self) -> np.ndarray:
@@ -301,12 +300,11 @@ class BezierMotion(WindowTimes):
             if ref.shape != (nbody, 3):
                 raise InvalidInputError(f"ref_points must have shape ({nbody}, 3), got {ref.shape}")
             K.check_finite("ref_points", ref)
+        t, p, q, ref = (sealed(a) for a in (t, p, q, ref))  # read-only for good (the memos trust them)
         self._times = t
         self._pos = p
         self._quat = q
         self._ref = ref
-        for a in (t, p, q, ref):
-            a.setflags(write=False)
         self._motions = mot
         self._tol = tolerances
         self._refH = {b: rb.ref_curve(ref[b]) for b, rb in mot.items()}

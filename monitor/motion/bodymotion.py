@@ -65,7 +65,7 @@ import numpy as np
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
 from monitor.motion import _screw as S
-from monitor.motion.base import MotionBounds, WindowTimes, chord
+from monitor.motion.base import MotionBounds, WindowTimes, chord, sealed
 from monitor.tolerances import DEFAULT, Tolerances
 
 
@@ -124,12 +124,11 @@ class BodyMotion(WindowTimes):
             k = int(np.argmax(moved0))
             raise InvalidInputError(f"the world body (body 0) must be constant; it moves at waypoint {k}")
         self._tol = tolerances
+        t, p, q, ref = (sealed(a) for a in (t, p, q, ref))  # read-only for good (the memos trust them)
         self._times = t
         self._pos = p
         self._quat = q
         self._ref = ref
-        for arr in (t, p, q, ref):
-            arr.setflags(write=False)
         self._seg = K.Segments(t)
         self._tracks = [K.QuatTrack(q[:, b]) for b in range(nbody)]
         pos_moves = np.any(p != p[0], axis=(0, 2))

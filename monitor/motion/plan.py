@@ -120,7 +120,7 @@ import numpy as np
 from monitor.certify.common import check_active_budget
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, WindowTimes, chord
+from monitor.motion.base import MotionBounds, WindowTimes, chord, sealed
 from monitor.tolerances import DEFAULT, Tolerances
 
 _FREE = int(mujoco.mjtJoint.mjJNT_FREE)
@@ -556,10 +556,8 @@ class Plan(WindowTimes):
             for j, a, _ in st.quat_joints:
                 self._quat_tracks[j] = K.QuatTrack(q[:, a:a + 4])
 
-        self._times = t
-        self._qpos = q
-        self._times.setflags(write=False)
-        self._qpos.setflags(write=False)
+        self._times = t = sealed(t)   # no setflags(write=True) later: the pack and call memos trust them
+        self._qpos = q = sealed(q)
         self._mocap_pos = mp
         self._mocap_quat = mq
         self._seg = K.Segments(t)
