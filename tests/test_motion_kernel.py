@@ -533,3 +533,15 @@ def test_fk_on_scalars_gives_the_former_fks_bits():
             assert pos[k].tobytes() == p_ref.tobytes() and mat[k].tobytes() == R_ref.tobytes(), (k, m.nbody)
             n += 1
     assert n > 50
+
+
+def test_no_nrt_option_follows_the_installed_numba(monkeypatch):
+    """``NO_NRT`` holds numba's private ``_nrt`` option only while numba has it: a numba without
+    it would raise "Unrecognized options" at the first call of every kernel compiled with it."""
+    from numba.core import options
+
+    from monitor.motion import kernel as MK
+
+    assert MK.NO_NRT == ({"_nrt": False} if hasattr(options.DefaultOptions, "_nrt") else {})
+    monkeypatch.delattr(options.DefaultOptions, "_nrt", raising=False)
+    assert MK._no_nrt_option() == {}

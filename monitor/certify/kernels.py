@@ -102,6 +102,7 @@ from monitor.geometry._gjk import (
 )
 from monitor.motion import pack as _pack  # read per call (_pack.f): tests replace its functions
 from monitor.motion.kernel import (
+    NO_NRT,
     _bounds_core,
     _search_right,
     body_pose,
@@ -295,7 +296,7 @@ def _curved_support(curve, cparam, cframe, ccenter, R, off, v, sign, pt):
     return val
 
 
-@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, no_cfunc_wrapper=True, **NO_NRT)
 def separated_beyond(gp, ga, Ra, pa, gb, Rb, pb, target, floor, rel_pad, abs_pad, VA, VB, W, IA, IB, lam, v,
                      vn, X):
     """The best separating-axis lower bound on ``dist(core_a, core_b)`` found (early-exit GJK), or -inf.
@@ -508,7 +509,7 @@ def _rel_terms(P, dP, TA, chA, RA, pA, TB, chB, cB, RB, pB, w, weighted):
 # with the motion bound's change, bit-identical, and ~1.5 s less cold compile CPU). Python callers
 # still get a compiled pair_window. Small helpers stay separate functions (inlining them per call
 # site costs more compile time), and nothing Python never calls gets a CPython wrapper.
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
 def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pad, pws, dref):
     """Bound (m) on how far the cores of ga, gb can come closer on [ta, tb] than at its midpoint.
 

@@ -56,6 +56,9 @@ array: they read and write arrays their caller owns, and views of them, during t
 so no reference they would count can be the last one. Keep it that way: numba types the
 callees a no-NRT function compiles on first use with its flags, so an allocation anywhere
 below these two fails to compile (``_qpos_at`` therefore slerps straight into its output).
+``_nrt`` is a private numba option (checked on numba 0.68): the decorators take it through
+:data:`NO_NRT`, which is empty when an installed numba no longer has it (then NRT stays on:
+slower, the same numbers).
 
 Preconditions (not checked in the kernels, checked by the Python helpers):
 ``0 <= body < nbody``; ``t0 <= ta <= tb <= t1`` (the window).
@@ -69,6 +72,24 @@ import math
 
 import numpy as np
 from numba import njit
+
+
+def _no_nrt_option() -> dict[str, bool]:
+    """``{"_nrt": False}`` when this numba has its private ``_nrt`` jit option, else ``{}``.
+
+    Without it numba raises "Unrecognized options" at the first call of every function
+    compiled with it; with ``{}`` they compile with reference counting on (slower only:
+    they allocate nothing, see "Reference counting" above).
+    """
+    try:
+        from numba.core.options import DefaultOptions
+    except ImportError:
+        return {}
+    return {"_nrt": False} if hasattr(DefaultOptions, "_nrt") else {}
+
+
+NO_NRT = _no_nrt_option()
+"""Keyword options of the jit decorators that switch numba's reference counting off (see above)."""
 
 _FREE = 0
 _BALL = 1
@@ -656,7 +677,7 @@ def _velocity_bound(chain: np.ndarray, vkind: np.ndarray, vrate: np.ndarray, D: 
         Th2 += rel * (4.0 * h * wrot_sum + mag * L)
     return T2, Th2
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
 def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, xmat: np.ndarray,
                  trans: np.ndarray, angle: np.ndarray, ws) -> None:
     """Poses at m = (ta + tb) / 2 and bounds over [ta, tb] for the bodies with need[b] != 0.
@@ -874,7 +895,7 @@ def pair_workspace(mp):
             np.zeros(nbody), bounds_workspace(mp))
 
 
-@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, **NO_NRT)
 def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
                pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
     """:func:`body_bound` of two bodies in ONE pass over the union of their chains.
