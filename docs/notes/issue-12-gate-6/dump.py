@@ -1,5 +1,7 @@
 """sha256 of every gated step (decisions, certificates, applied controls, info, full states), old vs new tree.
 
+The report and info keys are tests/test_gate_reports.py's (of the tree under test).
+
 PYTHONPATH=<tree> python docs/notes/issue-12-gate-6/dump.py STEPS [WORKLOAD ...]
 WORKLOAD: tunnel | Pusher-v5 | Pusher-nobrake | monitor/Arm-v0 | Arm-nobrake | Arm-violation | Reacher-v5
 (default: all). One line per workload: counters and the digest. Per step it hashes the StepReport (verdicts,
@@ -9,14 +11,16 @@ MjData state after the step (mjSTATE_FULLPHYSICS + USER + WARMSTART: every integ
 The gym actions are resampled in bursts (action_space.sample(), seeded) so that the arm swings hard
 (brake rejections, fallbacks, committed-tail reuse).
 """
-import hashlib, sys
+import hashlib, os, sys
 import gymnasium as gym, mujoco, numpy as np
-import monitor.envs  # noqa
+import monitor, monitor.envs  # noqa
 from monitor._paths import scene_path
 from monitor.gate import Gate
 from monitor.gym_gate import SafetyGate
 
-_TIMING = ("wall_seconds", "certify_us")
+sys.path.insert(0, os.path.join(os.path.dirname(monitor.__file__), os.pardir, "tests"))  # the tree's own tests
+from test_gate_reports import _info_key as info_key, report_key as _report_key  # noqa: E402
+
 _ALL = (mujoco.mjtState.mjSTATE_FULLPHYSICS | mujoco.mjtState.mjSTATE_USER
         | mujoco.mjtState.mjSTATE_WARMSTART)
 steps = int(sys.argv[1])
@@ -24,24 +28,8 @@ which = sys.argv[2:] or ["tunnel", "Pusher-v5", "Pusher-nobrake", "monitor/Arm-v
                          "Arm-violation", "Reacher-v5"]
 
 
-def cert_key(c):
-    if c is None:
-        return None
-    d = c.to_dict()
-    d["stats"] = {k: v for k, v in d["stats"].items() if k not in _TIMING}
-    return repr(d)
-
-
-def info_key(info):
-    return repr({k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in sorted(info.items())
-                 if k not in _TIMING})
-
-
 def report_key(r):
-    return repr((str(r.verdict), np.asarray(r.proposed_ctrl).tobytes(), np.asarray(r.applied_ctrl).tobytes(),
-                 r.replaced, r.terminated, r.unsafe, str(r.applied_verdict), r.fallback_certified, r.time,
-                 str(r.brake_verdict), r.stepped, cert_key(r.certificate), cert_key(r.fallback_certificate),
-                 info_key(r.info())))
+    return repr(_report_key(r))
 
 
 def state(m, d):
