@@ -149,7 +149,8 @@ def test_arm_reports_equal_with_the_tail_read_through_its_plan():
     m = mujoco.MjModel.from_xml_path(gym.make("monitor/Arm-v0").unwrapped.fullpath)
     assert poses
     for (pos, rot), rows, mp, mq in poses:
-        own = plan_mod.Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=m, mocap_pos=mp, mocap_quat=mq)
+        own = plan_mod.Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=m, mocap_pos=mp,
+                                     mocap_quat=mq)
         p, r = own.body_poses(np.array([rows[0, 0]]))
         assert p.tobytes() == pos.tobytes() and r.tobytes() == rot.tobytes()
     assert new == old and s_new["tail_reused"] == s_old["tail_reused"]
