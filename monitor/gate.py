@@ -866,7 +866,7 @@ class _Tail:
     :meth:`Rollout.brake_tail` builds (same rows, mocap copied from the live data).
     """
 
-    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan")
+    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan", "_plan_mocap_quat")
 
     def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         nq = model.nq
@@ -876,6 +876,45 @@ class _Tail:
         self.mocap_quat = np.array(data.mocap_quat)
         self._model = model
         self._plan: Any = None
+        self._plan_mocap_quat: np.ndarray | None = None
+
+    def plan_qpos_row(self, k: int) -> np.ndarray:
+        """(nq,) ``plan.qpos[k]``, without building the Plan when the rows are its qpos.
+
+        The Plan copies the rows' qpos and changes them only by normalising ball / free
+        quaternions; a model without such joints (``nq == nv``: hinge and slide joints have
+        one qpos entry per dof, ball 4 for 3, free 7 for 6) has none, so its row ``k`` is the
+        rows' row ``k`` bit for bit. Else (or once built) the Plan's own row.
+        """
+        m = self._model
+        if self._plan is None and m.nq == m.nv:
+            return self.rows[k, 1:]
+        return self.plan.qpos[k]
+
+    def plan_mocap_quat(self) -> np.ndarray:
+        """(nmocap, 4) ``plan.mocap_quat``, without building the Plan.
+
+        The Plan's held mocap quaternions are ``monitor.motion.plan._normalized`` of the
+        copy it gets (``Plan._setup``, default tolerances as in :attr:`plan`), or its
+        ``normalize_quats`` error when a norm is out of tolerance: the same function of the
+        same bytes here; a norm out of tolerance builds the Plan (which raises as before).
+        No mocap body: the (0, 4) array as given.
+        """
+        if self._plan is not None:
+            return self._plan.mocap_quat
+        q = self._plan_mocap_quat
+        if q is None:
+            mq = self.mocap_quat
+            if not mq.size:
+                q = mq
+            else:
+                from monitor.motion.plan import _normalized
+
+                q = _normalized(mq, DEFAULT)
+                if q is None:
+                    return self.plan.mocap_quat  # raises (see above)
+            self._plan_mocap_quat = q
+        return q
 
     @property
     def plan(self) -> Any:
@@ -1193,6 +1232,7 @@ class Gate:
         self._joint_tail = True  # private: False forces today's two certify calls (the tests' oracle)
         self._joint_hint = True  # try the joint window + tail call (see decide)
         self._joint_witness: Any = None  # the last failed joint call's witness inside the tail, or None
+        self._joint_of: tuple[np.ndarray, Any] | None = None  # with it: (the tail rows, the joint Plan)
         self._plain: tuple[CertifyRequest, CertifyRequest] | None = None  # (request, its plain copy)
         self._nothing_template: tuple[Any, ...] | None = None  # see _certify_nothing
         self._static_keys: tuple[Any, dict[bytes, dict[int, bytes]]] | None = None  # see _certify_static
@@ -1636,7 +1676,7 @@ class Gate:
         """
         from monitor.motion.plan import Plan
 
-        self._joint_witness = None
+        self._joint_witness = self._joint_of = None
         # Bit-for-bit checks (bytes: stricter than ==, e.g. -0.0 != 0.0); both hold by
         # construction on the gate's own path, a failure only means two calls.
         if (window_rows is None or len(tail_rows) < 2 or window_rows.shape[1] != tail_rows.shape[1]
@@ -1644,9 +1684,12 @@ class Gate:
                         or window_rows[:, 0].tobytes() == np.asarray(plan.times).tobytes())
                 or window_rows[-1].tobytes() != tail_rows[0].tobytes()):
             return None
-        rows = np.concatenate((window_rows, tail_rows[1:]))
-        joint = Plan._trusted(rows[:, 0].copy(), rows[:, 1:].copy(), model=self.model,
-                              mocap_pos=mocap_pos.copy(), mocap_quat=mocap_quat.copy())
+        # times (K,) and qpos (K, nq): fresh C-contiguous arrays, the values of the rows
+        # concatenated (window, then the tail after its first row)
+        times = np.concatenate((window_rows[:, 0], tail_rows[1:, 0]))
+        qpos = np.concatenate((window_rows[:, 1:], tail_rows[1:, 1:]))
+        joint = Plan._trusted(times, qpos, model=self.model, mocap_pos=mocap_pos.copy(),
+                              mocap_quat=mocap_quat.copy())
         self._call_request = self._plain_request()
         try:
             cert, us = self._certify(joint)
@@ -1655,12 +1698,13 @@ class Gate:
         if not cert.certified or cert.stats.get("ongoing", 0):
             w = cert.witness
             if (cert.verdict == Verdict.VIOLATION and not cert.stats.get("ongoing", 0) and w is not None
-                    and float(tail_rows[0, 0]) <= w.time <= float(rows[-1, 0])):
+                    and float(tail_rows[0, 0]) <= w.time <= float(times[-1])):
                 self._joint_witness = w  # a confirmed violation inside the tail (see _tail_refuted)
+                self._joint_of = (tail_rows, joint)
             return None
         cert.__dict__["request"] = self.request  # (not a compared field) what a call under it returns
         self.stats["joint"] += 1
-        t0, t1, t_end = float(rows[0, 0]), float(tail_rows[0, 0]), float(rows[-1, 0])
+        t0, t1, t_end = float(times[0]), float(tail_rows[0, 0]), float(times[-1])
         span = [t0, t_end]
         return _part(cert, (t0, t1), span), _part(cert, (t1, t_end), span), us
 
@@ -1724,11 +1768,35 @@ class Gate:
                 ga, gb = scene.geom(witness.geoms[0]), scene.geom(witness.geoms[1])
             except InvalidInputError:   # not a geom of the scene (cannot happen on the gate's path)
                 return False
-            plan = tail.plan
-            dist = start_distance(ga, gb, plan.body_poses(np.array([float(plan.times[0])])), self.tolerances)
+            poses = self._joint_poses_at_tail_start(tail)
+            if poses is None:
+                plan = tail.plan
+                poses = plan.body_poses(np.array([float(plan.times[0])]))
+            dist = start_distance(ga, gb, poses, self.tolerances)
             if not dist.lower > self.margin:
                 return False
         return True
+
+    def _joint_poses_at_tail_start(self, tail: _Tail) -> tuple[np.ndarray, np.ndarray] | None:
+        """``tail.plan.body_poses([t1])`` from the failed joint call's Plan, or None.
+
+        Only for the tail whose rows that joint Plan was built from (the same array object, see
+        :meth:`_certify_joint`) and a model without ball / free joints (``nq == nv``). Then the
+        two are the same floats: the joint Plan's waypoints are the window's rows followed by
+        the tail's after its first row, and the window's last row is the tail's first, bit for
+        bit (checked by :meth:`_certify_joint`); at t1, a waypoint of both, each Plan locates
+        the segment that starts there with local parameter ``(t1 - t1) / dt = 0.0`` and
+        interpolates ``q[i] + 0.0 * (q[i + 1] - q[i])`` on the same two rows (the tail's first
+        two), so the same qpos (no quaternion track: lerp only); held mocap poses are
+        normalised from copies of the same arrays with the same default tolerances; FK is
+        ``mj_kinematics`` on the same model. The tail's own Plan (a 100+ waypoint build on the
+        Arm) is then not needed.
+        """
+        hit = self._joint_of
+        m = self.model
+        if hit is None or hit[0] is not tail.rows or m.nq != m.nv:
+            return None
+        return hit[1].body_poses(np.array([float(tail.rows[0, 0])]))
 
     def _split_reuse(self, scene: Any, plan: Any) -> tuple[list[int] | None, dict[int, PairResult],
                                                              dict[int, bytes]]:
@@ -1876,18 +1944,21 @@ class Gate:
         if self._tail_context != self._reuse_context():
             return None  # no tail, or certified under other settings / geometry
         tail, cert, qvel = self._tail
-        plan = tail.plan  # built now, on the rare path that reads it
         if not cert.certified:
             return None
-        hits = np.flatnonzero(plan.times == data.time)
+        # The tail Plan's times, qpos row and held mocap poses, read without building the
+        # Plan where they are the rows' bit for bit (_Tail.plan_qpos_row / plan_mocap_quat;
+        # times: the Plan's are a copy of rows[:, 0]; mocap_pos: a copy of tail.mocap_pos).
+        times = tail.rows[:, 0]
+        hits = np.flatnonzero(times == data.time)
         if len(hits) != 1:
             return None
         k = int(hits[0])
         # bit for bit: bytes (stricter than ==: -0.0 != 0.0); shapes are the model's, fixed
-        if (k + n >= len(plan.times) or plan.qpos[k].tobytes() != data.qpos.tobytes()
+        if (k + n >= len(times) or tail.plan_qpos_row(k).tobytes() != data.qpos.tobytes()
                 or qvel[k].tobytes() != data.qvel.tobytes()
-                or plan.mocap_pos.tobytes() != data.mocap_pos.tobytes()
-                or plan.mocap_quat.tobytes() != data.mocap_quat.tobytes()):
+                or tail.mocap_pos.tobytes() != data.mocap_pos.tobytes()
+                or tail.plan_mocap_quat().tobytes() != data.mocap_quat.tobytes()):
             return None
         # replay: the brake's window under the live model must be the certified tail's rows
         rows = self._rollout._window(data, self._committed, n)

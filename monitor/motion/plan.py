@@ -361,6 +361,31 @@ def _normalized(q: np.ndarray, tol: Tolerances) -> np.ndarray | None:
     return q / n[..., None]
 
 
+_LAST_MOCAP: list[tuple | None] = [None]
+"""[(input bytes, shape, quat_norm_tol, normalised (nmocap, 4))] of the last :func:`_normalized_mocap`."""
+
+
+def _normalized_mocap(mq: np.ndarray, tol: Tolerances) -> np.ndarray:
+    """Held mocap quaternions (nmocap, 4) as a Plan keeps them: ``_normalized``, else its error.
+
+    A gate builds several Plans per step (window, braking tail, both joined) holding the same
+    mocap poses, usually the same for a whole episode: the last result is kept and handed out
+    as a fresh copy when the input has the same bytes and shape and the tolerance is the same
+    (``_normalized`` is a function of those alone, and a result is only kept when it succeeded).
+    Else: ``_normalized``, and ``normalize_quats`` (which raises naming the quaternion) when a
+    norm is out of tolerance.
+    """
+    key = mq.tobytes()
+    last = _LAST_MOCAP[0]
+    if last is not None and last[0] == key and last[1] == mq.shape and last[2] == tol.quat_norm_tol:
+        return last[3].copy()
+    n = _normalized(mq, tol)
+    if n is None:
+        return K.normalize_quats("mocap_quat", mq, tol)
+    _LAST_MOCAP[0] = (key, mq.shape, tol.quat_norm_tol, n.copy())
+    return n
+
+
 _LAST_STRUCT: dict[int, tuple[mujoco.MjModel, _ModelStructure]] = {}
 """Per model object, the structure :func:`_structure` returned last (a hint: checked by its key)."""
 
@@ -536,8 +561,7 @@ class Plan(WindowTimes):
         self._tol = tolerances
         self._st = st
         if mq.size:  # (0, 4) when the model has no mocap body: nothing to normalise
-            n = _normalized(mq, tolerances)
-            mq = K.normalize_quats("mocap_quat", mq, tolerances) if n is None else n
+            mq = _normalized_mocap(mq, tolerances)
 
         # Joint structure.
         self._quat_tracks: dict[int, K.QuatTrack] = {}
