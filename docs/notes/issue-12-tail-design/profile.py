@@ -12,7 +12,8 @@ from each kept start, holds that brake for 2 s of ``mj_step`` (the gate's tail i
   kinetic energy <= 1 % / 0.01 % of the start's;
 * the motion left after a tail of H s: max over [H, 2 s] of the largest body origin
   displacement from its position at H (m), for H = 0.05, 0.1, 0.25, 0.5, 1;
-* what holds the velocity up at 1 s: the dof with the largest |qvel|, contacts, |qfrc_bias|;
+* what holds the velocity up at 1 s: the dof with the largest |qvel|, contacts; the most sign
+  changes of one dof's velocity over 2 s (servo oscillation);
 * CERT=1: the brake motion [0, H] certified with the gate's scene and request for H = 0.05,
   0.1, 0.25, 0.5, 1, 2 s: how often a tail certified at H is NOT certified at a longer horizon.
 Prints "PROFILE {...}".
@@ -84,7 +85,9 @@ for state, brake, mp, mq in starts:
     def first(mask):
         w = np.flatnonzero(mask)
         return float(w[0] * dt) if len(w) else None
-    r = {"vmax": {str(tm): float(vmax[idx[tm]]) for tm in marks},
+    sgn = np.sign(v)
+    flips = int(((sgn[1:] * sgn[:-1]) < 0).sum(axis=0).max())   # most velocity reversals of one dof in 2 s
+    r = {"flips": flips, "vmax": {str(tm): float(vmax[idx[tm]]) for tm in marks},
          "t_rest_tol": first(vmax <= tol), "vmax_min": float(vmax.min()),
          "t_rel10": first(vmax <= 0.1 * vmax[0]), "t_rel1": first(vmax <= 0.01 * vmax[0]),
          "t_ke1": first(ke <= 1e-2 * ke0), "t_ke001": first(ke <= 1e-4 * ke0),
@@ -106,6 +109,8 @@ out = {"work": work, "starts": len(recs), "timestep": dt, "brake_steps": g.brake
        "vmax_p90": {str(tm): med([r["vmax"][str(tm)] for r in recs], 90) for tm in marks},
        "reach_tol_within_2s": sum(r["t_rest_tol"] is not None for r in recs),
        "t_rest_tol_median": med([r["t_rest_tol"] for r in recs]),
+       "t_rest_tol_p90": med([r["t_rest_tol"] for r in recs], 90),
+       "velocity_reversals_2s_median": med([r["flips"] for r in recs]),
        "vmax_min_median": med([r["vmax_min"] for r in recs]),
        "t_rel10": {"n": sum(r["t_rel10"] is not None for r in recs), "median": med([r["t_rel10"] for r in recs]),
                    "p90": med([r["t_rel10"] for r in recs], 90)},
