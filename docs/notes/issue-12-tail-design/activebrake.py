@@ -18,27 +18,14 @@ import json, sys
 import mujoco
 import numpy as np
 
-import monitor.gate as G
 import wl
 from monitor.certify.engine import certify
 from monitor.motion.plan import Plan
 
 work, blocks, every = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
-W = wl.make(work)
+W, starts = wl.brake_starts(work, blocks, every)
 g, m = W.gate, W.model
 fs = {"Pusher-v5": 5, "monitor/Arm-v0": 10, "hand30": 5, "tunnel": 1}[work]
-starts, count = [], [0]
-_brake_rows = G.Rollout.brake_rows
-def brake_rows(self, *a, **k):
-    rows, brake = _brake_rows(self, *a, **k)
-    count[0] += 1
-    if count[0] % every == 0:
-        starts.append((self._end_state.copy(), brake.copy(), np.array(a[0].mocap_pos), np.array(a[0].mocap_quat)))
-    return rows, brake
-G.Rollout.brake_rows = brake_rows
-for rep in range(blocks):
-    for _ in W.steps(wl.BLOCK[work], rep):
-        pass
 
 dt = m.opt.timestep
 N = int(round(2.0 / dt))

@@ -18,24 +18,11 @@ import json, sys
 import mujoco
 import numpy as np
 
-import monitor.gate as G
 import wl
 
 work, blocks, every = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
-W = wl.make(work)
+W, starts = wl.brake_starts(work, blocks, every)
 g, m = W.gate, W.model
-starts, count = [], [0]
-_brake_rows = G.Rollout.brake_rows
-def brake_rows(self, *a, **k):
-    rows, brake = _brake_rows(self, *a, **k)
-    count[0] += 1
-    if count[0] % every == 0:
-        starts.append((self._end_state.copy(), brake.copy()))
-    return rows, brake
-G.Rollout.brake_rows = brake_rows
-for rep in range(blocks):
-    for _ in W.steps(wl.BLOCK[work], rep):
-        pass
 
 m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)   # a copy's flag would do; the run is over
 servo = (m.actuator_biastype == int(mujoco.mjtBias.mjBIAS_AFFINE)) & (m.actuator_trntype == int(mujoco.mjtTrn.mjTRN_JOINT))
@@ -47,7 +34,7 @@ N = int(round(1.0 / m.opt.timestep))
 kH = int(round(0.25 / m.opt.timestep))
 ups, worst, ratio = 0, 0.0, []
 total = 0
-for state, brake in starts:
+for state, brake, _, _ in starts:
     mujoco.mj_setState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
     d.ctrl[:] = brake
     V = np.empty(N + 1)

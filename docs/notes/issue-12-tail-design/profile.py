@@ -23,26 +23,12 @@ import json, sys
 import mujoco
 import numpy as np
 
-import monitor.gate as G
 import wl
 
 work, blocks, every = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 do_cert = len(sys.argv) > 4 and sys.argv[4] == "1"
-W = wl.make(work)
+W, starts = wl.brake_starts(work, blocks, every)
 g, m = W.gate, W.model
-starts = []
-count = [0]
-_brake_rows = G.Rollout.brake_rows
-def brake_rows(self, *a, **k):
-    rows, brake = _brake_rows(self, *a, **k)
-    count[0] += 1
-    if count[0] % every == 0:
-        starts.append((self._end_state.copy(), brake.copy(), np.array(a[0].mocap_pos), np.array(a[0].mocap_quat)))
-    return rows, brake
-G.Rollout.brake_rows = brake_rows
-for rep in range(blocks):
-    for _ in W.steps(wl.BLOCK[work], rep):
-        pass
 
 dt = m.opt.timestep
 T_END = 2.0

@@ -123,3 +123,33 @@ def make(work, horizon=0.25, brake=True):
 
 # steps per block as the bench's full run uses them (gym 30, tunnel 200, hand30 20)
 BLOCK = {"Pusher-v5": 30, "monitor/Arm-v0": 30, "tunnel": 200, "hand30": 20}
+
+
+def brake_starts(work, blocks, every):
+    """Run ``work`` gated at the defaults for ``blocks`` blocks; keep every ``every``-th braking tail's start.
+
+    Returns (W, starts): each start is (the window end's integration state (``Rollout._end_state``),
+    the brake control the gate held, mocap_pos, mocap_quat), from which ``mj_setState`` + that
+    control + ``mj_step`` reproduce the gate's tail bit for bit.
+    """
+    import monitor.gate as G
+
+    W = make(work)
+    starts, count = [], [0]
+    orig = G.Rollout.brake_rows
+
+    def brake_rows(self, *a, **k):
+        rows, brake = orig(self, *a, **k)
+        count[0] += 1
+        if count[0] % every == 0:
+            starts.append((self._end_state.copy(), brake.copy(), np.array(a[0].mocap_pos),
+                           np.array(a[0].mocap_quat)))
+        return rows, brake
+    G.Rollout.brake_rows = brake_rows
+    try:
+        for rep in range(blocks):
+            for _ in W.steps(BLOCK[work], rep):
+                pass
+    finally:
+        G.Rollout.brake_rows = orig
+    return W, starts
