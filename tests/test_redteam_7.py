@@ -1,0 +1,148 @@
+"""Red team 7: the last session's fast paths and the inputs at their edges.
+
+Oracles are independent of ``monitor``'s checkers:
+
+* where MuJoCo puts a geom: ``mj_forward``'s ``geom_xpos`` / ``geom_xmat`` on a fresh ``MjData``, and the
+  exact sphere-box distance in closed form at those poses;
+* a straight motion that crosses a wall: by continuity the ball's centre passes every point of its
+  segment, including one inside the wall, so a "certified" window is a proven false certificate
+  whatever the checker says about the sampled ends.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from monitor import BodyMotion, Plan, Scene, certify
+from monitor.certify import extrusion
+from monitor.certify.types import Verdict
+from monitor.errors import InvalidInputError
+
+_WORLD_WALL = """
+<mujoco>
+  <worldbody>
+    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0" euler="0 0 10"
+          contype="0" conaffinity="0"/>
+    <body name="ball">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <geom name="ball" type="sphere" size="0.02" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def _sphere_box_distance(model: mujoco.MjModel, data: mujoco.MjData, box: int, sphere: int) -> float:
+    """Exact signed distance (m) of geoms ``box`` and ``sphere`` at ``data``'s poses (closed form)."""
+    rot = data.geom_xmat[box].reshape(3, 3)
+    c = rot.T @ (data.geom_xpos[sphere] - data.geom_xpos[box])
+    half = model.geom_size[box]
+    outside = np.linalg.norm(c - np.clip(c, -half, half))
+    inside = -float(np.min(half - np.abs(c))) if outside == 0.0 else outside
+    return float(inside - model.geom_size[sphere, 0])
+
+
+@pytest.mark.parametrize("body_sf,geom_sf", [(0, 2), (0, 4), (3, 2)])
+def test_a_world_geom_on_the_world_inertial_frame_is_where_mujoco_puts_it(body_sf, geom_sf):
+    """``mj_kinematics`` puts the world's inertial frame at the origin whatever ``body_sameframe[0]``,
+    ``body_ipos[0]`` and ``body_iquat[0]`` say; a world geom on that frame (``geom_sameframe``
+    INERTIA / INERTIAROT, a hand edit) is there. The scene read ``body_ipos[0]`` and certified a ball
+    that overlaps the wall where MuJoCo has it."""
+    model = mujoco.MjModel.from_xml_string(_WORLD_WALL)
+    model.body_sameframe[0] = body_sf
+    model.body_ipos[0] = [0.3, 0.0, 0.0]
+    q = np.array([0.9, 0.1, 0.3, -0.2])
+    model.body_iquat[0] = q / np.linalg.norm(q)
+    model.geom_sameframe[0] = geom_sf
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    wall = scene.geom("wall").shape  # body frame of the world = world frame
+    size = model.geom_size[0]
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * size
+    mujoco_corners = corners @ data.geom_xmat[0].reshape(3, 3).T + data.geom_xpos[0]
+    gap = np.linalg.norm(wall.points[:, None, :] - mujoco_corners[None], axis=2).min(axis=1).max()
+    assert gap < 1e-12
+    if geom_sf == 2:  # INERTIA: MuJoCo's wall is at the origin, the scene's was at body_ipos[0]
+        # the ball's segment x in [0, 0.05] m starts inside MuJoCo's wall
+        assert _sphere_box_distance(model, data, 0, 1) < 0.0
+        cert = certify(scene, Plan([0.0, 1.0], [[0.0], [0.05]], model), margin=0.01)
+        assert cert.verdict != Verdict.CERTIFIED
+
+
+_FREE_BALL = """
+<mujoco>
+  <worldbody>
+    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0"/>
+    <body name="ball"><freejoint/><geom name="ball" type="sphere" size="0.02"/></body>
+  </worldbody>
+</mujoco>
+"""
+_SLIDE_BALL = """
+<mujoco>
+  <worldbody>
+    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0"/>
+    <body name="ball"><joint name="x" type="slide" axis="1 0 0"/><geom name="ball" type="sphere" size="0.02"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+# (duration s, half-stroke m): the ball goes from x = -a to x = +a through the wall at x = 0.3 m
+# in one segment whose velocity 2a / dt is not a float64 (subnormal durations, or a quotient or a
+# difference beyond 1.8e308): the extrusion route divided by it and certified on NaN arithmetic.
+_OVERFLOWING = [(1e-308, 1.0), (5e-324, 1.0), (1e-300, 5e9), (1.0, 9e307)]
+
+
+@pytest.mark.parametrize("dt,a", _OVERFLOWING)
+@pytest.mark.parametrize("method", ["auto", "extrusion"])
+def test_a_plan_through_a_wall_in_an_overflowing_segment_is_not_certified(dt, a, method):
+    model = mujoco.MjModel.from_xml_string(_SLIDE_BALL)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    plan = Plan([0.0, dt], [[-a], [a]], model)
+    with np.errstate(all="ignore"):
+        try:
+            cert = certify(scene, plan, margin=0.0, method=method)
+        except InvalidInputError:
+            return  # a typed refusal is a correct answer
+    assert cert.verdict != Verdict.CERTIFIED
+
+
+@pytest.mark.parametrize("dt", [1e-308, 5e-324])
+def test_a_body_motion_through_a_wall_in_a_subnormal_segment_is_not_certified(dt):
+    model = mujoco.MjModel.from_xml_string(_FREE_BALL)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    pos = np.zeros((2, 2, 3))
+    pos[0, 1, 0], pos[1, 1, 0] = -1.0, 1.0
+    quat = np.zeros((2, 2, 4))
+    quat[..., 0] = 1.0
+    motion = BodyMotion([0.0, dt], pos, quat)
+    with np.errstate(all="ignore"):
+        assert certify(scene, motion, margin=0.0).verdict != Verdict.CERTIFIED
+        with pytest.raises(InvalidInputError):
+            certify(scene, motion, margin=0.0, method="extrusion")
+
+
+@pytest.mark.parametrize("dt", [1e-308, 5e-324])
+def test_the_extrusion_checker_refuses_an_overflowing_velocity(dt):
+    """The public checker (``extrusion.check_pairs``) on the same motion: a typed error, never certified."""
+    model = mujoco.MjModel.from_xml_string(_FREE_BALL)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    pair = extrusion.TranslatingPair(
+        name=("wall", "ball"), shape_a=scene.geom("wall").shape, R_a=np.eye(3), times_a=[0.0, dt],
+        origins_a=[[0.0, 0.0, 0.0]] * 2, shape_b=scene.geom("ball").shape, R_b=np.eye(3),
+        times_b=[0.0, dt], origins_b=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    with np.errstate(all="ignore"), pytest.raises(InvalidInputError, match="overflows"):
+        extrusion.check_pairs([pair], (0.0, dt), 0.0)
+
+
+def test_normal_fast_segments_still_take_the_extrusion_route():
+    """The refusal is about overflow only: a 1e-300 s segment of 2 m (velocity 2e300 m/s) is a float64
+    constant-velocity segment, and the exact checker still finds the crossing."""
+    model = mujoco.MjModel.from_xml_string(_SLIDE_BALL)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    plan = Plan([0.0, 1e-300], [[-1.0], [1.0]], model)
+    assert plan.translation_segments(1) is not None
+    cert = certify(scene, plan, margin=0.0, method="extrusion")
+    assert cert.verdict == Verdict.VIOLATION
