@@ -146,3 +146,64 @@ def test_normal_fast_segments_still_take_the_extrusion_route():
     assert plan.translation_segments(1) is not None
     cert = certify(scene, plan, margin=0.0, method="extrusion")
     assert cert.verdict == Verdict.VIOLATION
+
+
+_TUNNEL = """
+<mujoco>
+  <option timestep="0.01" integrator="implicitfast" gravity="0 0 0"/>
+  <worldbody>
+    <body name="wall" pos="-0.05 0 0">
+      <geom name="wall" type="box" size="0.005 0.2 0.2" contype="0" conaffinity="0"/>
+    </body>
+    <body name="ball">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <geom name="ball" type="sphere" size="0.01" mass="0.01" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+  <actuator><velocity name="vx" joint="x" kv="10" ctrlrange="-6 6"/></actuator>
+</mujoco>
+"""
+
+
+def test_a_cast_that_edits_the_model_during_the_tail_rollout_does_not_leave_a_stale_proposal_certificate():
+    """On the two-call path ``decide`` certifies the proposal, THEN rolls out its braking tail, calling
+    ``cast`` (user code) on every brake control. A ``cast`` that moves the wall into the proposal's path
+    left the proposal certified on the model before the edit, and the proposal ran through the wall
+    (the log then recorded the edit before the proposal's record: ``review --verify`` flagged it).
+    Oracle: the motion that ran, replayed from a copy of the state on the edited model, with the exact
+    sphere-box distance at every substep."""
+    import copy
+
+    from monitor.gate import Gate
+
+    model = mujoco.MjModel.from_xml_string(_TUNNEL)
+    data = mujoco.MjData(model)
+    wall = model.body("wall").id
+    gate = Gate(model, margin=1e-3, pairs="all", allowed=None, ongoing="violation", frame_skip=5)
+    armed = [False]
+
+    def cast(c):
+        if armed[0]:  # the wall moves onto the proposal's path (past the tail's start)
+            model.body_pos[wall, 0] = 0.02
+            armed[0] = False
+        return np.asarray(c, dtype=np.float64)
+
+    first = gate.decide(data, np.array([-6.0]), cast=cast)   # into the wall: blocked -> two calls next
+    assert first.replaced
+    data.ctrl[:] = first.applied_ctrl
+    mujoco.mj_step(model, data, nstep=5)
+    armed[0] = True
+    before = copy.copy(data)
+    report = gate.decide(data, np.array([6.0]), cast=cast)
+    assert not armed[0] and model.body_pos[wall, 0] == 0.02  # the edit happened inside decide
+    applied_certified = report.fallback_certified if report.replaced else report.certificate.certified
+    replay = copy.copy(before)
+    replay.ctrl[:] = report.applied_ctrl
+    mujoco.mj_forward(model, replay)
+    dists = [_sphere_box_distance(model, replay, 0, 1)]
+    for _ in range(5):
+        mujoco.mj_step(model, replay)
+        mujoco.mj_forward(model, replay)
+        dists.append(_sphere_box_distance(model, replay, 0, 1))
+    assert not (applied_certified and min(dists) <= 1e-3), (report.replaced, dists)
+    assert report.replaced  # the proposal crosses the wall as it is now
