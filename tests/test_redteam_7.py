@@ -213,3 +213,46 @@ def test_a_cast_that_edits_the_model_during_the_tail_rollout_does_not_leave_a_st
         dists.append(_sphere_box_distance(model, probe, 0, 1))
     assert not (applied_certified and min(dists) <= 1e-3), (report.replaced, xs, dists)
     assert report.replaced  # the proposal crosses the wall as it is now
+
+
+_BALL_ON_PLANE = """
+<mujoco>
+  <worldbody>
+    <body name="S">
+      <joint name="sz" type="slide" axis="0 0 1"/><geom name="s" type="sphere" size="0.03"/>
+    </body>
+    <body name="P"><geom name="plane" type="plane" size="1 1 0.1"/></body>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("penetration_tol", [1e13, 1e16])
+def test_a_huge_penetration_tol_does_not_overstate_the_clearance(penetration_tol):
+    """The ongoing rule shifts the plane by ``penetration_tol`` and subtracts it from the clearance again;
+    for 1e13 m and more that subtraction's rounding exceeded every pad and the claimed clearance (a lower
+    bound of the distance) was above the true one (0.0 m claimed for -0.03 m at 1e16). Closed form: the
+    sphere (r = 3 cm, centre z) above the plane z = 0 is at z - 0.03, least at the lower end."""
+    model = mujoco.MjModel.from_xml_string(_BALL_ON_PLANE)
+    scene = Scene.from_model(model, pairs=[("s", "plane")])
+    plan = Plan([0.0, 1.0], [[0.02], [0.0]], model)
+    true_least = 0.0 - 0.03
+    try:
+        cert = certify(scene, plan, margin=0.0, ongoing="deepen", penetration_tol=penetration_tol)
+    except InvalidInputError as exc:
+        assert "penetration_tol" in str(exc)
+        return
+    assert cert.clearance <= true_least
+
+
+def test_the_penetration_tol_bound_is_the_same_for_certify_and_the_gate():
+    from monitor.certify.ongoing import MAX_PENETRATION_TOL
+    from monitor.certify.request import CertifyRequest
+    from monitor.gate import Gate
+
+    CertifyRequest(ongoing="deepen", penetration_tol=MAX_PENETRATION_TOL)
+    with pytest.raises(InvalidInputError, match="penetration_tol"):
+        CertifyRequest(ongoing="deepen", penetration_tol=np.nextafter(MAX_PENETRATION_TOL, np.inf))
+    model = mujoco.MjModel.from_xml_string(_BALL_ON_PLANE)
+    with pytest.raises(InvalidInputError, match="penetration_tol"):
+        Gate(model, ongoing="deepen", penetration_tol=2 * MAX_PENETRATION_TOL)
