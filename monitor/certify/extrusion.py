@@ -213,7 +213,7 @@ def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float
         raise InvalidInputError(f"{name}: times/origins contain NaN or inf")
     if (times[1:] <= times[:-1]).any():
         raise InvalidInputError(f"{name}: times must be strictly increasing")
-    if not finite_velocities(times, origins):
+    if not finite_velocities(times.tolist(), origins):
         raise InvalidInputError(f"{name}: a segment's velocity (origin change / duration) overflows float64")
     if times[0] > window[0] or times[-1] < window[1]:
         raise InvalidInputError(f"{name}: motion covers [{times[0]}, {times[-1]}] s, "
