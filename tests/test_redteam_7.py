@@ -256,3 +256,37 @@ def test_the_penetration_tol_bound_is_the_same_for_certify_and_the_gate():
     model = mujoco.MjModel.from_xml_string(_BALL_ON_PLANE)
     with pytest.raises(InvalidInputError, match="penetration_tol"):
         Gate(model, ongoing="deepen", penetration_tol=2 * MAX_PENETRATION_TOL)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(2))
+def test_fuzz_crossing_motions_with_extreme_segments_are_never_certified(seed):
+    """Random one-segment crossings of the wall (x from -a to +a, |a| >= 0.4 m) with durations from
+    subnormal to 1 s and strokes up to the float64 limit, as Plans (slide) and BodyMotions (free body),
+    every method: a typed error or a verdict other than certified (continuity oracle as above)."""
+    rng = np.random.default_rng(seed)
+    slide = mujoco.MjModel.from_xml_string(_SLIDE_BALL)
+    free = mujoco.MjModel.from_xml_string(_FREE_BALL)
+    scenes = [Scene.from_model(m, pairs="all", allowed=None) for m in (slide, free)]
+    for _ in range(30):
+        dt = float(10.0 ** rng.uniform(-323.5, 0.0))
+        a = float(10.0 ** rng.uniform(np.log10(0.4), 308.2))
+        if not (dt > 0.0 and np.isfinite(a)):
+            continue
+        pos = np.zeros((2, 2, 3))
+        pos[0, 1, 0], pos[1, 1, 0] = -a, a
+        quat = np.zeros((2, 2, 4))
+        quat[..., 0] = 1.0
+        try:
+            motions = ((scenes[0], Plan([0.0, dt], [[-a], [a]], slide)),
+                       (scenes[1], BodyMotion([0.0, dt], pos, quat)))
+        except InvalidInputError:
+            continue
+        for scene, motion in motions:
+            for method in ("auto", "toleranced", "extrusion"):
+                with np.errstate(all="ignore"):
+                    try:
+                        cert = certify(scene, motion, margin=0.0, method=method)
+                    except InvalidInputError:
+                        continue
+                assert cert.verdict != Verdict.CERTIFIED, (dt, a, type(motion).__name__, method)
