@@ -157,7 +157,8 @@ def finite_velocities(times: list[float], points: np.ndarray) -> bool:
     exactly so; an infinite velocity turns its tests into NaN, which certified such motions (red team 7).
     """
     dt_min = min(map(operator.sub, times[1:], times[:-1]))
-    if float(abs(points).max()) <= dt_min * 1e307:
+    # in Python floats: a few numpy reductions cost ~15 us per certify call in place (tunnel window)
+    if max(map(abs, points.ravel().tolist())) <= dt_min * 1e307:
         return True   # every |difference| / duration <= 2 max|point| / min duration <= 2e307
     t = np.asarray(times, dtype=np.float64)
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):

@@ -321,9 +321,11 @@ class BodyMotion(WindowTimes):
         if not self._moving[b]:
             p = self._pos[0, b]
             return np.array([self.t0, self.t1]), np.stack([p, p])
-        if self._rotating[b] or not K.finite_velocities(self._times.tolist(), self._pos[:, b]):
-            return None   # (an overflowing velocity: not a float64 constant-velocity segment)
-        return self._times.copy(), self._pos[:, b].copy()
+        if self._rotating[b]:
+            return None
+        o = self._pos[:, b].copy()
+        # an overflowing velocity: not a float64 constant-velocity segment (red team 7)
+        return (self._times.copy(), o) if K.finite_velocities(self._times.tolist(), o) else None
 
 
 __all__ = ["BodyMotion"]

@@ -1081,9 +1081,11 @@ class Plan(WindowTimes):
             p = self._wp_pos[0, b]
             # = np.array([t0, t1]), np.stack([p, p]) (fresh float64 arrays), in fewer numpy calls
             return self._times[[0, -1]], p[None].repeat(2, 0)
-        if self._rotating[b] or not K.finite_velocities(self._tlist, self._wp_pos[:, b]):
-            return None   # (an overflowing velocity: not a float64 constant-velocity segment)
-        return self._times.copy(), self._wp_pos[:, b].copy()
+        if self._rotating[b]:
+            return None
+        o = self._wp_pos[:, b].copy()
+        # an overflowing velocity: not a float64 constant-velocity segment (red team 7)
+        return (self._times.copy(), o) if K.finite_velocities(self._tlist, o) else None
 
 
 __all__ = ["Plan"]
