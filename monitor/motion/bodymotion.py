@@ -323,9 +323,7 @@ class BodyMotion(WindowTimes):
             return np.array([self.t0, self.t1]), np.stack([p, p])
         if self._rotating[b]:
             return None
-        o = self._pos[:, b].copy()
-        # an overflowing velocity: not a float64 constant-velocity segment (red team 7)
-        return (self._times.copy(), o) if K.finite_velocities(self._times.tolist(), o) else None
+        return self._times.copy(), self._pos[:, b].copy()
 
 
 __all__ = ["BodyMotion"]

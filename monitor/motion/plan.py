@@ -1083,9 +1083,7 @@ class Plan(WindowTimes):
             return self._times[[0, -1]], p[None].repeat(2, 0)
         if self._rotating[b]:
             return None
-        o = self._wp_pos[:, b].copy()
-        # an overflowing velocity: not a float64 constant-velocity segment (red team 7)
-        return (self._times.copy(), o) if K.finite_velocities(self._tlist, o) else None
+        return self._times.copy(), self._wp_pos[:, b].copy()
 
 
 __all__ = ["Plan"]
