@@ -2051,7 +2051,9 @@ class Gate:
                 # no proposal can ever be rejected, so the tail and its brake are never used.
                 brake_verdict = Verdict.CERTIFIED
             elif not unsafe and brake_on:
+                version = None
                 if tail is None:  # raw rows kept: a committed tail is replayed against them (_tail_covers)
+                    version = getattr(self.scene, "version", 0)  # the proposal was certified on it
                     rows, brake_next = self._rollout.brake_rows(
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
@@ -2070,6 +2072,12 @@ class Gate:
                 if self.is_unsafe(brake_verdict):
                     unsafe = True
                     self.stats["brake_rejected"] += 1
+                elif version is not None and getattr(self.scene, "version", 0) != version:
+                    # ``cast`` (user code, called while the tail was rolled out) edited the model after
+                    # the proposal was certified (red team 7): certify it again on the model as it is
+                    cert, p_us = self._certify(_plan_of(plan))
+                    us += p_us
+                    unsafe = self.is_unsafe(cert.verdict)
             # Try the joint call next step only when this step's two calls would have allowed it
             # (both certified, no ongoing contact): a streak of rejected or in-contact windows
             # then costs two calls per step, not three.

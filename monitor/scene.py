@@ -294,10 +294,11 @@ def _inertial_frame(model: Any, b: int) -> tuple[np.ndarray, np.ndarray]:
     MuJoCo places it by ``body_sameframe`` (red team 6): BODY -> the body frame itself
     (``body_ipos`` / ``body_iquat`` ignored), BODYROT -> the body's rotation at ``body_ipos``, NONE ->
     ``body_iquat`` at ``body_ipos``. The compiler sets no other value for a body; one edited in is
-    refused rather than guessed.
+    refused rather than guessed. The world's (b = 0) is the world frame whatever its flags:
+    ``mj_kinematics`` sets ``xipos[0]`` / ``ximat[0]`` to the origin / identity (red team 7).
     """
     sf = int(model.body_sameframe[b])
-    if sf == _SAME.mjSAMEFRAME_BODY:
+    if sf == _SAME.mjSAMEFRAME_BODY or b == 0:
         return np.eye(3), np.zeros(3)
     if sf == _SAME.mjSAMEFRAME_BODYROT:
         return np.eye(3), np.array(model.body_ipos[b], dtype=np.float64)

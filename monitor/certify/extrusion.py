@@ -104,6 +104,7 @@ from monitor.certify.extrusion_null import (
 from monitor.certify.extrusion_sbounds import RootBound, pair_sbounds, swept_box
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.geometry.shapes import ConvexShape
+from monitor.motion._kinematics import finite_velocities
 from monitor.tolerances import DEFAULT, Tolerances
 
 KAPPA_MAX_DEPTH = 12
@@ -212,6 +213,8 @@ def _check_body(name: str, R: Any, times: Any, origins: Any, window: tuple[float
         raise InvalidInputError(f"{name}: times/origins contain NaN or inf")
     if (times[1:] <= times[:-1]).any():
         raise InvalidInputError(f"{name}: times must be strictly increasing")
+    if not finite_velocities(times.tolist(), origins):
+        raise InvalidInputError(f"{name}: a segment's velocity (origin change / duration) overflows float64")
     if times[0] > window[0] or times[-1] < window[1]:
         raise InvalidInputError(f"{name}: motion covers [{times[0]}, {times[-1]}] s, "
                                 f"not the window {window}")

@@ -53,6 +53,7 @@ from numba import njit
 
 from monitor.certify.common import Outcome, PairOutcome
 from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
+from monitor.motion._kinematics import finite_velocities
 from monitor.tolerances import Tolerances
 
 SWEPT_MAX_POINTS = 1 << 15
@@ -431,6 +432,9 @@ def decide_pair(shape_a: Any, R_a: np.ndarray, times_a: np.ndarray, origins_a: n
         ``witness_point``, ``info["earliest_time"]`` the exact first contact at ``margin``,
         ``intervals == [(earliest, witness)]``), or None when the pass cannot decide.
     """
+    if not (finite_velocities(times_a.tolist(), origins_a)
+            and finite_velocities(times_b.tolist(), origins_b)):
+        return None   # a segment velocity overflows: bad input, which the Python checker refuses (red team 7)
     ka, kb = shape_a.kind, shape_b.kind
     plane = ka == "halfspace" or kb == "halfspace"
     if plane and (ka == kb or (ka if kb == "halfspace" else kb) not in _KINDS):

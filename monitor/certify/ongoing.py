@@ -70,6 +70,10 @@ DEFAULT_PENETRATION_TOL = 0.005
 """Metres of penetration an ongoing contact may reach within a window (5 mm: above
 MuJoCo's typical resting penetration of soft contacts, ~1 mm, below any geometry
 feature that matters for a collision)."""
+MAX_PENETRATION_TOL = 1e9
+"""Largest accepted ``penetration_tol`` (m), the geometry's coordinate limit. The rule shifts shapes by
+it and subtracts it back from the clearance: far beyond it that subtraction's rounding (~1e-16 of it)
+exceeds every pad, and clearances of 1e14 m tolerances were overstated by centimetres (red team 7)."""
 ONGOING_RULES = ("violation", "deepen")
 _REL = 1e-9  # relative safety factor on the shrink amount (rounding of r - x, o - x)
 POLYTOPE_NOTE = "ongoing contact, polytope cores"
@@ -83,8 +87,9 @@ def check_rule(ongoing: Any, penetration_tol: Any) -> float:
         d = float(penetration_tol)
     except (TypeError, ValueError):
         raise InvalidInputError(f"penetration_tol must be a number (m), got {penetration_tol!r}") from None
-    if not math.isfinite(d) or d <= 0:
-        raise InvalidInputError(f"penetration_tol must be finite and > 0 (m), got {penetration_tol!r}")
+    if not 0 < d <= MAX_PENETRATION_TOL:
+        raise InvalidInputError(f"penetration_tol must be > 0 and <= {MAX_PENETRATION_TOL:g} (m), "
+                                f"got {penetration_tol!r}")
     return d
 
 
@@ -283,4 +288,5 @@ def _recombine(cert: Certificate, pairs: list[PairResult], n_ongoing: int, tol: 
                    pairs=tuple(pairs), stats=stats)
 
 
-__all__ = ["deepen", "shrink_pair", "check_rule", "DEFAULT_PENETRATION_TOL", "ONGOING_RULES", "POLYTOPE_NOTE"]
+__all__ = ["deepen", "shrink_pair", "check_rule", "DEFAULT_PENETRATION_TOL", "MAX_PENETRATION_TOL",
+           "ONGOING_RULES", "POLYTOPE_NOTE"]

@@ -27,7 +27,7 @@ from typing import Any
 
 from monitor.certify import common as _common
 from monitor.certify.common import Budget
-from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, ONGOING_RULES
+from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, MAX_PENETRATION_TOL, ONGOING_RULES
 from monitor.certify.types import Method, as_method
 from monitor.errors import InvalidInputError
 from monitor.tolerances import DEFAULT, Tolerances
@@ -168,8 +168,9 @@ class CertifyRequest:
         if self.ongoing not in ONGOING_RULES:
             raise InvalidInputError(f"{own}.ongoing must be one of {ONGOING_RULES}, got {self.ongoing!r}")
         pen = _real(own, "penetration_tol", self.penetration_tol)
-        if pen <= 0:
-            raise InvalidInputError(f"{own}.penetration_tol must be > 0 (m), got {pen}")
+        if not 0 < pen <= MAX_PENETRATION_TOL:
+            raise InvalidInputError(f"{own}.penetration_tol must be > 0 and <= {MAX_PENETRATION_TOL:g} (m), "
+                                    f"got {pen}")
         object.__setattr__(self, "penetration_tol", pen)
 
     def new_budget(self) -> Any:

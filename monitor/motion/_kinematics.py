@@ -18,6 +18,8 @@ At a waypoint time the stored waypoint values are returned exactly.
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from monitor.errors import InvalidInputError
@@ -144,6 +146,25 @@ def quat_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     d = np.linalg.norm(a - b, axis=-1)
     s = np.linalg.norm(a + b, axis=-1)
     return 4.0 * np.arctan2(np.minimum(d, s), np.maximum(d, s))
+
+
+def finite_velocities(times: list[float], points: np.ndarray) -> bool:
+    """True when every segment velocity ``(points[k+1] - points[k]) / (times[k+1] - times[k])`` is finite.
+
+    ``times``: the K strictly increasing waypoint times (s) as Python floats; ``points`` (K, ...) finite.
+    False when a difference or a quotient overflows float64: a segment a few ulp of the smallest
+    normal long (1e-308 s), or coordinates near the float64 limit. The extrusion checker divides
+    exactly so; an infinite velocity turns its tests into NaN, which certified such motions (red team 7).
+    """
+    dt_min = min(map(operator.sub, times[1:], times[:-1]))
+    # in Python floats: a few numpy reductions cost ~15 us per certify call in place (tunnel window)
+    if max(map(abs, points.ravel().tolist())) <= dt_min * 1e307:
+        return True   # every |difference| / duration <= 2 max|point| / min duration <= 2e307
+    t = np.asarray(times, dtype=np.float64)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        d = (points[1:] - points[:-1]).reshape(t.shape[0] - 1, -1)
+        v = d / (t[1:] - t[:-1])[:, None]
+    return bool(np.isfinite(v).all())
 
 
 class Segments:
