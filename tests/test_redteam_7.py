@@ -92,7 +92,7 @@ _SLIDE_BALL = """
 # (duration s, half-stroke m): the ball goes from x = -a to x = +a through the wall at x = 0.3 m
 # in one segment whose velocity 2a / dt is not a float64 (subnormal durations, or a quotient or a
 # difference beyond 1.8e308): the extrusion route divided by it and certified on NaN arithmetic.
-_OVERFLOWING = [(1e-308, 1.0), (5e-324, 1.0), (1e-300, 5e9), (1.0, 9e307)]
+_OVERFLOWING = [(1e-308, 1.0), (5e-324, 1.0), (1e-300, 5e9), (1.0, 9e307), (20.0, 9e307)]
 
 
 @pytest.mark.parametrize("dt,a", _OVERFLOWING)

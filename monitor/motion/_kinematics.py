@@ -158,8 +158,9 @@ def finite_velocities(times: list[float], points: np.ndarray) -> bool:
     """
     dt_min = min(map(operator.sub, times[1:], times[:-1]))
     # in Python floats: a few numpy reductions cost ~15 us per certify call in place (tunnel window)
-    if max(map(abs, points.ravel().tolist())) <= dt_min * 1e307:
-        return True   # every |difference| / duration <= 2 max|point| / min duration <= 2e307
+    m = max(map(abs, points.ravel().tolist()))
+    if m <= 1e307 and m <= dt_min * 1e307:  # (the first: dt_min * 1e307 overflows to inf beyond ~18 s)
+        return True   # every |difference| <= 2 max|point| <= 2e307, / min duration <= 2e307
     t = np.asarray(times, dtype=np.float64)
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         d = (points[1:] - points[:-1]).reshape(t.shape[0] - 1, -1)
