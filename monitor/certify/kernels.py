@@ -1063,7 +1063,7 @@ def _pair_row(pairs, rows, a, b):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
-def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0):
+def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0, sep_min):
     """Sort-and-sweep over swept AABBs: the rows of ``pairs`` whose boxes are within ``thr`` on every axis.
 
     Args:
@@ -1078,17 +1078,21 @@ def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0):
         pairs: (P, 2) int64 selected pairs, a < b per row, rows strictly increasing (lexicographic).
         rows: (G + 1,) int64: the rows with ``pairs[k, 0] == a`` are ``rows[a]:rows[a + 1]``.
         out: (>= n0 + produced,) int64 output rows, written from ``n0``.
+        sep_min: (1,) output: a lower bound (m) on the largest computed separation of every pair
+            of bounded geoms NOT produced (inf if none), selected or not.
 
     A pair is produced iff each of its six computed separations ``lo_b - hi_a``, ``lo_a - hi_b``
     (per axis) is ``<= thr``: the very subtractions of :func:`window_kernel`'s AABB test, so a
     pair left out has ``sep > thr`` there (rounding is monotone). Along x the scan of ``a``
     stops at the first later geom with ``lo_b - hi_a > thr`` (``lo`` sorted, so every later one
-    too); ``lo_a - hi_b <= 0`` for a later ``b``. Each unordered pair is met once.
+    too, with an x separation at least as large: that one bounds ``sep_min`` for the rest of the
+    scan); ``lo_a - hi_b <= 0`` for a later ``b``. Each unordered pair is met once.
 
     Returns:
         The new end of ``out`` (n0 + rows written).
     """
     n = n0
+    m = np.inf
     for i in range(nb):
         a = order[i]
         hx, hy, hz = hi[a, 0], hi[a, 1], hi[a, 2]
@@ -1097,12 +1101,17 @@ def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0):
             b = order[j]
             sx = lo[b, 0] - hx
             if sx > thr:
+                if sx < m:
+                    m = sx
                 break
             s1 = lo[b, 1] - hy
             s2 = ly - hi[b, 1]
             s3 = lo[b, 2] - hz
             s4 = lz - hi[b, 2]
             if s1 > thr or s2 > thr or s3 > thr or s4 > thr:
+                sep = max(sx, s1, s2, s3, s4)
+                if sep < m:
+                    m = sep
                 continue
             if thr_old >= 0.0:
                 s0 = lx - hi[b, 0]
@@ -1125,25 +1134,23 @@ def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0):
                 if k >= 0:
                     out[n] = k
                     n += 1
+    sep_min[0] = m
     return n
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _sweep_first(lo, hi, margin, pad, pairs, rows, surv):
+def _sweep_first(lo, hi, margin, pad, pairs, rows, surv, sep_min):
     """The first sweep of :func:`window_kernel`'s stage 0 (its docstring, "Sweep"): rows into ``surv``.
 
-    Returns (swept, nrows, thr, lk, smax, order, nb, unb, span): ``swept`` False (nrows = P) when
-    the threshold is not numerically sound (then the pair loop visits every pair); else the
-    sorted produced rows are ``surv[:nrows]``; ``order[:nb]`` the bounded geoms by ``lo[:, 0]``,
-    ``unb`` (G,) the unbounded flags, ``span`` the largest computed extent of all bounded boxes
-    along an axis (a threshold >= span produces every bounded pair).
+    Returns (swept, nrows, thr, lk, smax, order, nb, unb): ``swept`` False (nrows = P) when the
+    threshold is not numerically sound (then the pair loop visits every pair); else the sorted
+    produced rows are ``surv[:nrows]``, every pair left out has ``sep >= lk > margin``;
+    ``order[:nb]`` the bounded geoms by ``lo[:, 0]``, ``unb`` (G,) the unbounded flags.
     """
     G = lo.shape[0]
     unb = np.zeros(G, np.int64)
     keyx = np.empty(G)
     idx = np.empty(G, np.int64)
-    mn = np.full(3, np.inf)
-    mx = np.full(3, -np.inf)
     nb = 0
     smax = 1.0
     for g in range(G):
@@ -1159,12 +1166,6 @@ def _sweep_first(lo, hi, margin, pad, pairs, rows, surv):
         nb += 1
         for r in range(3):
             smax = max(smax, abs(lo[g, r]), abs(hi[g, r]))
-            mn[r] = min(mn[r], lo[g, r])
-            mx[r] = max(mx[r], hi[g, r])
-    span = 0.0
-    if nb:
-        for r in range(3):
-            span = max(span, mx[r] - mn[r])
     perm = np.argsort(keyx[:nb])
     order = np.empty(nb, np.int64)
     for i in range(nb):
@@ -1172,25 +1173,30 @@ def _sweep_first(lo, hi, margin, pad, pairs, rows, surv):
     thr = (margin + pad + 1e-12 * smax) * (1.0 + 1e-9) + 1e-12
     lk = thr - pad - 1e-12 * smax
     if not (thr >= 0.0 and thr < np.inf and lk > margin):
-        return False, pairs.shape[0], thr, lk, smax, order, nb, unb, span
-    n = sweep_rows(lo, hi, order, nb, unb, thr, -1.0, pairs, rows, surv, 0)
+        return False, pairs.shape[0], thr, lk, smax, order, nb, unb
+    n = sweep_rows(lo, hi, order, nb, unb, thr, -1.0, pairs, rows, surv, 0, sep_min)
     surv[:n].sort()
-    return True, n, thr, lk, smax, order, nb, unb, span
+    m = sep_min[0]
+    if m > thr:     # (always: every pair left out has a separation > thr) the tighter bound
+        lk = m - pad - 1e-12 * smax
+    return True, n, thr, lk, smax, order, nb, unb
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
-def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, span, margin, pad, best, pairs, rows, fixed, gbody,
-                code, sc, sr, surv, S):
+def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows, fixed, gbody, code,
+                sc, sr, surv, S, sep_min):
     """The smallest sphere gap over ALL culled pairs, from ``best`` over the first sweep's (window_kernel).
 
-    Every pair not produced at ``thr`` has ``sep >= lk``, hence sphere gap >= lk. While
-    ``best > lk``, sweep at a larger threshold (target: ``best`` when finite, else doubling from
-    the largest box extent) and take the sphere gaps of the pairs produced now and not before
-    (``surv[S:]`` as scratch: at most P - S of them); stop when ``best <= lk`` or the last
-    threshold is >= ``span`` (every bounded pair produced). If a threshold is not numerically
-    sound, or after 64 rounds, the sphere gaps of every unvisited pair decide instead.
+    Every pair not produced so far has ``sep >= lk`` (``lk`` from ``sep_min``, the kernel's own
+    expression ``sep - pad - 1e-12 scale`` with scale <= smax), hence sphere gap >= lk. While
+    ``best > lk``, sweep at a larger threshold -- the one that makes ``lk >= best`` when ``best``
+    is finite, else one for twice the last target, at least the largest box extent -- and
+    take the sphere gaps of the pairs produced now and not before (``surv[S:]`` as scratch: at
+    most P - S of them; they are culled: their ``sep`` exceeds the first sweep's ``lk``). If a
+    threshold is not numerically sound, or after 64 rounds, the sphere gaps of every unvisited
+    pair decide instead.
     """
-    ext = 0.0
+    ext = 0.0        # the largest box extent: the first widening's scale while nothing is found
     for i in range(nb):
         g = order[i]
         for r in range(3):
@@ -1200,19 +1206,16 @@ def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, span, margin, pad, best, 
     rounds = 0
     sound = True
     while not best <= lk:
-        if thr_old >= span:
-            return best
         rounds += 1
-        if best < np.inf:
-            target = best
-        else:
-            target = max(2.0 * target, ext, 1e-9)
+        target = best if best < np.inf else max(2.0 * target, ext, 1e-9)
         thr = (target + pad + 1e-12 * smax) * (1.0 + 1e-9) + 1e-12
-        lk = thr - pad - 1e-12 * smax
-        if rounds > 64 or not (lk >= target and thr > thr_old and thr < np.inf):
+        if not thr - pad - 1e-12 * smax >= target:
             sound = False
+        if rounds > 64 or not (thr > thr_old and thr < np.inf):
+            sound = False
+        if not sound:
             break
-        n = sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, surv, S)
+        n = sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, surv, S, sep_min)
         for kk in range(S, n):
             k = surv[kk]
             ga, gb = pairs[k, 0], pairs[k, 1]
@@ -1222,6 +1225,8 @@ def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, span, margin, pad, best, 
             if g < best:
                 best = g
         thr_old = thr
+        m = sep_min[0]
+        lk = m - pad - 1e-12 * smax if m > thr else -np.inf   # (m > thr always; else one more round)
     if not sound:
         for k in range(pairs.shape[0]):
             if code[k] == WK_UNVISITED:
@@ -1277,16 +1282,18 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     whose boxes are within ``thr = (margin + pad + 1e-12 smax)(1 + 1e-9) + 1e-12`` on every
     axis (``smax`` >= 1 and >= every finite box coordinate, so >= each pair's ``scale``);
     pairs with an unbounded box (half-spaces, no shape, NaN) are always produced. A pair left
-    out has a computed separation ``> thr``, so its ``sep = sep_raw - pad - 1e-12 scale >=
-    lk = thr - pad - 1e-12 smax > margin`` (the same expressions, monotone rounding; checked):
+    out has a computed separation ``sep_raw > thr``, so its ``sep = sep_raw - pad - 1e-12 scale
+    >= thr - pad - 1e-12 smax > margin`` (the same expressions, monotone rounding; checked):
     the pair loop would cull it too (``WK_UNVISITED``, gap NaN as for an AABB-culled pair). The
     produced pairs get the pair loop's decisions, in row order (so the survivors and their
     order are the pair loop's). Static-static pairs are marked from the rows of fixed geoms.
-    ``info[WI_BEST]`` stays the minimum sphere gap over ALL culled pairs: while the best
-    found exceeds ``lk`` (a pair left out may be smaller), sweep again at a larger threshold
-    (the best found, or a doubling one while none is found) and take the sphere gaps of the
-    newly produced pairs, until ``best <= lk`` or the threshold spans every box (every pair
-    produced); any numerical doubt falls back to the sphere gaps of every unvisited pair.
+    ``info[WI_BEST]`` stays the minimum sphere gap over ALL culled pairs: the sweep also
+    returns the smallest ``sep_raw`` left out (``m``), so every pair left out has a sphere gap
+    ``>= lk = m - pad - 1e-12 smax``; while the best found exceeds ``lk``, sweep again at a
+    larger threshold (the one giving ``lk >= best``; while nothing is found, doubling from the
+    largest box extent) and take
+    the sphere gaps of the newly produced pairs (:func:`_sweep_best`); any numerical doubt
+    falls back to the sphere gaps of every unvisited pair.
 
     Stage 1 (per survivor): the exact start-pose test at t0 (``posed_distance``:
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
@@ -1459,12 +1466,13 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             # -- which pairs: all of them, or the sweep's (sorted rows in surv[:nrows]) -----------
             nrows = pairs.shape[0]
             swept = False
-            thr, lk, smax, span, nb = 0.0, 0.0, 1.0, 0.0, 0
+            thr, lk, smax, nb = 0.0, 0.0, 1.0, 0
             order = np.empty(0, np.int64)
             unb = order
+            sep_min = np.full(1, np.inf)
             if rows.shape[0] == G + 1 and nrows > 0:
-                swept, nrows, thr, lk, smax, order, nb, unb, span = _sweep_first(
-                    lo, hi, margin, pad, pairs, rows, surv)
+                swept, nrows, thr, lk, smax, order, nb, unb = _sweep_first(lo, hi, margin, pad, pairs, rows,
+                                                                           surv, sep_min)
             if swept:
                 for a in range(G):        # static-static pairs among the rows left out
                     if fixed[gp.body[a]] != 0:
@@ -1520,8 +1528,8 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     surv[S] = k
                     S += 1
             if swept:
-                best = _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, span, margin, pad, best, pairs,
-                                   rows, fixed, gp.body, code, sc, sr, surv, S)
+                best = _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows,
+                                   fixed, gp.body, code, sc, sr, surv, S, sep_min)
             info[WI_BEST] = best
             info[WI_SURV] = S
             k0 = 0
