@@ -560,9 +560,10 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
 
 _FAST_CHUNK = 4
 
-SWEEP_MIN_GEOMS = 128
+SWEEP_MIN_GEOMS = 400
 """Geoms from which stage 0 of the window kernel sweeps (sort-and-sweep on the swept boxes) instead of
-visiting every selected pair (measured: docs/notes/issue-12-sweep-2.md); tests set it to 0 to force it."""
+visiting every selected pair: on the scaling scenes the sweep wins from ~60 geoms when sparse, from
+~400 on the dense grid (x-slabs); docs/notes/issue-12-sweep-2.md. Tests set it to 0 to force it."""
 
 
 def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
