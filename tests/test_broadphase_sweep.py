@@ -106,6 +106,14 @@ def _cases():
 CASES = _cases()
 
 
+def _same_type_copy(x: np.ndarray) -> np.ndarray:
+    """A copy with the same numba type (read-only stays read-only: another type would compile a second
+    ``window_kernel`` specialisation and switch off the engine's direct call for the rest of the process)."""
+    y = x.copy()
+    y.flags.writeable = x.flags.writeable
+    return y
+
+
 def _stage0_calls(monkeypatch, scene, plan, kw) -> list[tuple]:
     """The arguments of every stage-0 ``window_kernel`` call of one certify (sweep forced)."""
     calls = []
@@ -113,7 +121,7 @@ def _stage0_calls(monkeypatch, scene, plan, kw) -> list[tuple]:
 
     def spy(*a):
         if a[7] == 0:
-            calls.append(tuple(x.copy() if isinstance(x, np.ndarray) else x for x in a))
+            calls.append(tuple(_same_type_copy(x) if isinstance(x, np.ndarray) else x for x in a))
         return orig(*a)
 
     monkeypatch.setattr(engine, "_window_kernel", spy)
@@ -129,8 +137,10 @@ def _run_stage0(a: tuple, rows: np.ndarray) -> tuple:
      info) = a
     code, gap, surv = np.zeros_like(code), np.full_like(gap, -7.0), np.zeros_like(surv)
     res, sc, sr, info = np.empty_like(res), np.empty_like(sc), np.empty_like(sr), np.zeros_like(info)
+    n_sig = len(KS.window_kernel.signatures)
     S = int(KS.window_kernel(gp, mp, pairs, fixed, mov, route, 0, 0, 0, prm, code, gap, surv, res, sc, sr,
                              rows, info))
+    assert len(KS.window_kernel.signatures) == n_sig, "the replay compiled another specialisation"
     return S, code, gap, surv, sc, sr, info
 
 

@@ -571,22 +571,24 @@ def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
 
     Empty below :data:`SWEEP_MIN_GEOMS` geoms, or when ``pid`` is not strictly increasing in
     (a, b) with a < b per row (the sweep finds a produced pair's row by binary search). The
-    check and the starts are cached per ``pid`` object (the pack's, for a full selection) in
-    ``Scene._hot``; a subset selection's fresh ``pid`` is checked per call (O(S)).
+    check and the starts are cached in ``Scene._hot`` per pair array (the pack's ``pair_ids`` for a full
+    selection, whatever view of it ``pid`` is); a subset selection's fresh ``pid`` is checked per call (O(S)).
     """
     G = sp.geoms.kind.shape[0]
     if G < SWEEP_MIN_GEOMS or G < 2 or len(pid) == 0:
         return _NONE
+    # a full selection's pid is the pack's array or a read-only view of it (a new view per request)
+    key = sp.pair_ids if len(pid) == len(sp.pair_ids) else pid
     hot = _hot(scene)
     hit = None if hot is None else hot.get("sweep_rows")
-    if hit is not None and hit[0] is pid and hit[1] == G:
+    if hit is not None and hit[0] is key and hit[1] == G:
         return hit[2]
     a, b = pid[:, 0], pid[:, 1]
-    key = a * G + b              # (a, b) in lexicographic order, a < b < G
-    ok = bool(a.min() >= 0 and b.max() < G and (a < b).all() and (key[1:] > key[:-1]).all())
+    lex = a * G + b              # (a, b) in lexicographic order, a < b < G
+    ok = bool(a.min() >= 0 and b.max() < G and (a < b).all() and (lex[1:] > lex[:-1]).all())
     rows = np.searchsorted(a, np.arange(G + 1, dtype=np.int64)).astype(np.int64) if ok else _NONE
     if hot is not None:
-        hot["sweep_rows"] = (pid, G, rows)
+        hot["sweep_rows"] = (key, G, rows)
     return rows
 
 """Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
