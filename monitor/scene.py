@@ -454,6 +454,9 @@ class Scene:
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
+        self._sorted_pairs = pair_ids if lex_sorted_pairs(pair_ids, len(geoms)) else None
+        """``pair_ids`` itself when its rows are strictly increasing (a, b) with 0 <= a < b < ngeom (the
+        engine's sweep finds rows by binary search; checked here, once per pair array), else None."""
         self.body_names = body_names
         self.body_static = body_static
         self.facets = facets
@@ -514,6 +517,7 @@ class Scene:
         self.geoms = fresh.geoms
         self.geom_frames = fresh.geom_frames
         self.pair_ids = fresh.pair_ids
+        self._sorted_pairs = fresh._sorted_pairs
         self.body_names = fresh.body_names
         self.body_static = fresh.body_static
         self.approximations = fresh.approximations
@@ -721,6 +725,16 @@ class Scene:
     def __repr__(self) -> str:
         return (f"Scene(ngeom={len(self.geoms)}, nbody={len(self.body_names)}, "
                 f"pairs={len(self.candidate_pairs)})")
+
+
+def lex_sorted_pairs(pair_ids: np.ndarray, ngeom: int) -> bool:
+    """True if the (P, 2) int rows are strictly increasing in (a, b) with 0 <= a < b < ngeom (O(P))."""
+    pid = np.asarray(pair_ids).reshape(-1, 2)
+    if len(pid) == 0:
+        return True
+    a, b = pid[:, 0].astype(np.int64), pid[:, 1].astype(np.int64)
+    lex = a * max(int(ngeom), 1) + b
+    return bool(a.min() >= 0 and b.max() < ngeom and (a < b).all() and (lex[1:] > lex[:-1]).all())
 
 
 def model_hash(model: Any) -> str:

@@ -221,3 +221,26 @@ def test_unsorted_pair_rows_take_the_pair_loop():
         assert engine._sweep_rows(None, sp, np.ascontiguousarray(pid[:, ::-1])).size == 0
     finally:
         engine.SWEEP_MIN_GEOMS = old
+
+
+def test_scene_records_sorted_pairs_and_sync_keeps_it():
+    """A Scene records that its pair array is in strict (a, b) order (the sweep then skips its O(P) check);
+    an in-place model edit rebuilds the scene with its new array and the record follows it."""
+    from monitor.scene import lex_sorted_pairs
+
+    _policy, model, scene, _plan, _kw = CASES[1]
+    assert scene._sorted_pairs is scene.pair_ids
+    pid = np.asarray(scene.pair_ids)
+    assert lex_sorted_pairs(pid, len(scene.geoms))
+    assert not lex_sorted_pairs(pid[::-1], len(scene.geoms))
+    assert not lex_sorted_pairs(pid[:, ::-1], len(scene.geoms))
+    assert not lex_sorted_pairs(np.concatenate([pid[:1], pid[:1]]), len(scene.geoms))   # a repeated row
+    assert not lex_sorted_pairs(pid, int(pid.max()))                                       # id out of range
+    fresh = monitor.Scene.from_model(model, pairs="mujoco")
+    before, size = fresh.pair_ids, float(model.geom_size[0, 0])
+    model.geom_size[0, 0] = size * 1.01
+    try:
+        assert fresh.sync()
+        assert fresh.pair_ids is not before and fresh._sorted_pairs is fresh.pair_ids
+    finally:
+        model.geom_size[0, 0] = size      # the shared case's model, exactly as it was

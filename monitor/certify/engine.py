@@ -65,6 +65,7 @@ from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, deepen
 from monitor.certify.request import DEFAULT_EPSILON, BudgetLimits, CertifyRequest
 from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
+from monitor.scene import lex_sorted_pairs
 from monitor.tolerances import DEFAULT, Tolerances
 
 _METHODS = tuple(m.value for m in Method)  # ("auto", "toleranced", "extrusion")
@@ -566,6 +567,13 @@ visiting every selected pair: on the scaling scenes the sweep wins from ~60 geom
 ~400 on the dense grid (x-slabs); docs/notes/issue-12-sweep-2.md. Tests set it to 0 to force it."""
 
 
+def _pack_of_pairs(sp: Any, pair_ids: np.ndarray) -> bool:
+    """The pack's pair array is ``pair_ids``' own memory (same address, shape, strides, int64; no copy)."""
+    a = sp.pair_ids
+    return (a.dtype == np.int64 and pair_ids.dtype == np.int64 and a.shape == pair_ids.shape
+            and a.strides == pair_ids.strides and a.ctypes.data == pair_ids.ctypes.data)
+
+
 def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
     """(G + 1,) int64 row starts of ``pid`` per first geom for the kernel's sweep, or empty (the pair loop).
 
@@ -583,10 +591,12 @@ def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
     hit = None if hot is None else hot.get("sweep_rows")
     if hit is not None and hit[0] is key and hit[1] == G:
         return hit[2]
-    a, b = pid[:, 0], pid[:, 1]
-    lex = a * G + b              # (a, b) in lexicographic order, a < b < G
-    ok = bool(a.min() >= 0 and b.max() < G and (a < b).all() and (lex[1:] > lex[:-1]).all())
-    rows = np.searchsorted(a, np.arange(G + 1, dtype=np.int64)).astype(np.int64) if ok else _NONE
+    if key is sp.pair_ids and getattr(scene, "_sorted_pairs", None) is not None \
+            and scene._sorted_pairs is scene.pair_ids and _pack_of_pairs(sp, scene.pair_ids):
+        ok = True                # checked by the Scene when it was built (monitor.scene.lex_sorted_pairs)
+    else:
+        ok = lex_sorted_pairs(pid, G)
+    rows = np.searchsorted(pid[:, 0], np.arange(G + 1, dtype=np.int64)).astype(np.int64) if ok else _NONE
     if hot is not None:
         hot["sweep_rows"] = (key, G, rows)
     return rows

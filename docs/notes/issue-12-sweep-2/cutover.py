@@ -26,10 +26,11 @@ for n in sizes:
         for motion in [m for m in ("translating", "rotating") if "--" + m not in sys.argv]:
             model, bm = scaling_scene(n, density, motion)
             scene = monitor.Scene.from_model(model, pairs="all")
-            calls = []
+            calls: list = []
             orig = engine._window_kernel
 
-            def spy(*a):
+            def spy(*a, calls=calls, orig=orig):
+                """Record the first stage-0 call."""
                 if a[7] == 0 and not calls:
                     calls.append(a)
                 return orig(*a)
@@ -45,8 +46,8 @@ for n in sizes:
                 for mode in (0, 1) if r % 2 == 0 else (1, 0):
                     c = np.zeros_like(code)
                     t = time.perf_counter()
-                    S[mode] = KS.window_kernel(gp, mp, pairs, fixed, mov, route, 0, 0, 0, prm, c, gap, surv, res,
-                                               sc, sr, rows if mode else engine._NONE, info)
+                    S[mode] = KS.window_kernel(gp, mp, pairs, fixed, mov, route, 0, 0, 0, prm, c, gap, surv,
+                                               res, sc, sr, rows if mode else engine._NONE, info)
                     ts[mode].append(time.perf_counter() - t)
             assert S[0] == S[1]
             a, b = np.median(ts[0]) * 1e3, np.median(ts[1]) * 1e3

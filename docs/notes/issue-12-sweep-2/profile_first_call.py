@@ -7,8 +7,6 @@ import sys
 import time
 from collections import defaultdict
 
-import numpy as np
-
 import monitor
 import monitor.scene as SC
 from monitor.bench.suites import scaling_scene
@@ -20,6 +18,7 @@ T = defaultdict(float)
 
 
 def wrap(mod, name, label=None):
+    """Replace ``mod.name`` by a timed wrapper adding to ``T[label]``."""
     f = getattr(mod, name)
     label = label or f"{mod.__name__.split('.')[-1]}.{name}"
 
@@ -39,7 +38,8 @@ monitor.certify(monitor.Scene.from_model(m3, pairs="all"), b3, epsilon=1e-3)   #
 for mod, name in [(SC, "_filter_pairs"), (SC, "_drop_overlapping_world_children"), (SC, "_geom_shape"),
                   (SC, "_to_body"), (SC, "geom_frame"), (SC, "_Snapshot"),
                   (K, "scene_pack"), (PK, "pack_shapes"), (PK, "_curved_geoms"), (PK, "_content_key"),
-                  (K, "trajectory_pack_memo"), (E, "_select"), (E, "_plan_inputs"), (E, "_check_model"),
+                  (K, "trajectory_pack_memo"), (E, "_sweep_rows"), (E, "_select"), (E, "_plan_inputs"),
+                  (E, "_check_model"),
                   (E, "_window_kernel"), (E, "_all_culled"), (E, "_fast_prep")]:
     wrap(mod, name)
 model, bm = scaling_scene(n, "sparse", motion)
@@ -60,7 +60,7 @@ for i in range(6):
     if i == 0:
         first = dict(T)
         T.clear()
-print(f"  certify calls (ms): " + ", ".join(f"{x * 1e3:.2f}" for x in ts))
+print("  certify calls (ms): " + ", ".join(f"{x * 1e3:.2f}" for x in ts))
 for k in sorted(first, key=first.get, reverse=True):
     print(f"  first call  {k:40s} {first[k] * 1e3:9.2f} ms")
 for k in sorted(T, key=T.get, reverse=True):
