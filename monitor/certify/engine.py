@@ -560,6 +560,7 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
 
 
 _FAST_CHUNK = 4
+"""Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
 
 SWEEP_MIN_GEOMS = 400
 """Geoms from which stage 0 of the window kernel sweeps (sort-and-sweep on the swept boxes) instead of
@@ -600,8 +601,6 @@ def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
     if hot is not None:
         hot["sweep_rows"] = (key, G, rows)
     return rows
-
-"""Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
 
 
 def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
