@@ -80,6 +80,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from monitor.certify.packed import lex_sorted_pairs
 from monitor.errors import InvalidInputError, ModelMismatchError, UnsupportedGeometryError
 from monitor.geometry.polytope import (
     box_polytope,
@@ -725,16 +726,6 @@ class Scene:
     def __repr__(self) -> str:
         return (f"Scene(ngeom={len(self.geoms)}, nbody={len(self.body_names)}, "
                 f"pairs={len(self.candidate_pairs)})")
-
-
-def lex_sorted_pairs(pair_ids: np.ndarray, ngeom: int) -> bool:
-    """True if the (P, 2) int rows are strictly increasing in (a, b) with 0 <= a < b < ngeom (O(P))."""
-    pid = np.asarray(pair_ids).reshape(-1, 2)
-    if len(pid) == 0:
-        return True
-    a, b = pid[:, 0].astype(np.int64), pid[:, 1].astype(np.int64)
-    lex = a * max(int(ngeom), 1) + b
-    return bool(a.min() >= 0 and b.max() < ngeom and (a < b).all() and (lex[1:] > lex[:-1]).all())
 
 
 def model_hash(model: Any) -> str:

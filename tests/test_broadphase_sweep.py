@@ -226,7 +226,7 @@ def test_unsorted_pair_rows_take_the_pair_loop():
 def test_scene_records_sorted_pairs_and_sync_keeps_it():
     """A Scene records that its pair array is in strict (a, b) order (the sweep then skips its O(P) check);
     an in-place model edit rebuilds the scene with its new array and the record follows it."""
-    from monitor.scene import lex_sorted_pairs
+    from monitor.certify.packed import lex_sorted_pairs
 
     _policy, model, scene, _plan, _kw = CASES[1]
     assert scene._sorted_pairs is scene.pair_ids

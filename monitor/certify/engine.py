@@ -62,10 +62,10 @@ from monitor.certify.common import (
     active_budget,
 )
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, deepen
+from monitor.certify.packed import lex_sorted_pairs
 from monitor.certify.request import DEFAULT_EPSILON, BudgetLimits, CertifyRequest
 from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
-from monitor.scene import lex_sorted_pairs
 from monitor.tolerances import DEFAULT, Tolerances
 
 _METHODS = tuple(m.value for m in Method)  # ("auto", "toleranced", "extrusion")
@@ -594,7 +594,7 @@ def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
         return hit[2]
     if key is sp.pair_ids and getattr(scene, "_sorted_pairs", None) is not None \
             and scene._sorted_pairs is scene.pair_ids and _pack_of_pairs(sp, scene.pair_ids):
-        ok = True                # checked by the Scene when it was built (monitor.scene.lex_sorted_pairs)
+        ok = True                # checked by the Scene when it was built (lex_sorted_pairs)
     else:
         ok = lex_sorted_pairs(pid, G)
     rows = np.searchsorted(pid[:, 0], np.arange(G + 1, dtype=np.int64)).astype(np.int64) if ok else _NONE
