@@ -80,6 +80,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from monitor.certify.packed import lex_sorted_pairs
 from monitor.errors import InvalidInputError, ModelMismatchError, UnsupportedGeometryError
 from monitor.geometry.polytope import (
     box_polytope,
@@ -455,6 +456,9 @@ class Scene:
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
+        self._sorted_pairs = pair_ids if lex_sorted_pairs(pair_ids, len(geoms)) else None
+        """``pair_ids`` itself when its rows are strictly increasing (a, b) with 0 <= a < b < ngeom (the
+        engine's sweep finds rows by binary search; checked here, once per pair array), else None."""
         self.body_names = body_names
         self.body_static = body_static
         self.facets = facets
@@ -515,6 +519,7 @@ class Scene:
         self.geoms = fresh.geoms
         self.geom_frames = fresh.geom_frames
         self.pair_ids = fresh.pair_ids
+        self._sorted_pairs = fresh._sorted_pairs
         self.body_names = fresh.body_names
         self.body_static = fresh.body_static
         self.approximations = fresh.approximations

@@ -62,6 +62,7 @@ from monitor.certify.common import (
     active_budget,
 )
 from monitor.certify.ongoing import DEFAULT_PENETRATION_TOL, deepen
+from monitor.certify.packed import lex_sorted_pairs
 from monitor.certify.request import DEFAULT_EPSILON, BudgetLimits, CertifyRequest
 from monitor.certify.types import Method
 from monitor.errors import InvalidInputError, ModelMismatchError, MonitorError
@@ -561,6 +562,46 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
 _FAST_CHUNK = 4
 """Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
 
+SWEEP_MIN_GEOMS = 400
+"""Geoms from which stage 0 of the window kernel sweeps (sort-and-sweep on the swept boxes) instead of
+visiting every selected pair: on the scaling scenes the sweep wins from ~60 geoms when sparse, from
+~400 on the dense grid (x-slabs); docs/notes/issue-12-sweep-2.md. Tests set it to 0 to force it."""
+
+
+def _pack_of_pairs(sp: Any, pair_ids: np.ndarray) -> bool:
+    """The pack's pair array is ``pair_ids``' own memory (same address, shape, strides, int64; no copy)."""
+    a = sp.pair_ids
+    return (a.dtype == np.int64 and pair_ids.dtype == np.int64 and a.shape == pair_ids.shape
+            and a.strides == pair_ids.strides and a.ctypes.data == pair_ids.ctypes.data)
+
+
+def _sweep_rows(scene: Any, sp: Any, pid: np.ndarray) -> np.ndarray:
+    """(G + 1,) int64 row starts of ``pid`` per first geom for the kernel's sweep, or empty (the pair loop).
+
+    Empty below :data:`SWEEP_MIN_GEOMS` geoms, or when ``pid`` is not strictly increasing in
+    (a, b) with a < b per row (the sweep finds a produced pair's row by binary search). The
+    check and the starts are cached in ``Scene._hot`` per pair array (the pack's ``pair_ids`` for a full
+    selection, whatever view of it ``pid`` is); a subset selection's fresh ``pid`` is checked per call (O(S)).
+    """
+    G = sp.geoms.kind.shape[0]
+    if G < SWEEP_MIN_GEOMS or G < 2 or len(pid) == 0:
+        return _NONE
+    # a full selection's pid is the pack's array or a read-only view of it (a new view per request)
+    key = sp.pair_ids if len(pid) == len(sp.pair_ids) else pid
+    hot = _hot(scene)
+    hit = None if hot is None else hot.get("sweep_rows")
+    if hit is not None and hit[0] is key and hit[1] == G:
+        return hit[2]
+    if key is sp.pair_ids and getattr(scene, "_sorted_pairs", None) is not None \
+            and scene._sorted_pairs is scene.pair_ids and _pack_of_pairs(sp, scene.pair_ids):
+        ok = True                # checked by the Scene when it was built (lex_sorted_pairs)
+    else:
+        ok = lex_sorted_pairs(pid, G)
+    rows = np.searchsorted(pid[:, 0], np.arange(G + 1, dtype=np.int64)).astype(np.int64) if ok else _NONE
+    if hot is not None:
+        hot["sweep_rows"] = (key, G, rows)
+    return rows
+
 
 def _fast_inputs(scene: Any, plan: Any) -> tuple | None:
     """(ScenePack, MotionPack, memo) for the compiled window path, or None (then the Python pipeline runs).
@@ -790,6 +831,10 @@ class _WindowPairs:
         KS = _kernels()
 
         code, gap = self.code, self.gap
+        unvisited = code == KS.WK_UNVISITED     # left out by the sweep: culled, gap not computed
+        if unvisited.any():
+            code = np.where(unvisited, KS.WK_CULLED, code)
+            gap = np.where(unvisited, np.nan, gap)
         miss = np.flatnonzero((code == KS.WK_CULLED) & np.isnan(gap))
         if miss.size:
             gap = gap.copy()
@@ -884,7 +929,10 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     P = len(sel)
     pid, moving, fixed, mov, prm, narrow = prep
     route_all = narrow and method == "toleranced"
-    code = np.empty(P, np.int64)
+    rows = _sweep_rows(scene, sp, pid)
+    # the sweep leaves the pairs it does not produce untouched: zeroed (WK_UNVISITED), which for
+    # a large array costs no pass over it (fresh zero pages)
+    code = np.zeros(P, np.int64) if rows.size else np.empty(P, np.int64)
     gap = np.empty(P)
     surv = np.empty(P, np.int64)
     res = np.empty((P, KS.R_SIZE))
@@ -896,7 +944,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
-                           sc, sr, info))
+                           sc, sr, rows, info))
     done_to = min(first, S)
     charged = info.item(KS.WI_TESTS)
     if charged:
@@ -944,7 +992,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
             break
         k1 = min(S, done_to + chunk)
         _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, route, 1, done_to, k1, prm, code, gap, surv, res,
-                       sc, sr, info)
+                       sc, sr, rows, info)
         bud.charge(int(info[KS.WI_TESTS] - charged))
         charged = info[KS.WI_TESTS]
         done_to = k1
@@ -953,7 +1001,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         # start pose before any checker runs; start tests are not charged), then go on to the
         # checkers, which leave them undecided on the exhausted budget
         _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code,
-                       gap, surv, res, sc, sr, info)
+                       gap, surv, res, sc, sr, rows, info)
         done_to = S
     if _EXTRUSION_DIRECT and method != "toleranced" and done_to == S and not stopped:
         # every survivor on the extrusion route (the tunnel's window): its certificate without the

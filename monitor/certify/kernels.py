@@ -1042,9 +1042,204 @@ def _halfspace_gap(n, q, bh, c, sc, sr, trans, ang, rot, pos, pad):
             g = d
     return g - pad
 
+WK_UNVISITED = 0
+"""Not produced by the sort-and-sweep broad phase (``rows`` given to :func:`window_kernel`): culled,
+gap not computed (``code`` is allocated zeroed; read as ``WK_CULLED`` with gap NaN)."""
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+def _pair_row(pairs, rows, a, b):
+    """Row k of ``pairs`` equal to (a, b) (a < b), or -1 (binary search in rows[a]:rows[a + 1])."""
+    lo_k, hi_k = rows[a], rows[a + 1]
+    while lo_k < hi_k:
+        mid = (lo_k + hi_k) // 2
+        v = pairs[mid, 1]
+        if v < b:
+            lo_k = mid + 1
+        elif v > b:
+            hi_k = mid
+        else:
+            return mid
+    return -1
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0, sep_min):
+    """Sort-and-sweep over swept AABBs: the rows of ``pairs`` whose boxes are within ``thr`` on every axis.
+
+    Args:
+        lo, hi: (G, 3) box corners (world frame, m); a geom with a non-finite coordinate is
+            unbounded (``unb[g] == 1``) and pairs with every geom.
+        order: (>= nb,) int64 the bounded geoms sorted by ``lo[:, 0]``.
+        unb: (G,) int64 1 for unbounded geoms.
+        thr: the separation threshold (m, >= 0).
+        thr_old: < 0 on the first sweep; else only pairs NOT produced at ``thr_old`` are written
+            (some computed separation > thr_old), and pairs with an unbounded geom are skipped (the
+            first sweep produced them all).
+        pairs: (P, 2) int64 selected pairs, a < b per row, rows strictly increasing (lexicographic).
+        rows: (G + 1,) int64: the rows with ``pairs[k, 0] == a`` are ``rows[a]:rows[a + 1]``.
+        out: (>= n0 + produced,) int64 output rows, written from ``n0``.
+        sep_min: (1,) output: a lower bound (m) on the largest computed separation of every pair
+            of bounded geoms NOT produced (inf if none), selected or not.
+
+    A pair is produced iff each of its six computed separations ``lo_b - hi_a``, ``lo_a - hi_b``
+    (per axis) is ``<= thr``: the very subtractions of :func:`window_kernel`'s AABB test, so a
+    pair left out has ``sep > thr`` there (rounding is monotone). Along x the scan of ``a``
+    stops at the first later geom with ``lo_b - hi_a > thr`` (``lo`` sorted, so every later one
+    too, with an x separation at least as large: that one bounds ``sep_min`` for the rest of the
+    scan); ``lo_a - hi_b <= 0`` for a later ``b``. Each unordered pair is met once.
+
+    Returns:
+        The new end of ``out`` (n0 + rows written).
+    """
+    n = n0
+    m = np.inf
+    for i in range(nb):
+        a = order[i]
+        hx, hy, hz = hi[a, 0], hi[a, 1], hi[a, 2]
+        lx, ly, lz = lo[a, 0], lo[a, 1], lo[a, 2]
+        for j in range(i + 1, nb):
+            b = order[j]
+            sx = lo[b, 0] - hx
+            if sx > thr:
+                if sx < m:
+                    m = sx
+                break
+            s1 = lo[b, 1] - hy
+            s2 = ly - hi[b, 1]
+            s3 = lo[b, 2] - hz
+            s4 = lz - hi[b, 2]
+            if s1 > thr or s2 > thr or s3 > thr or s4 > thr:
+                sep = max(sx, s1, s2, s3, s4)
+                if sep < m:
+                    m = sep
+                continue
+            if thr_old >= 0.0:
+                s0 = lx - hi[b, 0]
+                if not (sx > thr_old or s0 > thr_old or s1 > thr_old or s2 > thr_old or s3 > thr_old
+                        or s4 > thr_old):
+                    continue
+            k = _pair_row(pairs, rows, a, b) if a < b else _pair_row(pairs, rows, b, a)
+            if k >= 0:
+                out[n] = k
+                n += 1
+    if thr_old < 0.0:
+        G = unb.shape[0]
+        for u in range(G):
+            if unb[u] == 0:
+                continue
+            for g in range(G):
+                if g == u or (unb[g] != 0 and g < u):   # a pair of two unbounded geoms once
+                    continue
+                k = _pair_row(pairs, rows, u, g) if u < g else _pair_row(pairs, rows, g, u)
+                if k >= 0:
+                    out[n] = k
+                    n += 1
+    sep_min[0] = m
+    return n
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _sweep_first(lo, hi, margin, pad, pairs, rows, surv, sep_min):
+    """The first sweep of :func:`window_kernel`'s stage 0 (its docstring, "Sweep"): rows into ``surv``.
+
+    Returns (swept, nrows, thr, lk, smax, order, nb, unb): ``swept`` False (nrows = P) when the
+    threshold is not numerically sound (then the pair loop visits every pair); else the sorted
+    produced rows are ``surv[:nrows]``, every pair left out has ``sep >= lk > margin``;
+    ``order[:nb]`` the bounded geoms by ``lo[:, 0]``, ``unb`` (G,) the unbounded flags.
+    """
+    G = lo.shape[0]
+    unb = np.zeros(G, np.int64)
+    keyx = np.empty(G)
+    idx = np.empty(G, np.int64)
+    nb = 0
+    smax = 1.0
+    for g in range(G):
+        fin = True
+        for r in range(3):
+            if not (abs(lo[g, r]) < np.inf and abs(hi[g, r]) < np.inf):
+                fin = False
+        if not fin:
+            unb[g] = 1
+            continue
+        idx[nb] = g
+        keyx[nb] = lo[g, 0]
+        nb += 1
+        for r in range(3):
+            smax = max(smax, abs(lo[g, r]), abs(hi[g, r]))
+    perm = np.argsort(keyx[:nb])
+    order = np.empty(nb, np.int64)
+    for i in range(nb):
+        order[i] = idx[perm[i]]
+    thr = (margin + pad + 1e-12 * smax) * (1.0 + 1e-9) + 1e-12
+    lk = thr - pad - 1e-12 * smax
+    if not (thr >= 0.0 and thr < np.inf and lk > margin):
+        return False, pairs.shape[0], thr, lk, smax, order, nb, unb
+    n = sweep_rows(lo, hi, order, nb, unb, thr, -1.0, pairs, rows, surv, 0, sep_min)
+    surv[:n].sort()
+    m = sep_min[0]
+    if m > thr:     # (always: every pair left out has a separation > thr) the tighter bound
+        lk = m - pad - 1e-12 * smax
+    return True, n, thr, lk, smax, order, nb, unb
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows, fixed, gbody, code,
+                sc, sr, surv, S, sep_min):
+    """The smallest sphere gap over ALL culled pairs, from ``best`` over the first sweep's (window_kernel).
+
+    Every pair not produced so far has ``sep >= lk`` (``lk`` from ``sep_min``, the kernel's own
+    expression ``sep - pad - 1e-12 scale`` with scale <= smax), hence sphere gap >= lk. While
+    ``best > lk``, sweep at a larger threshold -- the one that makes ``lk >= best`` when ``best``
+    is finite, else one for twice the last target, at least the largest box extent -- and
+    take the sphere gaps of the pairs produced now and not before (``surv[S:]`` as scratch: at
+    most P - S of them; they are culled: their ``sep`` exceeds the first sweep's ``lk``). If a
+    threshold is not numerically sound, or after 64 rounds, the sphere gaps of every unvisited
+    pair decide instead.
+    """
+    ext = 0.0        # the largest box extent: the first widening's scale while nothing is found
+    for i in range(nb):
+        g = order[i]
+        for r in range(3):
+            ext = max(ext, hi[g, r] - lo[g, r])
+    target = margin
+    thr_old = thr
+    rounds = 0
+    sound = True
+    while not best <= lk:
+        rounds += 1
+        target = best if best < np.inf else max(2.0 * target, ext, 1e-9)
+        thr = (target + pad + 1e-12 * smax) * (1.0 + 1e-9) + 1e-12
+        if not thr - pad - 1e-12 * smax >= target:
+            sound = False
+        if rounds > 64 or not (thr > thr_old and thr < np.inf):
+            sound = False
+        if not sound:
+            break
+        n = sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, surv, S, sep_min)
+        for kk in range(S, n):
+            k = surv[kk]
+            ga, gb = pairs[k, 0], pairs[k, 1]
+            if fixed[gbody[ga]] != 0 and fixed[gbody[gb]] != 0:
+                continue
+            g = sphere_gap(sc, sr, ga, gb, pad)
+            if g < best:
+                best = g
+        thr_old = thr
+        m = sep_min[0]
+        lk = m - pad - 1e-12 * smax if m > thr else -np.inf   # (m > thr always; else one more round)
+    if not sound:
+        for k in range(pairs.shape[0]):
+            if code[k] == WK_UNVISITED:
+                g = sphere_gap(sc, sr, pairs[k, 0], pairs[k, 1], pad)
+                if g < best:
+                    best = g
+    return best
+
+
 @njit(cache=True, no_cfunc_wrapper=True)
 def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code, gap, surv, res, sc, sr,
-                  info):
+                  rows, info):
     """One window of a packed scene and motion: cull, start pose, whole-shape stage (no Python per pair).
 
     Args:
@@ -1065,6 +1260,11 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         surv: (P,) int64: surviving pair indices in slots [0, S).
         res: (>= S, R_SIZE) result rows per survivor slot (see :func:`pair_window`).
         sc, sr: (T, G, 3), (T, G) swept spheres (stage 0 output, kept for :func:`sphere_gap`).
+        rows: empty (the pair loop below visits every pair), or (G + 1,) int64 row starts of
+            ``pairs`` (``pairs[k, 0] == a`` for k in ``rows[a]:rows[a + 1]``; ``pairs`` sorted
+            lexicographically, a < b per row): stage 0 then visits only the pairs a
+            sort-and-sweep of the boxes produces (see "Sweep" below); ``code`` must come zeroed
+            (``WK_UNVISITED`` marks the rest).
         info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth.
 
     Broad phase (stage 0, O(G T + P)): per geom the swept spheres and their AABB (one
@@ -1078,6 +1278,23 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     sub-range is bounded first: when it alone shows every selected pair of cores within the
     margin, none can be culled and the other sub-ranges are skipped (early survival; the
     argument is in stage 0's comment; not for long windows, which read every sub-range).
+
+    Sweep (issue 12, sparse scaling; ``rows`` given): :func:`sweep_rows` produces the pairs
+    whose boxes are within ``thr = (margin + pad + 1e-12 smax)(1 + 1e-9) + 1e-12`` on every
+    axis (``smax`` >= 1 and >= every finite box coordinate, so >= each pair's ``scale``);
+    pairs with an unbounded box (half-spaces, no shape, NaN) are always produced. A pair left
+    out has a computed separation ``sep_raw > thr``, so its ``sep = sep_raw - pad - 1e-12 scale
+    >= thr - pad - 1e-12 smax > margin`` (the same expressions, monotone rounding; checked):
+    the pair loop would cull it too (``WK_UNVISITED``, gap NaN as for an AABB-culled pair). The
+    produced pairs get the pair loop's decisions, in row order (so the survivors and their
+    order are the pair loop's). Static-static pairs are marked from the rows of fixed geoms.
+    ``info[WI_BEST]`` stays the minimum sphere gap over ALL culled pairs: the sweep also
+    returns the smallest ``sep_raw`` left out (``m``), so every pair left out has a sphere gap
+    ``>= lk = m - pad - 1e-12 smax``; while the best found exceeds ``lk``, sweep again at a
+    larger threshold (the one giving ``lk >= best``; while nothing is found, doubling from the
+    largest box extent) and take
+    the sphere gaps of the newly produced pairs (:func:`_sweep_best`); any numerical doubt
+    falls back to the sphere gaps of every unvisited pair.
 
     Stage 1 (per survivor): the exact start-pose test at t0 (``posed_distance``:
     ``upper + approx < margin`` is a violation at t0); pairs of two bodies the plan does
@@ -1247,9 +1464,28 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         lo[g, r] = -np.inf
                         hi[g, r] = np.inf
             info[WI_PAD] = pad
+            # -- which pairs: all of them, or the sweep's (sorted rows in surv[:nrows]) -----------
+            nrows = pairs.shape[0]
+            swept = False
+            thr, lk, smax, nb = 0.0, 0.0, 1.0, 0
+            order = np.empty(0, np.int64)
+            unb = order
+            sep_min = np.full(1, np.inf)
+            if rows.shape[0] == G + 1 and nrows > 0:
+                swept, nrows, thr, lk, smax, order, nb, unb = _sweep_first(lo, hi, margin, pad, pairs, rows,
+                                                                           surv, sep_min)
+            if swept:
+                for a in range(G):        # static-static pairs among the rows left out
+                    if fixed[gp.body[a]] != 0:
+                        for k in range(rows[a], rows[a + 1]):
+                            if fixed[gp.body[pairs[k, 1]]] != 0:
+                                code[k] = WK_SS
+                                gap[k] = np.inf
             # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
             best = np.inf
-            for k in range(pairs.shape[0]):
+            for kk in range(nrows):
+                # the sweep's rows are read before slot S <= kk is written: in place
+                k = surv[kk] if swept else kk
                 ga, gb = pairs[k, 0], pairs[k, 1]
                 if fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0:
                     code[k] = WK_SS
@@ -1292,6 +1528,9 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     code[k] = WK_OPEN
                     surv[S] = k
                     S += 1
+            if swept:
+                best = _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows,
+                                   fixed, gp.body, code, sc, sr, surv, S, sep_min)
             info[WI_BEST] = best
             info[WI_SURV] = S
             k0 = 0

@@ -255,6 +255,16 @@ class ScenePack(NamedTuple):
     pair_ids: np.ndarray
 
 
+def lex_sorted_pairs(pair_ids: np.ndarray, ngeom: int) -> bool:
+    """True if the (P, 2) int rows are strictly increasing in (a, b) with 0 <= a < b < ngeom (O(P))."""
+    pid = np.asarray(pair_ids).reshape(-1, 2)
+    if len(pid) == 0:
+        return True
+    a, b = pid[:, 0].astype(np.int64), pid[:, 1].astype(np.int64)
+    lex = a * max(int(ngeom), 1) + b
+    return bool(a.min() >= 0 and b.max() < ngeom and (a < b).all() and (lex[1:] > lex[:-1]).all())
+
+
 def pack_scene(scene) -> ScenePack:
     """Pack a :class:`monitor.Scene` (all geoms, candidate pairs)."""
     shapes = [g.shape for g in scene.geoms]
@@ -293,5 +303,5 @@ def _curved_geoms(scene) -> list:
     return out
 
 
-__all__ = ["GeomPack", "ScenePack", "pack_shapes", "pack_scene", "KIND_HALFSPACE", "KIND_NONE", "CURVE_NONE",
-           "CURVE_CYLINDER", "CURVE_ELLIPSOID", "exact_support"]
+__all__ = ["GeomPack", "ScenePack", "pack_shapes", "pack_scene", "lex_sorted_pairs", "KIND_HALFSPACE",
+           "KIND_NONE", "CURVE_NONE", "CURVE_CYLINDER", "CURVE_ELLIPSOID", "exact_support"]
