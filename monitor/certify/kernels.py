@@ -1047,7 +1047,7 @@ WK_UNVISITED = 0
 gap not computed (``code`` is allocated zeroed; read as ``WK_CULLED`` with gap NaN)."""
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
 def _pair_row(pairs, rows, a, b):
     """Row k of ``pairs`` equal to (a, b) (a < b), or -1 (binary search in rows[a]:rows[a + 1])."""
     lo_k, hi_k = rows[a], rows[a + 1]
@@ -1063,7 +1063,7 @@ def _pair_row(pairs, rows, a, b):
     return -1
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
 def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0, sep_min):
     """Sort-and-sweep over swept AABBs: the rows of ``pairs`` whose boxes are within ``thr`` on every axis.
 
@@ -1183,7 +1183,7 @@ def _sweep_first(lo, hi, margin, pad, pairs, rows, surv, sep_min):
     return True, n, thr, lk, smax, order, nb, unb
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
 def _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows, fixed, gbody, code,
                 sc, sr, surv, S, sep_min):
     """The smallest sphere gap over ALL culled pairs, from ``best`` over the first sweep's (window_kernel).
