@@ -1,0 +1,297 @@
+"""Red team 8: the sort-and-sweep stage 0 of the window kernel (``engine.SWEEP_MIN_GEOMS``).
+
+A pair the sweep wrongly leaves out is a false certificate. Every case here certifies one scene
+and motion twice, with the cutover forced off (the pair loop visits every selected pair) and
+forced on (``SWEEP_MIN_GEOMS = 0``), on fresh scenes, and checks:
+
+* the two certificates are equal (verdict, clearance, earliest time, witness, checker mix, and
+  every pair's verdict, method and clearance);
+* stage 0 alone (k1 = 0) on the captured arguments: survivors, their order and codes, the pad
+  and the smallest culled gap equal; every pair the sweep left out is one the pair loop culled;
+* where the scene is made of translating spheres, an independent closed form: the exact
+  minimum distance of two spheres moving linearly (relative motion ``d(s) = d0 + s (d1 - d0)``,
+  ``s`` in [0, 1]); a certified window must have every selected pair >= margin apart, and a
+  violation must have some pair < margin + epsilon-ish slack (the witness's own distance).
+
+Attacks: exact ties in the sort (quantised coordinates, stacked identical geoms), zero-size and
+huge geoms, planes, static world geoms, welded children, mocap bodies, meshes, a rotating arm
+whose swept boxes grow, margin > 0, coordinates offset by 1e6..1e9 m, pair policies
+("all", "mujoco" with contype/conaffinity/<exclude>/<pair>, lists, allowed pairs, request
+subsets), and scenes right at the default cutover (127 / 128 / 129 geoms).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+import monitor
+from monitor.certify import engine
+from monitor.certify import kernels as KS
+
+_MESH = "0 0 0  0.1 0 0  0 0.1 0  0 0 0.1  0.08 0.08 0.05"
+
+
+# ----------------------------------------------------------------------------- helpers
+def _summary(cert) -> tuple:
+    w = cert.witness
+    wit = None if w is None else (w.time, w.geoms, tuple(np.asarray(w.point).tolist()), w.distance)
+    pairs = tuple((p.geoms, str(p.verdict), str(p.method), p.clearance) for p in cert.pairs)
+    return (str(cert.verdict), cert.clearance, cert.earliest_time, wit, cert.stats["checker_mix"],
+            cert.stats["pairs"], pairs)
+
+
+def _both(monkeypatch, make_scene, plan, kw) -> tuple:
+    """(certificate with the pair loop, with the sweep, stage-0 args of the sweep's first call)."""
+    certs, calls, rows_seen = [], [], []
+    orig_wk, orig_rows = engine._window_kernel, engine._sweep_rows
+
+    def spy(*a):
+        if a[7] == 0 and not calls:
+            calls.append(tuple(x.copy() if isinstance(x, np.ndarray) else x for x in a))
+        return orig_wk(*a)
+
+    def rows_spy(*a):
+        r = orig_rows(*a)
+        rows_seen.append(r.size)
+        return r
+
+    monkeypatch.setattr(engine, "_sweep_rows", rows_spy)
+    for cut in (10 ** 9, 0):
+        monkeypatch.setattr(engine, "SWEEP_MIN_GEOMS", cut)
+        if cut == 0:
+            monkeypatch.setattr(engine, "_window_kernel", spy)
+        certs.append(monitor.certify(make_scene(), plan, **kw))
+    monkeypatch.setattr(engine, "_window_kernel", orig_wk)
+    assert rows_seen and rows_seen[0] == 0 and rows_seen[-1] > 0, "the sweep was not taken"
+    return certs[0], certs[1], calls[0] if calls else None
+
+
+def _stage0(a: tuple, rows: np.ndarray) -> tuple:
+    (_KS, gp, mp, pairs, fixed, mov, route, _stage, _k0, _k1, prm, code, gap, surv, res, sc, sr, _rows,
+     info) = a
+    code, gap, surv = np.zeros_like(code), np.full_like(gap, -7.0), np.zeros_like(surv)
+    res, sc, sr, info = np.empty_like(res), np.empty_like(sc), np.empty_like(sr), np.zeros_like(info)
+    S = int(KS.window_kernel(gp, mp, pairs, fixed, mov, route, 0, 0, 0, prm, code, gap, surv, res, sc, sr,
+                             rows, info))
+    return S, code, surv, info
+
+
+def _check_stage0(a: tuple) -> tuple[int, int]:
+    """Stage 0 pair loop vs sweep on the same arguments; returns (left out, survivors)."""
+    S0, code0, surv0, info0 = _stage0(a, engine._NONE)
+    S1, code1, surv1, info1 = _stage0(a, a[17])
+    assert S1 == S0 and np.array_equal(surv1[:S1], surv0[:S0])
+    assert np.array_equal(code1[surv1[:S1]], code0[surv0[:S0]])
+    assert np.array_equal(info1[[KS.WI_PAD, KS.WI_BEST, KS.WI_SURV]], info0[[KS.WI_PAD, KS.WI_BEST, KS.WI_SURV]],
+                          equal_nan=True), (info1, info0)
+    out = np.flatnonzero(code1 == KS.WK_UNVISITED)
+    assert np.all(code0[out] == KS.WK_CULLED)
+    return len(out), S1
+
+
+def _assert_same(c0, c1) -> None:
+    s0, s1 = _summary(c0), _summary(c1)
+    assert s0[:6] == s1[:6], (s0[:6], s1[:6])
+    diff = [(p, q) for p, q in zip(s0[6], s1[6]) if p != q]
+    assert not diff, diff[:5]
+
+
+def _sphere_truth(model: mujoco.MjModel, plan: monitor.Plan, names_pairs, margin: float) -> float:
+    """Smallest exact surface distance over the window of the given sphere pairs (linear motion)."""
+    d0, d1 = mujoco.MjData(model), mujoco.MjData(model)
+    d0.qpos[:] = plan.qpos[0]
+    d1.qpos[:] = plan.qpos[-1]
+    mujoco.mj_kinematics(model, d0)
+    mujoco.mj_kinematics(model, d1)
+    best = np.inf
+    for na, nb in names_pairs:
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, na)
+        b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, nb)
+        p = d0.geom_xpos[a] - d0.geom_xpos[b]
+        q = d1.geom_xpos[a] - d1.geom_xpos[b]
+        v = q - p
+        vv = float(v @ v)
+        s = 0.0 if vv == 0.0 else min(1.0, max(0.0, -float(p @ v) / vv))
+        dist = float(np.linalg.norm(p + s * v)) - model.geom_size[a, 0] - model.geom_size[b, 0]
+        best = min(best, dist)
+    return best
+
+
+# ----------------------------------------------------------------------------- scenes
+def _sphere_field(rng: np.random.Generator, n: int, quantum: float, offset: float, spread: int,
+                  radii: tuple, moves: float, unique: bool = False) -> tuple[mujoco.MjModel, monitor.Plan]:
+    """n free spheres on a quantised lattice (many exact ties in every coordinate), pure translations
+    by ``moves`` lattice quanta at most per axis (unique lattice points when ``unique``)."""
+    parts = []
+    cells = rng.integers(0, spread, (n, 3))
+    if unique:
+        flat = rng.choice(spread ** 3, size=n, replace=False)
+        cells = np.stack([flat // spread ** 2, (flat // spread) % spread, flat % spread], axis=1)
+    for i in range(n):
+        x, y, z = ((cells[i] * quantum) + np.array([offset, offset, offset])).tolist()
+        r = float(radii[int(rng.integers(len(radii)))])
+        parts.append(f'<body name="b{i}" pos="{x!r} {y!r} {z!r}"><freejoint/>'
+                     f'<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+                     f'<geom name="g{i}" type="sphere" size="{r!r}"/></body>')
+    xml = (f'<mujoco><compiler inertiafromgeom="false"/><option gravity="0 0 0"/><worldbody>{"".join(parts)}'
+           '</worldbody></mujoco>')
+    model = mujoco.MjModel.from_xml_string(xml)
+    q0 = model.qpos0.copy()
+    q1 = q0.copy()
+    for j in range(model.njnt):
+        a = int(model.jnt_qposadr[j])
+        if moves >= 1:
+            q1[a:a + 3] += rng.integers(-int(moves), int(moves) + 1, 3) * quantum
+        else:
+            q1[a:a + 3] += rng.integers(-1, 2, 3) * (moves * quantum)
+    return model, monitor.Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), model=model)
+
+
+FIELD_CASES = [
+    # (seed, n, quantum, offset, spread, radii, moves, margin)
+    (1, 140, 0.05, 0.0, 12, (0.025, 0.05), 1, 0.0),          # gaps exactly 0 / one quantum
+    (2, 140, 0.05, 0.0, 12, (0.025,), 1, 0.05),              # margin = one quantum: boundary pairs
+    (3, 140, 0.1, 0.0, 6, (1e-9, 0.05), 0, 0.0),             # stacked, zero-size, static window
+    (4, 140, 0.05, 1e6, 12, (0.025, 0.05), 1, 0.01),          # 1e6 m offset
+    (5, 140, 0.5, 5e8, 12, (0.25,), 1, 0.0),                  # 5e8 m offset (1e9: the typed input limit)
+    (6, 130, 1.0, 0.0, 40, (0.5, 1e-9), 2, 0.3),             # sparse, nothing within the margin
+]
+# unique lattice points, radius 0.5 quantum - gap, motions of a fraction of a quantum: mostly
+# certified, with many pairs right at the cull threshold: (seed, n, quantum, offset, spread, radii,
+# moves, margin)
+NEAR_CASES = [
+    (21, 150, 0.1, 0.0, 7, (0.04,), 0.25, 0.0),               # gap 0.02 - 2 * 0.025 motion: touching
+    (22, 150, 0.1, 0.0, 7, (0.04,), 0.05, 0.01),              # gap 0.02 - 0.01 = margin: boundary
+    (23, 150, 0.1, 0.0, 7, (0.0499999,), 0.0, 0.0),           # static, gap 2e-7
+    (24, 150, 0.125, 1e6, 7, (0.0625 - 2.0 ** -10,), 0.0, 2.0 ** -10),   # 1e6 m, gap 2 * 2^-10, margin 2^-10
+    (25, 150, 0.25, 1e8, 7, (0.125 - 2.0 ** -6,), 0.125, 0.0),       # 1e8 m offset, moving
+    (26, 150, 0.1, 0.0, 7, (0.045, 1e-9), 0.02, 0.005),
+    (27, 150, 1.0, 0.0, 7, (0.1,), 0.05, 0.0),                # sparse: the smallest culled gap by widening
+    (28, 150, 1.0, 1e8, 7, (1e-9,), 0.0, 0.0),                # sparse, point-size, static, 1e8 m
+]
+
+
+ALL_FIELDS = [c + (False,) for c in FIELD_CASES] + [c + (True,) for c in NEAR_CASES]
+
+
+@pytest.mark.parametrize("case", range(len(ALL_FIELDS)), ids=[f"field{c[0]}" for c in ALL_FIELDS])
+def test_sphere_fields_sweep_equals_pair_loop_and_truth(monkeypatch, case):
+    seed, n, quantum, offset, spread, radii, moves, margin, unique = ALL_FIELDS[case]
+    rng = np.random.default_rng(seed)
+    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves, unique)
+    kw = {"epsilon": 1e-3, "margin": margin}
+    c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="all"), plan, kw)
+    _assert_same(c0, c1)
+    if a is not None:
+        _check_stage0(a)
+    names = [(p.geoms[0], p.geoms[1]) for p in c1.pairs]
+    truth = _sphere_truth(model, plan, names, margin)
+    if str(c1.verdict) == "certified":
+        assert truth >= margin, (truth, margin)
+        assert c1.clearance <= truth, (c1.clearance, truth)
+
+
+def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0) -> mujoco.MjModel:
+    """n free bodies of every kind, welded children, a mocap body, a rotating arm, a huge static box,
+    a floor plane, static world geoms, contype bits, an <exclude> and an explicit <pair>."""
+    parts = []
+    for i in range(n):
+        x, y, z = np.round(rng.uniform(0.0, 1.5, 3), 2) + (offset, offset, offset + 0.3)
+        kind = int(rng.integers(6))
+        ct, ca = int(rng.integers(0, 4)), int(rng.integers(0, 4))
+        geom = [f'type="box" size="{rng.uniform(0.02, 0.08):.3f} 0.04 0.03"',
+                f'type="sphere" size="{rng.uniform(0.02, 0.08):.3f}"',
+                'type="capsule" size="0.03" fromto="0 0 0 0.1 0 0"', 'type="mesh" mesh="m"',
+                'type="ellipsoid" size="0.05 0.03 0.02"', 'type="cylinder" size="0.03 0.05"'][kind]
+        child = ""
+        if rng.random() < 0.3:
+            child = f'<body name="c{i}" pos="0.05 0 0"><geom name="cg{i}" type="sphere" size="0.03"/></body>'
+        parts.append(f'<body name="b{i}" pos="{x:.3f} {y:.3f} {z:.3f}"><freejoint/>'
+                     f'<geom name="g{i}" {geom} contype="{ct}" conaffinity="{ca}"/>{child}</body>')
+    o = offset
+    world = "".join(f'<geom name="w{j}" type="box" size="0.1 0.1 0.1" pos="{p[0] + o:.3f} {p[1] + o:.3f} {o + 0.3}"/>'
+                    for j, p in enumerate(np.round(rng.uniform(0.0, 1.5, (3, 2)), 2)))
+    arm = (f'<body name="arm" pos="{o + 0.75} {o + 0.75} {o + 0.6}"><joint name="hinge" type="hinge" axis="0 0 1"/>'
+           '<geom name="armg" type="capsule" size="0.02" fromto="0 0 0 0.7 0 0"/></body>')
+    mocap = f'<body name="mc" mocap="true" pos="{o + 0.4} {o + 0.4} {o + 0.4}"><geom name="mcg" type="box" size="0.05 0.05 0.05"/></body>'
+    huge = f'<geom name="huge" type="box" size="1e4 1e4 0.01" pos="{o} {o} {o - 1.0}"/>'
+    xml = (f'<mujoco><option gravity="0 0 0"/><asset><mesh name="m" vertex="{_MESH}"/></asset>'
+           f'<worldbody><geom name="floor" type="plane" size="5 5 0.1" pos="0 0 {o}"/>{huge}{world}{arm}{mocap}'
+           f'{"".join(parts)}</worldbody>'
+           f'<contact><exclude body1="b0" body2="b1"/><pair geom1="g2" geom2="g3"/>'
+           f'<pair geom1="g4" geom2="armg"/></contact></mujoco>')
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def _mixed_plan(model: mujoco.MjModel, rng: np.random.Generator, step: float, spin: float) -> monitor.Plan:
+    q0 = model.qpos0.copy()
+    q1 = q0.copy()
+    for j in range(model.njnt):
+        a = int(model.jnt_qposadr[j])
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+            q1[a] += spin
+            continue
+        q1[a:a + 3] += rng.normal(size=3) * step
+        w = rng.normal(size=3) * 0.3
+        quat = np.zeros(4)
+        mujoco.mju_axisAngle2Quat(quat, w / np.linalg.norm(w), float(np.linalg.norm(w)))
+        q1[a + 3:a + 7] = quat
+    return monitor.Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), model=model)
+
+
+MIXED_CASES = [
+    # (seed, n bodies, offset, policy, margin, spin)
+    (11, 40, 0.0, "all", 0.0, 3.0),
+    (12, 40, 0.0, "mujoco", 0.05, 1.0),
+    (13, 40, 0.0, "list", 0.02, 6.0),
+    (14, 40, 0.0, "allowed", 0.0, 0.5),
+    (15, 40, 0.0, "subset", 0.1, 2.0),
+    (16, 40, 1e6, "all", 0.01, 3.0),
+]
+
+
+@pytest.mark.parametrize("case", range(len(MIXED_CASES)), ids=[f"mixed{c[0]}-{c[3]}" for c in MIXED_CASES])
+def test_mixed_scenes_sweep_equals_pair_loop(monkeypatch, case):
+    seed, n, offset, policy, margin, spin = MIXED_CASES[case]
+    rng = np.random.default_rng(seed)
+    model = _mixed_model(rng, n, offset)
+    plan = _mixed_plan(model, rng, 0.08, spin)
+    kw: dict = {"epsilon": 1e-3, "margin": margin}
+    every = monitor.Scene.from_model(model, pairs="all").candidate_pairs
+    if policy == "list":
+        pick = [every[i] for i in rng.choice(len(every), size=len(every) // 2, replace=False)]
+
+        def make():
+            return monitor.Scene.from_model(model, pairs=pick)
+    elif policy == "allowed":
+        allow = [every[i] for i in rng.choice(len(every), 60)]
+
+        def make():
+            return monitor.Scene.from_model(model, pairs="all", allowed=allow)
+    else:
+        def make():
+            return monitor.Scene.from_model(model, pairs="mujoco" if policy == "mujoco" else "all")
+    if policy == "subset":
+        kw["pairs"] = [every[i] for i in sorted(rng.choice(len(every), size=len(every) // 3, replace=False))]
+    c0, c1, a = _both(monkeypatch, make, plan, kw)
+    _assert_same(c0, c1)
+    if a is not None:
+        _check_stage0(a)
+
+
+@pytest.mark.parametrize("n_geoms", [127, 128, 129])
+def test_default_cutover_boundary(monkeypatch, n_geoms):
+    """At the default SWEEP_MIN_GEOMS: the sweep is taken from it on, and equals the pair loop."""
+    rng = np.random.default_rng(n_geoms)
+    model, plan = _sphere_field(rng, n_geoms, 0.05, 0.0, 10, (0.025, 0.05), 1)
+    assert model.ngeom == n_geoms
+    taken = []
+    orig = engine._sweep_rows
+    monkeypatch.setattr(engine, "_sweep_rows", lambda *a: taken.append(orig(*a).size) or orig(*a))
+    c_default = monitor.certify(monitor.Scene.from_model(model, pairs="all"), plan, epsilon=1e-3, margin=0.02)
+    assert (taken[-1] > 0) == (n_geoms >= engine.SWEEP_MIN_GEOMS)
+    monkeypatch.setattr(engine, "SWEEP_MIN_GEOMS", 10 ** 9)
+    c_loop = monitor.certify(monitor.Scene.from_model(model, pairs="all"), plan, epsilon=1e-3, margin=0.02)
+    _assert_same(c_loop, c_default)
