@@ -193,12 +193,12 @@ def test_sphere_fields_sweep_equals_pair_loop_and_truth(monkeypatch, case):
         assert c1.clearance <= truth, (c1.clearance, truth)
 
 
-def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0) -> mujoco.MjModel:
+def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0, extent: float = 1.5) -> mujoco.MjModel:
     """n free bodies of every kind, welded children, a mocap body, a rotating arm, a huge static box,
     a floor plane, static world geoms, contype bits, an <exclude> and an explicit <pair>."""
     parts = []
     for i in range(n):
-        x, y, z = np.round(rng.uniform(0.0, 1.5, 3), 2) + (offset, offset, offset + 0.3)
+        x, y, z = np.round(rng.uniform(0.0, extent, 3), 2) + (offset, offset, offset + 0.3)
         kind = int(rng.integers(6))
         ct, ca = int(rng.integers(0, 4)), int(rng.integers(0, 4))
         geom = [f'type="box" size="{rng.uniform(0.02, 0.08):.3f} 0.04 0.03"',
@@ -242,23 +242,28 @@ def _mixed_plan(model: mujoco.MjModel, rng: np.random.Generator, step: float, sp
 
 
 MIXED_CASES = [
-    # (seed, n bodies, offset, policy, margin, spin)
-    (11, 40, 0.0, "all", 0.0, 3.0),
-    (12, 40, 0.0, "mujoco", 0.05, 1.0),
-    (13, 40, 0.0, "list", 0.02, 6.0),
-    (14, 40, 0.0, "allowed", 0.0, 0.5),
-    (15, 40, 0.0, "subset", 0.1, 2.0),
-    (16, 40, 1e6, "all", 0.01, 3.0),
+    # (seed, n bodies, offset, policy, margin, spin, extent, step, extra certify kwargs)
+    (11, 40, 0.0, "all", 0.0, 3.0, 1.5, 0.08, {}),
+    (12, 40, 0.0, "mujoco", 0.05, 1.0, 1.5, 0.08, {}),
+    (13, 40, 0.0, "list", 0.02, 6.0, 1.5, 0.08, {}),
+    (14, 40, 0.0, "allowed", 0.0, 0.5, 1.5, 0.08, {}),
+    (15, 40, 0.0, "subset", 0.1, 2.0, 1.5, 0.08, {}),
+    (16, 40, 1e6, "all", 0.01, 3.0, 1.5, 0.08, {}),
+    # sparse, small motions: certified or near it (the arm sweeps a circle of radius 0.7)
+    (17, 60, 0.0, "all", 0.01, 0.2, 6.0, 0.002, {}),
+    (18, 60, 0.0, "mujoco", 0.0, 0.0, 6.0, 0.002, {"method": "toleranced"}),
+    (19, 60, 0.0, "all", 0.02, 0.1, 6.0, 0.002, {"ongoing": "deepen"}),
+    (20, 60, 1e6, "subset", 0.0, 0.3, 6.0, 0.002, {"method": "toleranced"}),
 ]
 
 
 @pytest.mark.parametrize("case", range(len(MIXED_CASES)), ids=[f"mixed{c[0]}-{c[3]}" for c in MIXED_CASES])
 def test_mixed_scenes_sweep_equals_pair_loop(monkeypatch, case):
-    seed, n, offset, policy, margin, spin = MIXED_CASES[case]
+    seed, n, offset, policy, margin, spin, extent, step, extra = MIXED_CASES[case]
     rng = np.random.default_rng(seed)
-    model = _mixed_model(rng, n, offset)
-    plan = _mixed_plan(model, rng, 0.08, spin)
-    kw: dict = {"epsilon": 1e-3, "margin": margin}
+    model = _mixed_model(rng, n, offset, extent)
+    plan = _mixed_plan(model, rng, step, spin)
+    kw: dict = {"epsilon": 1e-3, "margin": margin, **extra}
     every = monitor.Scene.from_model(model, pairs="all").candidate_pairs
     if policy == "list":
         pick = [every[i] for i in rng.choice(len(every), size=len(every) // 2, replace=False)]
@@ -295,3 +300,108 @@ def test_default_cutover_boundary(monkeypatch, n_geoms):
     monkeypatch.setattr(engine, "SWEEP_MIN_GEOMS", 10 ** 9)
     c_loop = monitor.certify(monitor.Scene.from_model(model, pairs="all"), plan, epsilon=1e-3, margin=0.02)
     _assert_same(c_loop, c_default)
+
+
+def _captured(monkeypatch, seed: int, unique: bool, radii: tuple, quantum: float, moves: float) -> tuple:
+    rng = np.random.default_rng(seed)
+    model, plan = _sphere_field(rng, 140, quantum, 0.0, 7, radii, moves, unique)
+    _c0, _c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="all"), plan,
+                        {"epsilon": 1e-3, "margin": 0.0})
+    assert a is not None
+    return a
+
+
+# margins and pads from 0 to overflow: the sweep's threshold is unsound (-> the pair loop) or sound
+_MARGINS = [0.0, 5e-324, 1e-300, 1e-12, 0.01, 0.05, 0.5, 3.0, 1e3, 1e12, 1e300, 1.7e308, np.inf, -1e-3, -1.0]
+_PADS = [(0.0, 0.0), (1e-12, 0.0), (0.0, 1e-3), (0.0, 0.5), (0.0, 1e300), (1e-3, 0.0)]
+
+
+def test_stage0_equal_for_extreme_margins_and_pads(monkeypatch):
+    """Stage 0 replayed with the margin / rounding pads pushed from 0 to overflow (and below 0)."""
+    a = _captured(monkeypatch, 31, True, (0.04,), 0.1, 0.2)
+    checked = 0
+    for margin in _MARGINS:
+        for rel, ab in _PADS:
+            prm = a[10].copy()
+            prm[KS.WP_MARGIN], prm[KS.WP_REL], prm[KS.WP_ABS] = margin, rel, ab
+            _check_stage0(a[:10] + (prm,) + a[11:])
+            checked += 1
+    assert checked == len(_MARGINS) * len(_PADS)
+
+
+# bounding radii from zero to near overflow on a few geoms (zero-size, huge, boxes at +-1e300)
+_BRADS = [0.0, 5e-324, 1e-300, 1e-9, 1e6, 1e9, 1e150, 1e300, 1.7e308, np.inf, np.nan]
+
+
+def test_stage0_equal_for_extreme_geom_radii(monkeypatch):
+    """Stage 0 replayed with some geoms' bounding radii (hence swept boxes) pushed to the extremes:
+    the sweep's smax / span / widening sweeps and the unbounded-box rows."""
+    a = _captured(monkeypatch, 32, True, (0.04,), 0.1, 0.2)
+    gp = a[1]
+    rng = np.random.default_rng(32)
+    out_total = 0
+    for r in _BRADS:
+        for picks in (1, 3, 20):
+            brad = gp.brad.copy()
+            brad[rng.choice(len(brad), picks, replace=False)] = r
+            b = a[:1] + (gp._replace(brad=brad),) + a[2:]
+            for margin in (0.0, 0.05):
+                prm = a[10].copy()
+                prm[KS.WP_MARGIN] = margin
+                out, _S = _check_stage0(b[:10] + (prm,) + b[11:])
+                out_total += out
+    assert out_total > 0
+
+
+def _fuzz_field(seed: int) -> tuple:
+    """A random sphere-lattice case (seeded): quantum, offset, radii and motion drawn per seed."""
+    rng = np.random.default_rng(1000 + seed)
+    quantum = float(rng.choice([0.05, 0.1, 0.125, 0.5, 1.0]))
+    offset = float(rng.choice([0.0, 0.0, 1e3, 1e6, 1e8]))
+    gap = float(rng.choice([0.0, 2.0 ** -20, 2.0 ** -10, 0.01, 0.1])) * quantum
+    radii = (0.5 * quantum - gap, float(rng.choice([1e-9, 0.25 * quantum])))
+    moves = float(rng.choice([0.0, 0.01, 0.05, 0.25, 1.0]))
+    margin = float(rng.choice([0.0, 0.0, gap, 0.5 * gap, 0.1 * quantum]))
+    return (seed, int(rng.integers(128, 200)), quantum, offset, int(rng.integers(6, 9)), radii, moves, margin,
+            bool(rng.random() < 0.8))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(60))
+def test_fuzz_sphere_fields(monkeypatch, seed):
+    """Seeded random lattices: sweep == pair loop, and certified => the closed-form distance >= margin."""
+    case = _fuzz_field(seed)
+    _seed, n, quantum, offset, spread, radii, moves, margin, unique = case
+    rng = np.random.default_rng(seed)
+    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves, unique)
+    c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="all"), plan,
+                      {"epsilon": 1e-3, "margin": margin})
+    _assert_same(c0, c1)
+    if a is not None:
+        _check_stage0(a)
+    truth = _sphere_truth(model, plan, [(p.geoms[0], p.geoms[1]) for p in c1.pairs], margin)
+    if str(c1.verdict) == "certified":
+        assert truth >= margin and c1.clearance <= truth, (truth, c1.clearance, margin)
+    if str(c1.verdict) == "violation":
+        assert truth < margin + 1e-3, (truth, margin)     # within epsilon of the margin at least
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(30))
+def test_fuzz_mixed_scenes(monkeypatch, seed):
+    """Seeded random mixed scenes and policies: sweep == pair loop (certificate and stage 0)."""
+    rng = np.random.default_rng(2000 + seed)
+    policy = str(rng.choice(["all", "mujoco", "subset"]))
+    model = _mixed_model(rng, int(rng.integers(40, 80)), float(rng.choice([0.0, 1e5])),
+                         float(rng.choice([1.5, 3.0, 6.0])))
+    plan = _mixed_plan(model, rng, float(rng.choice([0.002, 0.02, 0.08])), float(rng.choice([0.0, 0.5, 3.0])))
+    kw: dict = {"epsilon": 1e-3, "margin": float(rng.choice([0.0, 0.01, 0.05])),
+                "method": str(rng.choice(["auto", "toleranced"]))}
+    every = monitor.Scene.from_model(model, pairs="all").candidate_pairs
+    if policy == "subset":
+        kw["pairs"] = [every[i] for i in sorted(rng.choice(len(every), size=len(every) // 2, replace=False))]
+    c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="mujoco" if policy == "mujoco"
+                                                                     else "all"), plan, kw)
+    _assert_same(c0, c1)
+    if a is not None:
+        _check_stage0(a)
