@@ -84,8 +84,8 @@ def _check_stage0(a: tuple) -> tuple[int, int]:
     S1, code1, surv1, info1 = _stage0(a, a[17])
     assert S1 == S0 and np.array_equal(surv1[:S1], surv0[:S0])
     assert np.array_equal(code1[surv1[:S1]], code0[surv0[:S0]])
-    assert np.array_equal(info1[[KS.WI_PAD, KS.WI_BEST, KS.WI_SURV]], info0[[KS.WI_PAD, KS.WI_BEST, KS.WI_SURV]],
-                          equal_nan=True), (info1, info0)
+    keep = [KS.WI_PAD, KS.WI_BEST, KS.WI_SURV]
+    assert np.array_equal(info1[keep], info0[keep], equal_nan=True), (info1, info0)
     out = np.flatnonzero(code1 == KS.WK_UNVISITED)
     assert np.all(code0[out] == KS.WK_CULLED)
     return len(out), S1
@@ -99,10 +99,15 @@ def _assert_same(c0, c1) -> None:
 
 
 def _sphere_truth(model: mujoco.MjModel, plan: monitor.Plan, names_pairs, margin: float) -> float:
-    """Smallest exact surface distance over the window of the given sphere pairs (linear motion)."""
+    """Smallest exact surface distance over the window of the given sphere pairs (piecewise linear)."""
+    return min(_segment_truth(model, plan.qpos[i], plan.qpos[i + 1], names_pairs)
+               for i in range(len(plan.qpos) - 1))
+
+
+def _segment_truth(model: mujoco.MjModel, qa: np.ndarray, qb: np.ndarray, names_pairs) -> float:
     d0, d1 = mujoco.MjData(model), mujoco.MjData(model)
-    d0.qpos[:] = plan.qpos[0]
-    d1.qpos[:] = plan.qpos[-1]
+    d0.qpos[:] = qa
+    d1.qpos[:] = qb
     mujoco.mj_kinematics(model, d0)
     mujoco.mj_kinematics(model, d1)
     best = np.inf
@@ -121,9 +126,11 @@ def _sphere_truth(model: mujoco.MjModel, plan: monitor.Plan, names_pairs, margin
 
 # ----------------------------------------------------------------------------- scenes
 def _sphere_field(rng: np.random.Generator, n: int, quantum: float, offset: float, spread: int,
-                  radii: tuple, moves: float, unique: bool = False) -> tuple[mujoco.MjModel, monitor.Plan]:
+                  radii: tuple, moves: float, unique: bool = False,
+                  segments: int = 1) -> tuple[mujoco.MjModel, monitor.Plan]:
     """n free spheres on a quantised lattice (many exact ties in every coordinate), pure translations
-    by ``moves`` lattice quanta at most per axis (unique lattice points when ``unique``)."""
+    by ``moves`` lattice quanta at most per axis and segment (unique lattice points when ``unique``;
+    ``segments`` >= 9: a long window, more waypoints inside it than the kernel's sub-ranges)."""
     parts = []
     cells = rng.integers(0, spread, (n, 3))
     if unique:
@@ -138,15 +145,17 @@ def _sphere_field(rng: np.random.Generator, n: int, quantum: float, offset: floa
     xml = (f'<mujoco><compiler inertiafromgeom="false"/><option gravity="0 0 0"/><worldbody>{"".join(parts)}'
            '</worldbody></mujoco>')
     model = mujoco.MjModel.from_xml_string(xml)
-    q0 = model.qpos0.copy()
-    q1 = q0.copy()
-    for j in range(model.njnt):
-        a = int(model.jnt_qposadr[j])
-        if moves >= 1:
-            q1[a:a + 3] += rng.integers(-int(moves), int(moves) + 1, 3) * quantum
-        else:
-            q1[a:a + 3] += rng.integers(-1, 2, 3) * (moves * quantum)
-    return model, monitor.Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), model=model)
+    qs = [model.qpos0.copy()]
+    for _ in range(segments):
+        q1 = qs[-1].copy()
+        for j in range(model.njnt):
+            a = int(model.jnt_qposadr[j])
+            if moves >= 1:
+                q1[a:a + 3] += rng.integers(-int(moves), int(moves) + 1, 3) * quantum
+            else:
+                q1[a:a + 3] += rng.integers(-1, 2, 3) * (moves * quantum)
+        qs.append(q1)
+    return model, monitor.Plan(np.linspace(0.0, 0.1, segments + 1), np.stack(qs), model=model)
 
 
 FIELD_CASES = [
@@ -171,16 +180,22 @@ NEAR_CASES = [
     (27, 150, 1.0, 0.0, 7, (0.1,), 0.05, 0.0),                # sparse: the smallest culled gap by widening
     (28, 150, 1.0, 1e8, 7, (1e-9,), 0.0, 0.0),                # sparse, point-size, static, 1e8 m
 ]
+# long windows (12 segments: more waypoints inside than the kernel's 8 sub-ranges)
+LONG_CASES = [
+    (41, 150, 0.1, 0.0, 7, (0.04,), 0.02, 0.0, True, 12),
+    (42, 150, 0.1, 1e6, 7, (0.045,), 0.01, 0.002, True, 12),
+]
 
 
-ALL_FIELDS = [c + (False,) for c in FIELD_CASES] + [c + (True,) for c in NEAR_CASES]
+ALL_FIELDS = ([c + (False, 1) for c in FIELD_CASES] + [c + (True, 1) for c in NEAR_CASES]
+              + [tuple(c) for c in LONG_CASES])
 
 
 @pytest.mark.parametrize("case", range(len(ALL_FIELDS)), ids=[f"field{c[0]}" for c in ALL_FIELDS])
 def test_sphere_fields_sweep_equals_pair_loop_and_truth(monkeypatch, case):
-    seed, n, quantum, offset, spread, radii, moves, margin, unique = ALL_FIELDS[case]
+    seed, n, quantum, offset, spread, radii, moves, margin, unique, segments = ALL_FIELDS[case]
     rng = np.random.default_rng(seed)
-    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves, unique)
+    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves, unique, segments)
     kw = {"epsilon": 1e-3, "margin": margin}
     c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="all"), plan, kw)
     _assert_same(c0, c1)
@@ -193,7 +208,8 @@ def test_sphere_fields_sweep_equals_pair_loop_and_truth(monkeypatch, case):
         assert c1.clearance <= truth, (c1.clearance, truth)
 
 
-def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0, extent: float = 1.5) -> mujoco.MjModel:
+def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0,
+                 extent: float = 1.5) -> mujoco.MjModel:
     """n free bodies of every kind, welded children, a mocap body, a rotating arm, a huge static box,
     a floor plane, static world geoms, contype bits, an <exclude> and an explicit <pair>."""
     parts = []
@@ -211,14 +227,18 @@ def _mixed_model(rng: np.random.Generator, n: int, offset: float = 0.0, extent: 
         parts.append(f'<body name="b{i}" pos="{x:.3f} {y:.3f} {z:.3f}"><freejoint/>'
                      f'<geom name="g{i}" {geom} contype="{ct}" conaffinity="{ca}"/>{child}</body>')
     o = offset
-    world = "".join(f'<geom name="w{j}" type="box" size="0.1 0.1 0.1" pos="{p[0] + o:.3f} {p[1] + o:.3f} {o + 0.3}"/>'
+    world = "".join(f'<geom name="w{j}" type="box" size="0.1 0.1 0.1" '
+                    f'pos="{p[0] + o:.3f} {p[1] + o:.3f} {o + 0.3}"/>'
                     for j, p in enumerate(np.round(rng.uniform(0.0, 1.5, (3, 2)), 2)))
-    arm = (f'<body name="arm" pos="{o + 0.75} {o + 0.75} {o + 0.6}"><joint name="hinge" type="hinge" axis="0 0 1"/>'
+    arm = (f'<body name="arm" pos="{o + 0.75} {o + 0.75} {o + 0.6}">'
+           '<joint name="hinge" type="hinge" axis="0 0 1"/>'
            '<geom name="armg" type="capsule" size="0.02" fromto="0 0 0 0.7 0 0"/></body>')
-    mocap = f'<body name="mc" mocap="true" pos="{o + 0.4} {o + 0.4} {o + 0.4}"><geom name="mcg" type="box" size="0.05 0.05 0.05"/></body>'
+    mocap = (f'<body name="mc" mocap="true" pos="{o + 0.4} {o + 0.4} {o + 0.4}">'
+             '<geom name="mcg" type="box" size="0.05 0.05 0.05"/></body>')
     huge = f'<geom name="huge" type="box" size="1e4 1e4 0.01" pos="{o} {o} {o - 1.0}"/>'
     xml = (f'<mujoco><option gravity="0 0 0"/><asset><mesh name="m" vertex="{_MESH}"/></asset>'
-           f'<worldbody><geom name="floor" type="plane" size="5 5 0.1" pos="0 0 {o}"/>{huge}{world}{arm}{mocap}'
+           f'<worldbody><geom name="floor" type="plane" size="5 5 0.1" pos="0 0 {o}"/>'
+           f'{huge}{world}{arm}{mocap}'
            f'{"".join(parts)}</worldbody>'
            f'<contact><exclude body1="b0" body2="b1"/><pair geom1="g2" geom2="g3"/>'
            f'<pair geom1="g4" geom2="armg"/></contact></mujoco>')
@@ -362,8 +382,9 @@ def _fuzz_field(seed: int) -> tuple:
     radii = (0.5 * quantum - gap, float(rng.choice([1e-9, 0.25 * quantum])))
     moves = float(rng.choice([0.0, 0.01, 0.05, 0.25, 1.0]))
     margin = float(rng.choice([0.0, 0.0, gap, 0.5 * gap, 0.1 * quantum]))
+    segments = int(rng.choice([1, 1, 3, 12]))
     return (seed, int(rng.integers(128, 200)), quantum, offset, int(rng.integers(6, 9)), radii, moves, margin,
-            bool(rng.random() < 0.8))
+            bool(rng.random() < 0.8), segments)
 
 
 @pytest.mark.slow
@@ -371,9 +392,9 @@ def _fuzz_field(seed: int) -> tuple:
 def test_fuzz_sphere_fields(monkeypatch, seed):
     """Seeded random lattices: sweep == pair loop, and certified => the closed-form distance >= margin."""
     case = _fuzz_field(seed)
-    _seed, n, quantum, offset, spread, radii, moves, margin, unique = case
+    _seed, n, quantum, offset, spread, radii, moves, margin, unique, segments = case
     rng = np.random.default_rng(seed)
-    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves, unique)
+    model, plan = _sphere_field(rng, n, quantum, offset, spread, radii, moves / segments, unique, segments)
     c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="all"), plan,
                       {"epsilon": 1e-3, "margin": margin})
     _assert_same(c0, c1)
@@ -400,8 +421,8 @@ def test_fuzz_mixed_scenes(monkeypatch, seed):
     every = monitor.Scene.from_model(model, pairs="all").candidate_pairs
     if policy == "subset":
         kw["pairs"] = [every[i] for i in sorted(rng.choice(len(every), size=len(every) // 2, replace=False))]
-    c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs="mujoco" if policy == "mujoco"
-                                                                     else "all"), plan, kw)
+    spec = "mujoco" if policy == "mujoco" else "all"
+    c0, c1, a = _both(monkeypatch, lambda: monitor.Scene.from_model(model, pairs=spec), plan, kw)
     _assert_same(c0, c1)
     if a is not None:
         _check_stage0(a)
