@@ -191,7 +191,11 @@ ALL_FIELDS = ([c + (False, 1) for c in FIELD_CASES] + [c + (True, 1) for c in NE
               + [tuple(c) for c in LONG_CASES])
 
 
-@pytest.mark.parametrize("case", range(len(ALL_FIELDS)), ids=[f"field{c[0]}" for c in ALL_FIELDS])
+_FAST_FIELDS = {22, 24, 27}     # the rest run with -m slow (the fast suite's budget)
+
+
+@pytest.mark.parametrize("case", [pytest.param(i, id=f"field{c[0]}", marks=() if c[0] in _FAST_FIELDS
+                                               else pytest.mark.slow) for i, c in enumerate(ALL_FIELDS)])
 def test_sphere_fields_sweep_equals_pair_loop_and_truth(monkeypatch, case):
     seed, n, quantum, offset, spread, radii, moves, margin, unique, segments = ALL_FIELDS[case]
     rng = np.random.default_rng(seed)
@@ -277,7 +281,11 @@ MIXED_CASES = [
 ]
 
 
-@pytest.mark.parametrize("case", range(len(MIXED_CASES)), ids=[f"mixed{c[0]}-{c[3]}" for c in MIXED_CASES])
+_FAST_MIXED = {12, 19}
+
+
+@pytest.mark.parametrize("case", [pytest.param(i, id=f"mixed{c[0]}-{c[3]}", marks=() if c[0] in _FAST_MIXED
+                                               else pytest.mark.slow) for i, c in enumerate(MIXED_CASES)])
 def test_mixed_scenes_sweep_equals_pair_loop(monkeypatch, case):
     seed, n, offset, policy, margin, spin, extent, step, extra = MIXED_CASES[case]
     rng = np.random.default_rng(seed)
@@ -306,7 +314,8 @@ def test_mixed_scenes_sweep_equals_pair_loop(monkeypatch, case):
         _check_stage0(a)
 
 
-@pytest.mark.parametrize("n_geoms", [127, 128, 129])
+@pytest.mark.parametrize("n_geoms", [pytest.param(127, marks=pytest.mark.slow), 128,
+                                     pytest.param(129, marks=pytest.mark.slow)])
 def test_default_cutover_boundary(monkeypatch, n_geoms):
     """At the default SWEEP_MIN_GEOMS: the sweep is taken from it on, and equals the pair loop."""
     rng = np.random.default_rng(n_geoms)
@@ -443,6 +452,7 @@ def _gate_model(n_static: int, n_free: int) -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_string(xml)
 
 
+@pytest.mark.slow
 def test_gate_steps_equal_with_and_without_the_sweep(monkeypatch):
     """A Gate (reuse on: the resting boxes' pairs are reused, the rest certified as a subset) driving a
     slider into a row of world spheres: the same reports with the sweep forced on and off."""
@@ -465,3 +475,22 @@ def test_gate_steps_equal_with_and_without_the_sweep(monkeypatch):
     assert runs[0] == runs[1]
     assert runs[0][-1] > 0                                  # the reuse split ran
     assert {o[0] for o in runs[0][:-1]} == {"certified", "violation"}
+
+
+def test_stage0_equal_when_sphere_distances_overflow(monkeypatch):
+    """FINDING (kernel level): geoms whose swept-sphere centres are ~1e154 m apart. The pair loop's
+    sphere test squares the centre difference, which overflows: ``sphere_gap`` is -inf and the pair
+    SURVIVES (when its box test did not cull it first: the running best is still inf on the first
+    rows). The sweep leaves the same pair out (its box separation > threshold) and culls it, so
+    the two stage 0s differ (survivors, hence verdicts / pair methods). Not reachable through the
+    public API (the scene pack refuses coordinates beyond 1e9 m), but the sweep's argument "left
+    out => the pair loop culls it" is false there; the fix keeps the pair loop when the largest
+    finite box coordinate is >= 1e150 (no squared difference of coordinates can overflow below it).
+    """
+    a = _captured(monkeypatch, 32, True, (0.04,), 0.1, 0.2)
+    gp = a[1]
+    for far in (1e150, 1e153, 5e153, 1e154, 3e154, 1e155, 1e200):
+        bc = gp.bcenter.copy()
+        bc[0], bc[1], bc[2] = (far, 0.0, 0.0), (-far, 0.0, 0.0), (0.0, far, 0.0)
+        b = a[:1] + (gp._replace(bcenter=bc),) + a[2:]
+        _check_stage0(b)
