@@ -25,6 +25,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
+from test_broadphase_sweep import _run_stage0, _summary  # sweep2's stage-0 replay and summary
 
 import monitor
 from monitor.certify import engine
@@ -34,14 +35,6 @@ _MESH = "0 0 0  0.1 0 0  0 0.1 0  0 0 0.1  0.08 0.08 0.05"
 
 
 # ----------------------------------------------------------------------------- helpers
-def _summary(cert) -> tuple:
-    w = cert.witness
-    wit = None if w is None else (w.time, w.geoms, tuple(np.asarray(w.point).tolist()), w.distance)
-    pairs = tuple((p.geoms, str(p.verdict), str(p.method), p.clearance) for p in cert.pairs)
-    return (str(cert.verdict), cert.clearance, cert.earliest_time, wit, cert.stats["checker_mix"],
-            cert.stats["pairs"], pairs)
-
-
 def _both(monkeypatch, make_scene, plan, kw) -> tuple:
     """(certificate with the pair loop, with the sweep, stage-0 args of the sweep's first call)."""
     certs, calls, rows_seen = [], [], []
@@ -69,12 +62,8 @@ def _both(monkeypatch, make_scene, plan, kw) -> tuple:
 
 
 def _stage0(a: tuple, rows: np.ndarray) -> tuple:
-    (_KS, gp, mp, pairs, fixed, mov, route, _stage, _k0, _k1, prm, code, gap, surv, res, sc, sr, _rows,
-     info) = a
-    code, gap, surv = np.zeros_like(code), np.full_like(gap, -7.0), np.zeros_like(surv)
-    res, sc, sr, info = np.empty_like(res), np.empty_like(sc), np.empty_like(sr), np.zeros_like(info)
-    S = int(KS.window_kernel(gp, mp, pairs, fixed, mov, route, 0, 0, 0, prm, code, gap, surv, res, sc, sr,
-                             rows, info))
+    """(S, code, surv, info) of stage 0 alone on fresh outputs (the sweep's tests' replay)."""
+    S, code, _gap, surv, _sc, _sr, info = _run_stage0(a, rows)
     return S, code, surv, info
 
 
@@ -258,10 +247,9 @@ def _mixed_plan(model: mujoco.MjModel, rng: np.random.Generator, step: float, sp
             q1[a] += spin
             continue
         q1[a:a + 3] += rng.normal(size=3) * step
-        w = rng.normal(size=3) * 0.3
-        quat = np.zeros(4)
-        mujoco.mju_axisAngle2Quat(quat, w / np.linalg.norm(w), float(np.linalg.norm(w)))
-        q1[a + 3:a + 7] = quat
+        rotvec = rng.normal(size=3) * 0.3                  # a rotation of |rotvec| rad about it
+        angle = float(np.linalg.norm(rotvec))
+        q1[a + 3:a + 7] = np.r_[np.cos(0.5 * angle), np.sin(0.5 * angle) * rotvec / angle]
     return monitor.Plan(np.array([0.0, 0.1]), np.stack([q0, q1]), model=model)
 
 
