@@ -266,6 +266,8 @@ MIXED_CASES = [
     (18, 60, 0.0, "mujoco", 0.0, 0.0, 6.0, 0.002, {"method": "toleranced"}),
     (19, 60, 0.0, "all", 0.02, 0.1, 6.0, 0.002, {"ongoing": "deepen"}),
     (20, 60, 1e6, "subset", 0.0, 0.3, 6.0, 0.002, {"method": "toleranced"}),
+    (21, 60, 0.0, "all", 0.01, 0.2, 6.0, 0.002, {"window": (0.02, 0.07)}),     # a sub-window
+    (22, 40, 0.0, "all", 0.0, 3.0, 1.5, 0.08, {"budget": {"tests": 7}}),      # chunk 1, budget spent
 ]
 
 
