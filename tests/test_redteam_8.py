@@ -35,6 +35,16 @@ _MESH = "0 0 0  0.1 0 0  0 0.1 0  0 0 0.1  0.08 0.08 0.05"
 
 
 # ----------------------------------------------------------------------------- helpers
+def _copy_like(new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    """A copy of ``new`` with ``old``'s writeable flag: numba types that flag, and a replay with
+    other flags than the engine's call would compile (and keep) a second ``window_kernel``
+    overload in this process, which turns off the engine's direct entry-point call for every
+    later test (test_engine_kernel_decided counts on one overload)."""
+    out = new.copy()
+    out.flags.writeable = bool(old.flags.writeable)
+    return out
+
+
 def _both(monkeypatch, make_scene, plan, kw) -> tuple:
     """(certificate with the pair loop, with the sweep, stage-0 args of the sweep's first call)."""
     certs, calls, rows_seen = [], [], []
@@ -42,7 +52,7 @@ def _both(monkeypatch, make_scene, plan, kw) -> tuple:
 
     def spy(*a):
         if a[7] == 0 and not calls:
-            calls.append(tuple(x.copy() if isinstance(x, np.ndarray) else x for x in a))
+            calls.append(tuple(_copy_like(x, x) if isinstance(x, np.ndarray) else x for x in a))
         return orig_wk(*a)
 
     def rows_spy(*a):
@@ -363,7 +373,7 @@ def test_stage0_equal_for_extreme_geom_radii(monkeypatch):
         for picks in (1, 3, 20):
             brad = gp.brad.copy()
             brad[rng.choice(len(brad), picks, replace=False)] = r
-            b = a[:1] + (gp._replace(brad=brad),) + a[2:]
+            b = a[:1] + (gp._replace(brad=_copy_like(brad, gp.brad)),) + a[2:]
             for margin in (0.0, 0.05):
                 prm = a[10].copy()
                 prm[KS.WP_MARGIN] = margin
@@ -482,7 +492,7 @@ def test_stage0_equal_when_sphere_distances_overflow(monkeypatch):
     for far in (1e150, 1e153, 5e153, 1e154, 3e154, 1e155, 1e200):
         bc = gp.bcenter.copy()
         bc[0], bc[1], bc[2] = (far, 0.0, 0.0), (-far, 0.0, 0.0), (0.0, far, 0.0)
-        b = a[:1] + (gp._replace(bcenter=bc),) + a[2:]
+        b = a[:1] + (gp._replace(bcenter=_copy_like(bc, gp.bcenter)),) + a[2:]
         _check_stage0(b)
 
 
@@ -501,7 +511,8 @@ def test_stage0_equal_for_odd_centres_kinds_and_static_flags(monkeypatch):
                 bc[rng.choice(len(bc), 4, replace=False), int(rng.integers(3))] = val
                 kind[rng.choice(len(kind), kind_py, replace=False)] = -2
                 fx[rng.random(len(fx)) < static_frac] = 1
-                b = (a[:1] + (gp._replace(bcenter=bc, kind=kind),) + a[2:4] + (fx,) + a[5:])
+                gp2 = gp._replace(bcenter=_copy_like(bc, gp.bcenter), kind=_copy_like(kind, gp.kind))
+                b = a[:1] + (gp2,) + a[2:4] + (_copy_like(fx, fixed),) + a[5:]
                 _check_stage0(b)
                 cases += 1
     assert cases == 36
