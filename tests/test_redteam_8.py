@@ -534,3 +534,18 @@ def test_request_subset_in_any_order(monkeypatch):
             continue      # a typed refusal (e.g. of the duplicate) is fine; equality is checked below
         _assert_same(c0, c1)
         assert c1.stats["pairs"] == len(pick)
+
+
+def test_sweep_replays_add_no_window_kernel_overload(monkeypatch):
+    """FINDING (tests): sweep2's stage-0 replay (``test_broadphase_sweep._stage0_calls`` /
+    ``_run_stage0``) copied the engine's read-only ``pairs`` into a writable array, so numba compiled
+    and kept a second ``window_kernel`` overload in the process; the engine then stops taking its
+    direct entry-point call, and ``test_engine_kernel_decided`` (2 tests) fails whenever it runs
+    after ``test_broadphase_sweep`` in the same process (xdist: order dependent)."""
+    from test_broadphase_sweep import CASES, _stage0_calls
+    _policy, _model, scene, plan, kw = CASES[0]
+    a = _stage0_calls(monkeypatch, scene, plan, kw)[0]
+    before = set(KS.window_kernel.overloads)
+    _run_stage0(a, a[17])
+    _run_stage0(a, engine._NONE)
+    assert set(KS.window_kernel.overloads) == before
