@@ -106,6 +106,12 @@ def _cases():
 CASES = _cases()
 
 
+def _frozen_copy(x: np.ndarray) -> np.ndarray:
+    out = x.copy()
+    out.flags.writeable = bool(x.flags.writeable)
+    return out
+
+
 def _stage0_calls(monkeypatch, scene, plan, kw) -> list[tuple]:
     """The arguments of every stage-0 ``window_kernel`` call of one certify (sweep forced)."""
     calls = []
@@ -113,7 +119,9 @@ def _stage0_calls(monkeypatch, scene, plan, kw) -> list[tuple]:
 
     def spy(*a):
         if a[7] == 0:
-            calls.append(tuple(x.copy() if isinstance(x, np.ndarray) else x for x in a))
+            # copies with the engine's writeable flags (numba types them: another flag would
+            # compile and keep a second window_kernel overload in the process; red team 8)
+            calls.append(tuple(_frozen_copy(x) if isinstance(x, np.ndarray) else x for x in a))
         return orig(*a)
 
     monkeypatch.setattr(engine, "_window_kernel", spy)
