@@ -1139,13 +1139,20 @@ def sweep_rows(lo, hi, order, nb, unb, thr, thr_old, pairs, rows, out, n0, sep_m
     return n
 
 
+_SWEEP_MAX_COORD = 1e150
+"""Largest finite box coordinate (m) for which :func:`_sweep_first` sweeps: below it no squared
+centre difference of :func:`sphere_gap` (|d|^2 <= 3 (2 smax)^2) overflows, so a left-out pair's
+sphere gap is finite and > margin as the pair loop computes it; above it, the pair loop."""
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _sweep_first(lo, hi, margin, pad, pairs, rows, surv, sep_min):
     """The first sweep of :func:`window_kernel`'s stage 0 (its docstring, "Sweep"): rows into ``surv``.
 
     Returns (swept, nrows, thr, lk, smax, order, nb, unb): ``swept`` False (nrows = P) when the
-    threshold is not numerically sound (then the pair loop visits every pair); else the sorted
-    produced rows are ``surv[:nrows]``, every pair left out has ``sep >= lk > margin``;
+    threshold is not numerically sound or a box coordinate reaches ``_SWEEP_MAX_COORD`` (then the
+    pair loop visits every pair); else the sorted produced rows are ``surv[:nrows]``, every pair
+    left out has ``sep >= lk > margin``;
     ``order[:nb]`` the bounded geoms by ``lo[:, 0]``, ``unb`` (G,) the unbounded flags.
     """
     G = lo.shape[0]
@@ -1173,7 +1180,9 @@ def _sweep_first(lo, hi, margin, pad, pairs, rows, surv, sep_min):
         order[i] = idx[perm[i]]
     thr = (margin + pad + 1e-12 * smax) * (1.0 + 1e-9) + 1e-12
     lk = thr - pad - 1e-12 * smax
-    if not (thr >= 0.0 and thr < np.inf and lk > margin):
+    # smax < 1e150: no squared centre difference in sphere_gap overflows (it would return -inf, a
+    # survivor of the pair loop, for a pair the sweep leaves out; red team 8)
+    if not (thr >= 0.0 and thr < np.inf and lk > margin and smax < _SWEEP_MAX_COORD):
         return False, pairs.shape[0], thr, lk, smax, order, nb, unb
     n = sweep_rows(lo, hi, order, nb, unb, thr, -1.0, pairs, rows, surv, 0, sep_min)
     surv[:n].sort()
