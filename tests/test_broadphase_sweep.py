@@ -244,3 +244,25 @@ def test_scene_records_sorted_pairs_and_sync_keeps_it():
         assert fresh.pair_ids is not before and fresh._sorted_pairs is fresh.pair_ids
     finally:
         model.geom_size[0, 0] = size      # the shared case's model, exactly as it was
+
+
+def test_small_scenes_use_a_window_kernel_without_the_sweep_and_both_take_the_direct_call(monkeypatch):
+    """Below the cutover the engine passes ``rows=None``: numba prunes the sweep's branches, so a
+    process that never sweeps never compiles the sweep (cold start). With both specialisations in
+    the process, each kind of call still takes its own overload's entry point."""
+    from numba.core import types
+
+    policy, model, scene, plan, kw = CASES[0]
+    monkeypatch.setattr(engine, "SWEEP_MIN_GEOMS", 0)
+    swept = monitor.certify(scene, plan, **kw)
+    monkeypatch.setattr(engine, "SWEEP_MIN_GEOMS", 10 ** 9)
+    loop = monitor.certify(scene, plan, **kw)
+    assert _summary(swept) == _summary(loop)
+    kinds = {isinstance(sig[engine._WK_ROWS], types.NoneType) for sig in KS.window_kernel.overloads}
+    assert kinds == {True, False}, list(KS.window_kernel.overloads)
+    if len(KS.window_kernel.overloads) == 2:
+        eps = engine._entry_points_by_rows(KS.window_kernel.overloads)
+        assert eps[0] is not None and eps[1] is not None and eps[0] is not eps[1]
+        for slot in (0, 1):
+            d = engine._WK_DIRECT[slot]
+            assert d is not None and d[2] is eps[slot]

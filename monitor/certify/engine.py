@@ -865,9 +865,13 @@ class _WindowPairs:
                               self.bnames)
 
 
-_WK_DIRECT: list = [None]
-"""(dispatcher, number of its overloads, entry point, gp, mp, pairs, fixed, moving) of the last
-:func:`_window_kernel` call that went through numba's dispatcher (see there)."""
+_WK_DIRECT: list = [None, None]
+"""Per ``rows`` kind (slot 0: None, slot 1: an array): (dispatcher, number of its overloads, entry
+point, gp, mp, pairs, fixed, moving) of the last :func:`_window_kernel` call of that kind that went
+through numba's dispatcher (see there)."""
+
+_WK_ROWS = 16
+"""Position of ``rows`` among :func:`monitor.certify.kernels.window_kernel`'s arguments."""
 
 
 def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarray, moving: np.ndarray,
@@ -877,36 +881,65 @@ def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarr
     numba's dispatcher types every argument on every call; for the two packs (47 arrays) that
     costs ~9 us per call (issue 12, pair-window floor: a trivial njit function taking them
     costs 12-15 us, its compiled entry point 3-6 us). The caller builds every other argument
-    afresh with fixed types (int64 / float64 C-contiguous writable arrays, Python ints), so the
-    argument types are decided by these five objects: when they are the very objects of the
-    last call that went through the dispatcher, and that dispatcher still has exactly one
-    compiled overload (the one it ran: a different argument type would have compiled a
-    second), the overload's entry point is called directly -- what the dispatcher itself calls
-    after typing. Anything else (another pack or flag array, a monkeypatched or non-numba
-    ``window_kernel``, several overloads) goes through the dispatcher. The packs and flag arrays
-    are never modified in place (the kernels only read them).
+    afresh with fixed types (int64 / float64 C-contiguous writable arrays, Python ints), but
+    for ``rows``: None (no sweep: a specialisation without the sweep's code) or an int64 array.
+    So the argument types are decided by these five objects and by ``rows is None``: when they
+    are the very objects of the last call of that kind that went through the dispatcher, and
+    that dispatcher still has the overloads it had then -- one, or two that differ in nothing but
+    the type of ``rows`` (so the one that ran is the one of this kind) -- the overload's entry
+    point is called directly: what the dispatcher itself calls after typing. Anything else
+    (another pack or flag array, a monkeypatched or non-numba ``window_kernel``, other overloads)
+    goes through the dispatcher. The packs and flag arrays are never modified in place (the
+    kernels only read them).
     """
     wk = KS.window_kernel
-    d = _WK_DIRECT[0]
+    slot = 0 if rest[-2] is None else 1
+    d = _WK_DIRECT[slot]
     if (d is not None and d[0] is wk and d[3] is gp and d[4] is mp and d[5] is pairs and d[6] is fixed
             and d[7] is moving and len(wk.overloads) == d[1]):
         return d[2](gp, mp, pairs, fixed, moving, *rest)
     out = wk(gp, mp, pairs, fixed, moving, *rest)
     if type(wk).__name__ == "CPUDispatcher":
         ovl = getattr(wk, "overloads", None)
-        if ovl is not None and len(ovl) == 1:
+        if ovl is not None and 1 <= len(ovl) <= 2:
             ep = _ENTRY_POINTS.get(id(wk))
-            if ep is None or ep[0] is not wk:
-                # (reading the overload costs ~50-100 us: once per dispatcher and process; a numba
-                # without this attribute keeps the dispatcher path)
-                ep = _ENTRY_POINTS[id(wk)] = (wk, getattr(next(iter(ovl.values())), "entry_point", None))
-            if ep[1] is not None:
-                _WK_DIRECT[0] = (wk, 1, ep[1], gp, mp, pairs, fixed, moving)
+            if ep is None or ep[0] is not wk or ep[1] != len(ovl):
+                # (reading the overloads costs ~50-100 us: once per dispatcher, overload count and
+                # process; a numba without these attributes keeps the dispatcher path)
+                ep = _ENTRY_POINTS[id(wk)] = (wk, len(ovl), _entry_points_by_rows(ovl))
+            if ep[2][slot] is not None:
+                _WK_DIRECT[slot] = (wk, len(ovl), ep[2][slot], gp, mp, pairs, fixed, moving)
     return out
 
 
+def _entry_points_by_rows(ovl: Any) -> tuple:
+    """(entry point of the overload whose ``rows`` is None, of the one whose ``rows`` is not), or None each.
+
+    Both None unless ``ovl`` (numba's ``overloads``: argument types -> compile result) holds one
+    overload, or two whose argument types differ only at ``rows`` (one None, one array).
+    """
+    from numba.core import types
+
+    sigs = list(ovl)
+    if len(sigs) == 2:
+        a, b = sigs
+        if len(a) != len(b) or len(a) <= _WK_ROWS or any(
+                x != y for i, (x, y) in enumerate(zip(a, b)) if i != _WK_ROWS):
+            return (None, None)
+    out = [None, None]
+    for sig, cres in ovl.items():
+        if len(sig) <= _WK_ROWS:
+            return (None, None)
+        slot = 0 if isinstance(sig[_WK_ROWS], types.NoneType) else 1
+        if out[slot] is not None:
+            return (None, None)
+        out[slot] = getattr(cres, "entry_point", None)
+    return tuple(out)
+
+
 _ENTRY_POINTS: dict[int, tuple] = {}
-"""id(dispatcher) -> (the dispatcher, the entry point of its single overload), read once per process."""
+"""id(dispatcher) -> (the dispatcher, its overload count, :func:`_entry_points_by_rows`), read once per
+process and overload count."""
 
 
 def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: str, t0: float, t1: float,
@@ -943,6 +976,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
     first = chunk if route_all else 0
+    if not rows.size:
+        rows = None  # window_kernel's specialisation without the sweep (see its "rows")
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, rows, info))
     done_to = min(first, S)

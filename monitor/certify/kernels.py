@@ -1269,7 +1269,8 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         surv: (P,) int64: surviving pair indices in slots [0, S).
         res: (>= S, R_SIZE) result rows per survivor slot (see :func:`pair_window`).
         sc, sr: (T, G, 3), (T, G) swept spheres (stage 0 output, kept for :func:`sphere_gap`).
-        rows: empty (the pair loop below visits every pair), or (G + 1,) int64 row starts of
+        rows: None or empty (the pair loop below visits every pair; None compiles a
+            specialisation without the sweep), or (G + 1,) int64 row starts of
             ``pairs`` (``pairs[k, 0] == a`` for k in ``rows[a]:rows[a + 1]``; ``pairs`` sorted
             lexicographically, a < b per row): stage 0 then visits only the pairs a
             sort-and-sweep of the boxes produces (see "Sweep" below); ``code`` must come zeroed
@@ -1480,16 +1481,20 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             order = np.empty(0, np.int64)
             unb = order
             sep_min = np.full(1, np.inf)
-            if rows.shape[0] == G + 1 and nrows > 0:
-                swept, nrows, thr, lk, smax, order, nb, unb = _sweep_first(lo, hi, margin, pad, pairs, rows,
-                                                                           surv, sep_min)
-            if swept:
-                for a in range(G):        # static-static pairs among the rows left out
-                    if fixed[gp.body[a]] != 0:
-                        for k in range(rows[a], rows[a + 1]):
-                            if fixed[gp.body[pairs[k, 1]]] != 0:
-                                code[k] = WK_SS
-                                gap[k] = np.inf
+            # ``rows is None``: numba prunes this branch and the one after the pair loop, so the
+            # sweep's kernels are not compiled into a window_kernel that never sweeps (the small
+            # scenes' specialisation; the engine passes None below SWEEP_MIN_GEOMS geoms)
+            if rows is not None:
+                if rows.shape[0] == G + 1 and nrows > 0:
+                    swept, nrows, thr, lk, smax, order, nb, unb = _sweep_first(lo, hi, margin, pad, pairs,
+                                                                               rows, surv, sep_min)
+                if swept:
+                    for a in range(G):        # static-static pairs among the rows left out
+                        if fixed[gp.body[a]] != 0:
+                            for k in range(rows[a], rows[a + 1]):
+                                if fixed[gp.body[pairs[k, 1]]] != 0:
+                                    code[k] = WK_SS
+                                    gap[k] = np.inf
             # -- per pair: static-static, half-space gap, AABB pre-test, sphere gap ---------------
             best = np.inf
             for kk in range(nrows):
@@ -1537,9 +1542,10 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     code[k] = WK_OPEN
                     surv[S] = k
                     S += 1
-            if swept:
-                best = _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows,
-                                   fixed, gp.body, code, sc, sr, surv, S, sep_min)
+            if rows is not None:
+                if swept:
+                    best = _sweep_best(lo, hi, order, nb, unb, thr, lk, smax, margin, pad, best, pairs, rows,
+                                       fixed, gp.body, code, sc, sr, surv, S, sep_min)
             info[WI_BEST] = best
             info[WI_SURV] = S
             k0 = 0
