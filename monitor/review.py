@@ -812,6 +812,156 @@ def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
         return False
 
 
+def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
+                     plan_msgs: dict[int, list[dict[str, Any]]],
+                     edits: list[tuple[int, dict[str, np.ndarray], int | None]], edits_bad_from: int | None,
+                     find: Callable[..., None], notes: list[str]) -> dict[str, int]:
+    """Re-simulate every window whose rows come from the gate's own rollout; check the episode's continuity.
+
+    For a log whose gate records rollouts (run metadata :data:`topics.ROLLOUTS_KEY`, format 3), each
+    plan says where its rows come from (:mod:`monitor.log.replay`). Here, on the attached MJB model
+    (bit-exact) with the logged in-place edits applied in window order:
+
+    * a ``"rollout"`` plan is re-simulated from its logged integration state and controls, and its
+      rows (times, qpos, held mocap poses) must be the logged ones bit for bit; else the first
+      differing row is named;
+    * records whose rollouts start at the same time of one episode (a step's proposal, its fallback,
+      the braking tail simulated after it) must start from the same physical state (time, qpos,
+      qvel, act, ...: :func:`monitor.log.replay.physics_index`);
+    * consecutive steps of one episode: the motion that ran in step i (its window, or the applied
+      record its replaced action names), re-simulated, must reach the next step's start time in
+      the physical state the next window's rollout starts from (an edited control or state breaks
+      it; so does user code that sets the state between steps without ``gate.reset()``).
+
+    A failure is CRITICAL when the window claims ``certified`` (its certificate is about rows that
+    are not the motion), UNVERIFIABLE otherwise. A log of a rollout gate whose plan lacks ``source``
+    (stripped) is the same. Under another MuJoCo version than the logged one the re-simulation need
+    not be bit-exact: every failure is UNVERIFIABLE and a note says so (an exact match still counts).
+    Plans marked ``"user"`` are not re-simulated: a note, or UNVERIFIABLE when the run's predictor is
+    the gate's rollout (it makes no user rows). Logs without rollouts (older): a note.
+
+    Returns:
+        counts: ``replayed`` (re-simulated and identical), ``replay_user``, ``replay_failed``
+        (findings above, per window), ``continuity_checked`` (step pairs compared).
+    """
+    import mujoco
+
+    from monitor.errors import LogFormatError, MonitorError
+    from monitor.log import replay
+    from monitor.log.reader import load_model
+
+    run = contents.run
+    marked = run.get(topics.ROLLOUTS_KEY) == "logged"
+    out = {"replayed": 0, "replay_user": 0, "replay_failed": 0, "continuity_checked": 0}
+    if not marked and not any("source" in p for ps in plan_msgs.values() for p in ps):
+        if certs:
+            notes.append("no rollouts logged (a log before format 3, or not a gate's): the plans' rows are "
+                         "re-certified but not re-simulated")
+        return out
+    try:
+        model, _ = load_model(contents, "mjb")  # bit-exact (the XML keeps 6 digits)
+    except LogFormatError as exc:
+        find(UNVERIFIABLE, f"rollouts cannot be re-simulated: the MJB model does not load ({str(exc)[:200]})")
+        return out
+    exact = run.get("mujoco_version") == mujoco.__version__
+    if not exact:
+        notes.append(f"the log was written with MuJoCo {str(run.get('mujoco_version'))[:20]}, this is "
+                     f"{mujoco.__version__}: re-simulated rows need not be bit-exact, so a difference is "
+                     f"unverifiable, not critical")
+    data = mujoco.MjData(model)
+    phys = replay.physics_index(model)
+    by_index = {c["index"]: c for c in certs}
+    edits = list(edits)
+    ends: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # record -> (row times, integration states)
+    starts: dict[tuple[str, float], tuple[int, np.ndarray]] = {}  # (episode, t) -> (first record, state)
+    step_start: dict[int, np.ndarray] = {}  # window -> its start state (rows_from 0)
+    user: list[int] = []
+
+    def fail(k: int, reason: str) -> None:
+        out["replay_failed"] += 1
+        certified = by_index[k].get("verdict") == Verdict.CERTIFIED
+        find(CRITICAL if certified and exact else UNVERIFIABLE, reason, k)
+
+    for k in sorted(plan_msgs):
+        ps = plan_msgs[k]
+        if len(ps) != 1 or k not in by_index or (edits_bad_from is not None and k >= edits_bad_from):
+            continue  # duplicates / malformed certificates / unusable edits: reported by verify's loop
+        while edits and edits[0][0] <= k:
+            _apply_model_edit(model, edits.pop(0))
+        p = ps[0]
+        src = p.get("source")
+        if src == "user":
+            user.append(k)
+            continue
+        if src is None and p.get("kind", "plan") != "plan":
+            continue  # a body motion: never a gate rollout
+        if src != "rollout":
+            fail(k, "the run logs where every window's rows come from (rollouts: logged), but this plan has "
+                    + ("no source: its rollout was removed" if src is None else f"source {_short(src, 30)}")
+                    + "; its rows cannot be re-simulated")
+            continue
+        try:
+            ro = replay.decode(p.get("rollout"), model)
+            plan, states = replay.resimulate(model, data, ro)
+        except (MonitorError, ValueError, TypeError) as exc:
+            fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
+            continue
+        diff = replay.first_difference(plan, p)
+        if diff is not None:
+            fail(k, f"the logged rows are not the re-simulation of its logged rollout (start state and "
+                    f"controls) on the logged model: {diff}")
+            continue
+        out["replayed"] += 1
+        ends[k] = (plan.times, states)
+        at = (str(p.get("episode", 0)), float(ro.state[0]))
+        first = starts.setdefault(at, (k, ro.state))
+        if first[0] != k:
+            d = float(np.max(np.abs(first[1][phys] - ro.state[phys]), initial=0.0))
+            if not np.array_equal(first[1][phys], ro.state[phys]):
+                fail(k, f"its rollout starts at t = {at[1]!r} s from another physical state than window "
+                        f"{first[0]}'s (max |difference| {d:.3g}): both were simulated from the same step")
+                continue
+        if ro.rows_from == 0:
+            step_start[k] = ro.state
+    # consecutive steps: what ran in step i reaches step j's start state
+    acts = {a.get("index"): a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))}
+    steps = [c for c in certs if not is_applied_record(c)]
+    for c_i, c_j in zip(steps, steps[1:]):
+        i, j = c_i["index"], c_j["index"]
+        if str(c_i.get("episode", 0)) != str(c_j.get("episode", 0)) or j not in step_start:
+            continue
+        a = acts.get(i)
+        rec = a.get("applied_window") if a is not None and a.get("replaced") is True else i
+        if not _is_int(rec) or rec not in ends or rec not in by_index:
+            continue
+        times, states = ends[rec]
+        t_j = float(step_start[j][0])
+        hit = np.flatnonzero(times == t_j)
+        if len(hit) != 1:
+            continue  # not consecutive in time (the applied-motion checks cover a replaced step's span)
+        out["continuity_checked"] += 1
+        end, start = states[int(hit[0])][phys], step_start[j][phys]
+        if not np.array_equal(end, start):
+            d = float(np.max(np.abs(end - start), initial=0.0))
+            fail(rec, f"re-simulated, the motion that ran in step {i} reaches t = {t_j!r} s in another "
+                      f"physical state (time, qpos, qvel, act) than window {j} starts from (max |difference| "
+                      f"{d:.3g}): "
+                      f"an edited control or start state, or the state was set between steps without "
+                      f"gate.reset()")
+    out["replay_user"] = len(user)
+    if user:
+        text = (f"{len(user)} window(s) (first {user[0]}) have rows from user code (a predictor callable, an "
+                f"adapter or an explicit plan): not re-simulated")
+        if marked and run.get("predictor") == "rollout":
+            find(UNVERIFIABLE, text + ", although the run's predictor is the gate's own rollout")
+        else:
+            notes.append(text)
+    if out["replayed"]:
+        notes.append(f"{out['replayed']} window(s) re-simulated from their logged rollouts on the MJB model: "
+                     f"rows identical; {out['continuity_checked']} step-to-step state continuity check(s)")
+    return out
+
+
 def _engine() -> tuple[Any, Any]:
     """(Scene class, certify function); ImportError while the engine is not installed."""
     from monitor.certify.engine import certify
@@ -1170,6 +1320,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            "applied_checked": 0}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     edits, edits_bad_from = _model_edits(contents, model, find, notes)
+    replay_edits = list(edits)  # the loop below consumes edits; the re-simulation applies them again
     if edits and not trust_model_edits:
         first_edit = edits[0][0]
         n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
@@ -1293,6 +1444,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
     applied = _applied_findings(contents, good, plan_msgs, find, notes)
     out.update(applied)
+    out.update(_replay_findings(contents, good, plan_msgs, replay_edits, edits_bad_from, find, notes))
     unlogged = applied["unlogged_old"]
     if unlogged:
         notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "

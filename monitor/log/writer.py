@@ -63,7 +63,7 @@ from mcap.writer import CompressionType, Writer
 from monitor._json import jsonable
 from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError, LogFormatError
-from monitor.log import topics
+from monitor.log import replay, topics
 from monitor.log.digest import METADATA_DIGEST, Digest
 
 MAX_MESSAGES_PER_WINDOW = 8
@@ -362,6 +362,10 @@ class MonitorLog:
         ...     log.write_window(data.time, plan, cert)
     """
 
+    logs_rollouts = True
+    """:meth:`write_window` takes ``rollout=`` (a gate logs, for every window, where its rows come from
+    and, for its own MuJoCo rollouts, what re-simulates them: see :data:`monitor.log.topics.ROLLOUTS_KEY`)."""
+
     logs_applied_motions = True
     """:meth:`write_window` takes ``applied_window=`` / ``applied=`` (a gate logs, for every replaced
     action, the motion that ran: see :data:`monitor.log.topics.APPLIED_MOTIONS_KEY`)."""
@@ -394,6 +398,7 @@ class MonitorLog:
         self._closed = False
         self._model = None
         self._model_source = model_source
+        self._rollout_sizes: tuple[Any, int, int, int] | None = None  # (model, state spec, nstate, nu)
         self._scene = None
         self._want_foxglove = bool(foxglove)
         self.foxglove_enabled = False
@@ -585,7 +590,7 @@ class MonitorLog:
                      applied_action: Any = None, replaced: bool = False,
                      wall_time: float | None = None, episode: int | None = None,
                      reason: str | None = None, request: Any = None, applied_window: int | None = None,
-                     applied: dict[str, Any] | None = None) -> int:
+                     applied: dict[str, Any] | None = None, rollout: Any = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -618,6 +623,12 @@ class MonitorLog:
                 with ``i`` the index of the window whose certification covers it (a fallback:
                 this window itself; a committed braking tail: the accepted window it was
                 certified with, one step earlier). Stored in the certificate payload.
+            rollout: where the plan's rows come from (a joint-space Plan only), stored in the plan
+                payload (:mod:`monitor.log.replay`): ``(state, ((ctrl, substeps), ...), rows_from)``
+                for rows simulated by MuJoCo from ``state`` (the ``mjSTATE_INTEGRATION`` state,
+                (nstate,) float64 bytes or array) under each ctrl ((nu,) bytes or array) in turn,
+                from substep ``rows_from`` on (``source: "rollout"``, re-simulated by review);
+                ``"user"`` for rows made by user code (``source: "user"``); None: not stated.
 
         Returns:
             The window index in this log.
@@ -648,6 +659,10 @@ class MonitorLog:
                                     f"got {cert.get('verdict')!r}")
         if plan is not None:
             plan_msg = _plan_payload(plan)  # validates before anything is written
+            if rollout is not None:
+                plan_msg.update(self._rollout_payload(rollout, plan_msg, getattr(plan, "model", None)))
+        elif rollout is not None:
+            raise InvalidInputError("rollout needs the plan whose rows it made")
         if applied_window is not None and not _is_index(applied_window):
             raise InvalidInputError(f"applied_window must be a window index (int >= 0), "
                                     f"got {applied_window!r}")
@@ -700,6 +715,23 @@ class MonitorLog:
         self._last_log_ns = log_ns
         self._flush()
         return k
+
+    def _rollout_payload(self, rollout: Any, plan_msg: dict[str, Any], plan_model: Any) -> dict[str, Any]:
+        """The plan payload's ``source`` (and ``rollout``) for ``write_window(rollout=)``."""
+        if isinstance(rollout, str) and rollout == "user":
+            return {"source": "user"}
+        if plan_msg["kind"] != "plan":
+            raise InvalidInputError("rollout: only a joint-space Plan's rows come from a MuJoCo rollout")
+        model = self._model if self._model is not None else plan_model  # (attached below from the plan)
+        if model is None:
+            raise InvalidInputError("rollout needs the log's model (attached at open or from the plan)")
+        sizes = self._rollout_sizes
+        if sizes is None or sizes[0] is not model:
+            import mujoco
+
+            spec = int(mujoco.mjtState.mjSTATE_INTEGRATION)
+            sizes = self._rollout_sizes = (model, spec, mujoco.mj_stateSize(model, spec), int(model.nu))
+        return {"source": "rollout", "rollout": replay.encode(rollout, *sizes[1:])}
 
     def close(self) -> None:
         """Finish the journal, then (``index=True``) finalise it into an indexed file (idempotent).
