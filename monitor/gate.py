@@ -2291,7 +2291,9 @@ class Gate:
         if log is None:
             return
         version = getattr(self._scene, "version", 0)
-        if version != self._noted_version:
+        # a log of rollouts also records dynamics edits (masses, gains, options: not in the scene
+        # version) before every window, so that review re-simulates each on its model (a few µs)
+        if version != self._noted_version or getattr(log, "logs_rollouts", False):
             self._noted_version = version
             note = getattr(log, "note_model", None)
             if callable(note):  # the log records what changed, so review re-derives on the model as certified

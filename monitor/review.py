@@ -814,7 +814,7 @@ def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
 
 def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
                      plan_msgs: dict[int, list[dict[str, Any]]],
-                     edits: list[tuple[int, dict[str, np.ndarray], int | None]], edits_bad_from: int | None,
+                     edits: list[_Edit], edits_bad_from: int | None,
                      find: Callable[..., None], notes: list[str]) -> dict[str, int]:
     """Re-simulate every window whose rows come from the gate's own rollout; check the episode's continuity.
 
@@ -1052,19 +1052,56 @@ def _pair_key(geoms: Any) -> frozenset:
     return frozenset(map(str, geoms))
 
 
+_Edit = tuple[int, dict[str, np.ndarray], int | None, dict[str, Any]]
+"""A logged model edit: (window index, array field -> new array, disableflags or None, option -> value)."""
+
+
+def _option_problem(model: Any, options: Any) -> tuple[str | None, dict[str, Any]]:
+    """(problem or None, checked options) of a model edit record's ``"options"`` (format 3)."""
+    from monitor.log.replay import option_fields
+
+    if options is None:
+        return None, {}
+    if not isinstance(options, dict):
+        return "options is not an object", {}
+    known = option_fields(model)
+    out: dict[str, Any] = {}
+    for name, val in options.items():
+        ref = getattr(model.opt, name) if name in known else None
+        if ref is None:
+            return f"option {_short(name, 40)} is not a model option", {}
+        if isinstance(ref, np.ndarray):
+            ok = isinstance(val, list) and all(map(_is_num, val))
+            arr = np.asarray(val, dtype=np.float64) if ok else None
+            if arr is None or arr.shape != ref.shape:
+                return f"option {name}: not {ref.size} finite numbers", {}
+            out[name] = arr
+        elif isinstance(ref, int) and not isinstance(ref, bool):
+            if not _is_int(val):
+                return f"option {name}: {_short(val, 30)} is not an integer", {}
+            out[name] = int(val)
+        elif not _is_num(val):
+            return f"option {name}: {_short(val, 30)} is not a finite number", {}
+        else:
+            out[name] = float(val)
+    return None, out
+
+
 def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], notes: list[str]
-                 ) -> tuple[list[tuple[int, dict[str, np.ndarray], int | None]], int | None]:
+                 ) -> tuple[list[_Edit], int | None]:
     """The logged in-place model edits (``monitor.model_edit`` records), checked against ``model``.
 
     Returns:
-        (edits in file order as (window index, field -> new array, disableflags or None),
-        the first window index from which the edits are unusable (a malformed record: those
-        windows are reported UNVERIFIABLE, never re-derived on a model the run did not certify
-        on), or None).
+        (edits in file order as (window index, field -> new array, disableflags or None,
+        option -> value), the first window index from which the edits are unusable (a malformed
+        record: those windows are reported UNVERIFIABLE, never re-derived on a model the run did
+        not certify on), or None).
     """
+    from monitor.log.replay import model_fields
     from monitor.scene import SYNC_FIELDS
 
-    out: list[tuple[int, dict[str, np.ndarray], int | None]] = []
+    editable = set(SYNC_FIELDS) | set(model_fields(model))  # format 3 also logs dynamics arrays
+    out: list[_Edit] = []
     bad_from: int | None = None
     last = 0
     for n, rec in enumerate(contents.model_edits):
@@ -1077,8 +1114,9 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
         if problem is None and not isinstance(fields, dict):
             problem = "fields is not an object"
         for name, val in (fields.items() if problem is None else ()):
-            if name not in SYNC_FIELDS:
-                problem = f"field {_short(name, 40)} is not a model array a certificate depends on"
+            if name not in editable:
+                problem = f"field {_short(name, 40)} is not a model array a certificate or a simulation " \
+                          f"depends on"
                 break
             ref = getattr(model, name)
             try:
@@ -1097,28 +1135,36 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
         flags = rec.get("disableflags") if isinstance(rec, dict) else None
         if problem is None and flags is not None and not _is_int(flags):
             problem = f"disableflags {_short(flags, 40)} is not an integer"
+        options: dict[str, Any] = {}
+        if problem is None:
+            problem, options = _option_problem(model, rec.get("options"))
         if problem is not None:
             find(UNVERIFIABLE, f"model edit record {n} is malformed: {problem}")
             bad_from = w if _is_int(w) and w >= last else last
             break
         last = int(w)
-        out.append((int(w), arrays, None if flags is None else int(flags)))
+        out.append((int(w), arrays, None if flags is None else int(flags), options))
     if out:
-        names = sorted({k for _, a, _ in out for k in a} | ({"opt.disableflags"} if any(
-            f is not None for _, _, f in out) else set()))
+        names = sorted({k for _, a, _, _ in out for k in a} | ({"opt.disableflags"} if any(
+            f is not None for _, _, f, _ in out) else set()) | {f"opt.{k}" for *_, o in out for k in o})
         notes.append(f"{len(out)} in-place model edit(s) logged by the run (first at window {out[0][0]}; "
                      f"fields: {', '.join(names)}): each window re-derived on the model as edited before "
                      f"it (the run's record, like its requests: a forged record reads like a genuine one)")
     return out, bad_from
 
 
-def _apply_model_edit(model: Any, edit: tuple[int, dict[str, np.ndarray], int | None]) -> None:
+def _apply_model_edit(model: Any, edit: _Edit) -> None:
     """Write one logged edit into ``model`` in place (review's own copy of the attached model)."""
-    _, arrays, flags = edit
+    _, arrays, flags, options = edit
     for name, arr in arrays.items():
         getattr(model, name)[...] = arr
     if flags is not None:
         model.opt.disableflags = flags
+    for name, value in options.items():
+        if isinstance(value, np.ndarray):
+            getattr(model.opt, name)[...] = value
+        else:
+            setattr(model.opt, name, value)
 
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,

@@ -109,6 +109,31 @@ def test_arm_safety_gate_log_with_braking_tail_records_re_simulates(tmp_path):
     assert ver["replayed"] == len(contents.topic(topics.PLAN)) and ver["continuity_checked"] >= 25
 
 
+def test_in_place_dynamics_edits_are_logged_and_re_simulated(tmp_path):
+    """Physics randomised in place between steps (mass, damping, gravity, timestep): none is a scene
+    field, all change the motion; the log records them and every window still re-simulates."""
+    m = mujoco.MjModel.from_xml_string(BOUNCE)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = -0.25, 1.0
+    path = tmp_path / "dr.mcap"
+    rng = np.random.default_rng(3)
+    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn") as g:
+        for k in range(6):
+            if k % 2:
+                m.body_mass[2] = rng.uniform(0.005, 0.02)
+                m.dof_damping[0] = rng.uniform(0.0, 0.01)
+                m.opt.gravity[0] = rng.uniform(-0.5, 0.5)
+                m.opt.timestep = rng.choice([0.002, 0.0025])
+            g.step(d, np.zeros(1))
+    contents = read_log(path)
+    edited = {k for e in contents.model_edits for k in e["fields"]} | {
+        f"opt.{k}" for e in contents.model_edits for k in e.get("options", {})}
+    assert {"body_mass", "dof_damping", "opt.gravity"} <= edited, edited
+    code, ver = _verify(path, trust_model_edits=True)
+    assert code == 0, ver["findings"]
+    assert ver["replayed"] == 6 and ver["continuity_checked"] == 5
+
+
 def _forge(src, dst, msg=None, metadata=None):
     """Rewrite ``src`` as a forger would, then seal it again (``monitor.log.digest``)."""
     tmp = dst.with_suffix(".unsealed.mcap")

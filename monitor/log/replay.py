@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import base64
 import binascii
+import operator
 from dataclasses import dataclass
 from typing import Any
 
@@ -249,5 +250,69 @@ def physics_index(model: Any) -> np.ndarray:
     return np.asarray(idx, dtype=np.int64)
 
 
+_NOT_DYNAMICS = ("tex_", "bvh_", "mesh_", "skin_", "mat_", "light_", "cam_", "key_", "name", "paths", "text_",
+                 "numeric_", "tuple_", "plugin_", "vis")
+"""Prefixes of ``MjModel`` arrays that do not change a re-simulation (visual data, names, keyframes,
+derived bounding volumes, mesh data other than what :data:`monitor.scene.SYNC_FIELDS` watches)."""
+
+
+def model_fields(model: Any) -> tuple[str, ...]:
+    """Names of the ``MjModel`` arrays a re-simulation depends on.
+
+    :data:`monitor.scene.SYNC_FIELDS` and every other non-empty array but those of
+    :data:`_NOT_DYNAMICS` (masses, gains, damping, friction, solver parameters, ...); the
+    options are :func:`option_fields`.
+    """
+    from monitor.scene import SYNC_FIELDS
+
+    out = list(SYNC_FIELDS)
+    for name in dir(model):
+        if name.startswith("_") or name.startswith(_NOT_DYNAMICS) or name in out:
+            continue
+        v = getattr(model, name, None)
+        if isinstance(v, np.ndarray) and v.size:
+            out.append(name)
+    return tuple(out)
+
+
+def option_fields(model: Any) -> tuple[str, ...]:
+    """Names of the ``mjOption`` fields (``model.opt``): all of them change a simulation."""
+    opt = model.opt
+    return tuple(n for n in dir(opt) if not n.startswith("_") and not callable(getattr(opt, n)))
+
+
+class ModelWatch:
+    """A quick test that no array of :func:`model_fields` and no option changed since a snapshot.
+
+    The arrays lie in a few memory runs of the model's buffer (``monitor.scene._run_views``),
+    each compared with one ``tobytes``; the options are read field by field (array options
+    through views kept from construction). A few µs per call on the bundled models.
+    """
+
+    def __init__(self, model: Any) -> None:
+        from monitor.scene import _run_views
+
+        self.model = model
+        arrays = [getattr(model, f) for f in model_fields(model)]
+        self._runs = [(v, v.tobytes()) for v in _run_views([a for a in arrays if a.size])]
+        opt = self._opt = model.opt
+        names = option_fields(model)
+        self._opt_arrays = [(v, v.tobytes()) for v in (getattr(opt, n) for n in names)
+                            if isinstance(v, np.ndarray)]
+        scalars = [n for n in names if not isinstance(getattr(opt, n), np.ndarray)]
+        self._opt_scalars = operator.attrgetter(*scalars) if scalars else (lambda o: ())
+        self._opt_values = self._opt_scalars(opt)
+
+    def unchanged(self) -> bool:
+        """True if every watched byte and option equals the snapshot."""
+        for v, b in self._runs:
+            if v.tobytes() != b:
+                return False
+        for v, b in self._opt_arrays:
+            if v.tobytes() != b:
+                return False
+        return self._opt_scalars(self._opt) == self._opt_values
+
+
 __all__ = ["ENCODING", "SOURCES", "MAX_SUBSTEPS", "Rollout", "encode", "decode", "resimulate",
-           "first_difference", "physics_index"]
+           "first_difference", "physics_index", "model_fields", "option_fields", "ModelWatch"]

@@ -87,7 +87,10 @@ tuning), written before the first window certified on the edited model:
 certificate depends on) that differs from the model as last attached or recorded, its full new
 value (row-major). ``review --verify`` applies the records in order to the attached model, so each
 window is re-derived on the model as it was certified. A gate writes ``"model_edits": "logged"``
-(:data:`MODEL_EDITS_KEY`) in the run metadata."""
+(:data:`MODEL_EDITS_KEY`) in the run metadata. Format 3 (a gate that logs rollouts,
+:data:`ROLLOUTS_KEY`): the records also hold every other changed array a re-simulation depends on
+(:func:`monitor.log.replay.model_fields`: masses, gains, damping, ...) and, under ``"options"``
+(``{name: value}``), every changed ``model.opt`` field but ``disableflags``."""
 MODEL_EDITS_KEY = "model_edits"
 """``monitor.run`` key a gate writes (value ``"logged"``): every in-place model edit the gate certified
 on is in a :data:`METADATA_MODEL_EDIT` record."""

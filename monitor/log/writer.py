@@ -167,16 +167,22 @@ def package_versions() -> dict[str, str]:
 
 
 # --------------------------------------------------------------------------- model edits
-_DISABLEFLAGS = "opt.disableflags"
+_OPT = "opt."
+_DISABLEFLAGS = _OPT + "disableflags"
 
 
-def _model_fields(model: Any) -> dict[str, np.ndarray]:
-    """Copies of the model arrays a certificate depends on (``SYNC_FIELDS``) and ``opt.disableflags``."""
-    from monitor.scene import SYNC_FIELDS
+def _model_fields(model: Any, names: Any = None) -> dict[str, np.ndarray]:
+    """Copies of the model arrays a certificate or a re-simulation depends on, and of every option.
 
-    out = {k: np.array(getattr(model, k)) for k in SYNC_FIELDS}
-    out[_DISABLEFLAGS] = np.array([int(model.opt.disableflags)])
-    return out
+    ``names``: the keys to read (those of an earlier call on the attached model); default the
+    arrays of :func:`monitor.log.replay.model_fields` (``SYNC_FIELDS`` first) and ``opt.<field>``
+    for every :func:`monitor.log.replay.option_fields` entry (``opt.disableflags`` among them).
+    """
+    if names is None:
+        names = [*replay.model_fields(model), *(_OPT + n for n in replay.option_fields(model))]
+    opt = model.opt
+    return {k: np.array(getattr(opt, k[len(_OPT):]) if k.startswith(_OPT) else getattr(model, k), ndmin=1)
+            for k in names}
 
 
 # --------------------------------------------------------------------------- model export
@@ -420,7 +426,8 @@ class MonitorLog:
         if isinstance(run.get("request"), dict):
             self._requests[_request_key(run["request"])] = 0
         self.add_metadata(run)
-        self._model_base: dict[str, np.ndarray] | None = None  # SYNC_FIELDS as attached / last recorded
+        self._model_base: dict[str, np.ndarray] | None = None  # _model_fields as attached / last recorded
+        self._model_watch: replay.ModelWatch | None = None  # quick "unchanged since _model_base" test
         if model is not None:
             self._attach_model(model)
             self._model_base = _model_fields(model)
@@ -436,11 +443,15 @@ class MonitorLog:
     def note_model(self, model: Any) -> list[str]:
         """Record an in-place edit of the attached model (a ``monitor.model_edit`` record), if any.
 
-        Compares every :data:`monitor.scene.SYNC_FIELDS` array and ``opt.disableflags`` of
-        ``model`` with the attached model (or the last record) and, when some differ, writes
-        their full new values, tagged with the index of the next window (see
-        :data:`topics.METADATA_MODEL_EDIT`). Call it before writing a window certified on an
-        edited model; a gate calls it whenever its scene was rebuilt.
+        Compares every :data:`monitor.scene.SYNC_FIELDS` array, every other array a
+        re-simulation depends on (:func:`monitor.log.replay.model_fields`: masses, gains,
+        damping, ...) and every option of ``model`` with the attached model (or the last
+        record) and, when some differ, writes their full new values, tagged with the index of
+        the next window (see :data:`topics.METADATA_MODEL_EDIT`; options other than
+        ``disableflags`` under ``"options"``). Call it before writing a window certified or
+        simulated on an edited model; a gate calls it whenever its scene was rebuilt and, when
+        it logs rollouts, before every window. An unchanged model costs a few µs
+        (:class:`monitor.log.replay.ModelWatch`).
 
         Args:
             model: the ``MjModel`` the next window was certified on (the attached one, edited).
@@ -455,18 +466,33 @@ class MonitorLog:
         base = self._model_base
         if base is None:
             return []
-        now = _model_fields(model)
+        watch = self._model_watch
+        if watch is not None and watch.model is model and watch.unchanged():
+            return []
+        try:
+            now = _model_fields(model, base)
+        except AttributeError as exc:
+            raise InvalidInputError(f"model: not an MjModel like the one attached to the log "
+                                    f"({exc})") from exc
         if any(now[k].shape != v.shape for k, v in base.items()):
             raise InvalidInputError("model: its arrays do not have the shapes of the model attached to the "
                                     "log (another model, not an in-place edit)")
+        self._model_watch = replay.ModelWatch(model)
         changed = [k for k, v in base.items() if now[k].tobytes() != v.tobytes()]
         if not changed:
             return []
         fields = {k: {"shape": list(now[k].shape), "values": now[k].ravel().tolist()}
-                  for k in changed if k != _DISABLEFLAGS}
+                  for k in changed if not k.startswith(_OPT)}
         rec: dict[str, Any] = {"window": self._index, "fields": fields}
         if _DISABLEFLAGS in changed:
             rec["disableflags"] = int(now[_DISABLEFLAGS][0])
+        options = {}
+        for k in changed:
+            if k.startswith(_OPT) and k != _DISABLEFLAGS:
+                v = getattr(model.opt, k[len(_OPT):])
+                options[k[len(_OPT):]] = v.tolist() if isinstance(v, np.ndarray) else v
+        if options:
+            rec["options"] = options
         self.add_metadata(rec, name=topics.METADATA_MODEL_EDIT)
         self._model_base = now
         return changed
