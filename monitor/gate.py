@@ -963,6 +963,13 @@ _ROLLOUTS_KEY = "rollouts"
 """Run metadata key ``monitor.log.topics.ROLLOUTS_KEY``: every window says where its rows come from."""
 
 
+def _not_replayable(*windows: Any) -> None:
+    """Forget the rollout keys of ``windows`` (their rows are logged as not re-simulable, ``"user"``)."""
+    for w in windows:
+        if isinstance(w, (_WindowRows, _Tail)):
+            w.key = None
+
+
 def _logged_rollout(p: Any) -> Any:
     """What a log records of where the rows of window ``p`` come from (``MonitorLog.write_window(rollout=)``).
 
@@ -2041,6 +2048,10 @@ class Gate:
             # (before the scene is first built: `allowed="auto"` frees the pairs touching at THIS pose)
             self._reference_qpos = np.array(data.qpos)
         self._sync_scene()  # certify against the model as it is now (domain randomisation, tuning)
+        # user code in `cast` runs between the window's rollout and the note below: note before it
+        user_cast = cast is not None and not getattr(cast, "_model_untouched", False)
+        if user_cast:
+            self._note_model()
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
@@ -2120,7 +2131,8 @@ class Gate:
             self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
                                     and tail is not None and brake_verdict == Verdict.CERTIFIED
                                     and not tail_cert.stats.get("ongoing", 0))
-        self._note_model()  # the model the proposal was certified on, before a fallback callable runs
+        if self._note_model() and user_cast:  # `cast` edited the model after the rollout (red team 7):
+            _not_replayable(plan, tail)  # the rows are not the logged model's re-simulation
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
@@ -2280,16 +2292,21 @@ class Gate:
                 "allowed_mode": mode,
                 "reference_qpos": None if ref is None else np.asarray(ref, float).tolist()}
 
-    def _note_model(self) -> None:
+    def _note_model(self) -> bool:
         """Log the model as the next window was certified on: an in-place edit since the last note.
 
         Called by :meth:`decide` once the proposal is certified (the first window, or the scene was
         rebuilt after a model edit) and again before a fallback's record, which a fallback callable
         may have edited the model for (red team 6): review re-derives each window on its own model.
+        A log of rollouts is called every time (it records dynamics edits too; a few µs when the
+        model is unchanged), and also before the rollout when the caller's ``cast`` may edit it.
+
+        Returns:
+            whether an edit was recorded.
         """
         log = self._open_log()
         if log is None:
-            return
+            return False
         version = getattr(self._scene, "version", 0)
         # a log of rollouts also records dynamics edits (masses, gains, options: not in the scene
         # version) before every window, so that review re-simulates each on its model (a few µs)
@@ -2297,7 +2314,8 @@ class Gate:
             self._noted_version = version
             note = getattr(log, "note_model", None)
             if callable(note):  # the log records what changed, so review re-derives on the model as certified
-                note(self.model)
+                return bool(note(self.model))
+        return False
 
     def _write_log(self, r: StepReport, applied_plan: Any, plan: Any = None) -> None:
         """Log the step's windows; ``plan``: the proposal as :meth:`decide` made it (rows + rollout key)."""

@@ -597,4 +597,6 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         super().close()
 
 
+SafetyGate._as_inner._model_untouched = True  # type: ignore[attr-defined]  # decide's `cast`: no model edit
+
 __all__ = ["SafetyGate"]

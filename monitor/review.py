@@ -951,7 +951,8 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
     out["replay_user"] = len(user)
     if user:
         text = (f"{len(user)} window(s) (first {user[0]}) have rows from user code (a predictor callable, an "
-                f"adapter or an explicit plan): not re-simulated")
+                f"adapter, an explicit plan, or a `cast` that edited the model while they were simulated): "
+                f"not re-simulated")
         if marked and run.get("predictor") == "rollout":
             find(UNVERIFIABLE, text + ", although the run's predictor is the gate's own rollout")
         else:

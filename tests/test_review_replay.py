@@ -134,6 +134,29 @@ def test_in_place_dynamics_edits_are_logged_and_re_simulated(tmp_path):
     assert ver["replayed"] == 6 and ver["continuity_checked"] == 5
 
 
+def test_a_cast_that_edits_the_model_leaves_its_rows_not_re_simulable_but_never_critical(tmp_path):
+    """User code in ``Gate.decide(cast=)`` edits the dynamics after the window's rollout, before its
+    braking tail (red team 7's case): those rows are on no single logged model, so they are logged as
+    not re-simulable (review: unverifiable, exit 2), never a false critical finding."""
+    m = mujoco.MjModel.from_xml_string(BOUNCE)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = -0.25, 1.0
+
+    def cast(c):
+        m.dof_damping[0] += 1e-3
+        return np.asarray(c, dtype=np.float64)
+
+    path = tmp_path / "cast.mcap"
+    with Gate(m, log=path, frame_skip=50, allowed=None) as g:
+        for _ in range(4):
+            r = g.decide(d, np.zeros(1), cast=cast)
+            if not g._rollout.commit(d, r.applied_ctrl, 50):
+                d.ctrl[:] = r.applied_ctrl
+                mujoco.mj_step(m, d, nstep=50)
+    code, ver = _verify(path, trust_model_edits=True)
+    assert code == 2 and not _findings(ver, "critical") and ver["replay_user"] >= 4, ver["findings"]
+
+
 def _forge(src, dst, msg=None, metadata=None):
     """Rewrite ``src`` as a forger would, then seal it again (``monitor.log.digest``)."""
     tmp = dst.with_suffix(".unsealed.mcap")
