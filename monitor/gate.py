@@ -39,7 +39,10 @@ Logs. ``log="x.mcap"`` claims the path with an exclusive ``fcntl.flock`` for as
 long as the gate writes it. A path already claimed by another live gate (in
 this or another process, e.g. the sub-envs of a vector env built with one
 ``log=`` argument) is never overwritten: the gate writes ``x.1.mcap``,
-``x.2.mcap``, ... instead (the first free one; see :attr:`Gate.log_path`).
+``x.2.mcap``, ... instead (the first free one; see :attr:`Gate.log_path`). Every window
+whose rows come from this rollout is logged with the integration state it started from and
+its substep controls (:mod:`monitor.log.replay`; ``review --verify`` re-simulates it), and
+in-place model edits are noted before every window (dynamics too: a few µs per window).
 
 This module imports mujoco and monitor only (no gymnasium, no mcap).
 """

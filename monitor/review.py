@@ -12,7 +12,9 @@
   recomputation uses the library defaults unless the caller passes others), and
   ``model.xml`` must describe the same model as ``model.mjb``. A failed claim is a
   *critical* finding; a window that cannot be recomputed (no plan, an error, a
-  malformed message) is an *unverifiable* finding. See :func:`verify`.
+  malformed message) is an *unverifiable* finding. The rows of a gate's own rollouts
+  are themselves re-simulated from their logged start states and controls, and the
+  steps of an episode must continue each other (:func:`_replay_findings`). See :func:`verify`.
 * :func:`render_text` and :func:`write_report` present those dicts (text table,
   self-contained HTML with embedded matplotlib PNGs).
 
@@ -938,7 +940,12 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
         t_j = float(step_start[j][0])
         hit = np.flatnonzero(times == t_j)
         if len(hit) != 1:
-            continue  # not consecutive in time (the applied-motion checks cover a replaced step's span)
+            if rec == i and float(times[-1]) != t_j:  # a gate's step window ends where the next one starts
+                find(UNVERIFIABLE, f"steps {i} and {j} of one episode do not meet (window {i} ends at "
+                                   f"t = {float(times[-1])!r} s, window {j} starts at t = {t_j!r} s): the "
+                                   f"motion in between is not in the log (a window removed, or the state "
+                                   f"stepped without the gate)", j)
+            continue  # (a replaced step's record: the applied-motion checks cover its span)
         out["continuity_checked"] += 1
         end, start = states[int(hit[0])][phys], step_start[j][phys]
         if not np.array_equal(end, start):
@@ -1205,6 +1212,12 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
     setting changed during the run and an added record look the same).
 
+    Rows re-simulated (logs of format 3, :func:`_replay_findings`): every plan a gate made by its
+    own MuJoCo rollout must be, bit for bit, the re-simulation of its logged start state and
+    controls on the MJB model (with the logged edits), and consecutive steps of an episode must
+    continue each other (an edited plan, control or start state is critical when certified); a
+    plan that lost its rollout in a log that says it logs them is the same.
+
     In-place model edits the run logged (``monitor.model_edit`` records, written by a gate
     before the first window certified on the edited model) are applied in window order to
     the attached model, so each window is re-derived on the model it was certified on (flips
@@ -1238,7 +1251,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         of unverifiable findings), ``missing_plans``, ``errors`` (rows: index, error),
         ``pairs_differ``, and for applied-motion records (:func:`_applied_findings`)
         ``applied_checked`` (records re-derived, counted in ``checked`` too), ``applied_records``,
-        ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``.
+        ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``, and
+        ``replayed``, ``replay_user``, ``replay_failed``, ``continuity_checked``
+        (:func:`_replay_findings`).
 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
@@ -1491,7 +1506,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
     applied = _applied_findings(contents, good, plan_msgs, find, notes)
     out.update(applied)
-    out.update(_replay_findings(contents, good, plan_msgs, replay_edits, edits_bad_from, find, notes))
+    out.update(_replay_findings(contents, certs, plan_msgs, replay_edits, edits_bad_from, find, notes))
     unlogged = applied["unlogged_old"]
     if unlogged:
         notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "
@@ -1664,6 +1679,10 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
                      f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s); "
                      f"{ver.get('unverifiable', 0)} unverifiable, {ver.get('pairs_differ', 0)} with a "
                      f"different pair set; {ver.get('windows', '?')} window(s) in the log")
+        if ver.get("replayed") or ver.get("replay_failed") or ver.get("replay_user"):
+            lines.append(f"     rollouts re-simulated: {ver.get('replayed', 0)} window(s) identical, "
+                         f"{ver.get('replay_failed', 0)} failed, {ver.get('replay_user', 0)} with rows from "
+                         f"user code; {ver.get('continuity_checked', 0)} step-to-step continuity check(s)")
         if ver.get("applied_records") or ver.get("applied_missing"):
             lines.append(f"     applied motions re-derived: {ver.get('applied_checked', 0)} record(s) of "
                          f"{ver.get('applied_records', 0)}, covering {ver.get('applied_steps', 0)} replaced "

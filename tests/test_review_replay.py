@@ -269,6 +269,16 @@ def test_an_edited_ctrl_with_consistently_re_simulated_rows_breaks_the_continuit
     assert "motion that ran in step 3" in crit[0][1] and "than window 4 starts from" in crit[0][1]
 
 
+def test_a_removed_step_leaves_a_gap_that_is_reported(bounce, tmp_path):
+    path, _, _ = bounce
+    dst = tmp_path / "gap.mcap"
+    _forge(path, dst, msg=lambda topic, o: None if o.get("index") == 3 else o)
+    code, ver = _verify(dst)
+    assert code == 2 and not _findings(ver, "critical")
+    gaps = [k for k, r in _findings(ver, "unverifiable") if "steps 2 and 4 of one episode do not meet" in r]
+    assert gaps == [4]
+
+
 def _as_old_log(name, values):
     if name == topics.METADATA_RUN:
         values.pop(topics.ROLLOUTS_KEY, None)
