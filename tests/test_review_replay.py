@@ -10,18 +10,16 @@ its end points clear the wall, its interior does not), and the forger's edit, wh
 
 from __future__ import annotations
 
-import gymnasium as gym
 import mujoco
 import numpy as np
 import pytest
 from mcap_rewrite import rewrite
 from test_log_digest import seal_copy
+from test_review_applied import _arm_run
 
-import monitor.envs  # noqa: F401  (registers the ids)
 from monitor import review
 from monitor.certify.engine import certify
 from monitor.gate import Gate
-from monitor.gym_gate import SafetyGate
 from monitor.log import read_log, replay, topics
 from monitor.log.writer import _null_unknown
 from monitor.motion.plan import Plan
@@ -92,13 +90,7 @@ def test_a_genuine_gate_log_re_simulates_bit_for_bit(bounce):
 
 def test_arm_safety_gate_log_with_braking_tail_records_re_simulates(tmp_path):
     path = tmp_path / "arm.mcap"
-    env = SafetyGate(gym.make("monitor/Arm-v0"), log=path)
-    env.reset(seed=0)
-    env.action_space.seed(0)
-    for _ in range(30):
-        env.step(env.action_space.sample())
-    stats = dict(env.gate.stats)
-    env.close()
+    stats, _ = _arm_run(path, steps=30)  # SafetyGate(monitor/Arm-v0), seeded random actions
     assert stats["replaced"] >= 3  # blocked steps: their braking-tail records are re-simulated too
     contents = read_log(path)
     tails = [c["index"] for c in contents.certificates()
