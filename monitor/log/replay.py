@@ -297,8 +297,9 @@ class ModelWatch:
         self._runs = [(v, v.tobytes()) for v in _run_views([a for a in arrays if a.size])]
         opt = self._opt = model.opt
         names = option_fields(model)
-        self._opt_arrays = [(v, v.tobytes()) for v in (getattr(opt, n) for n in names)
-                            if isinstance(v, np.ndarray)]
+        # the array options (gravity, wind, ..., o_friction) are views into the mjOption struct: one run
+        self._opt_arrays = [(v, v.tobytes()) for v in _run_views(
+            [v for v in (getattr(opt, n) for n in names) if isinstance(v, np.ndarray) and v.size])]
         scalars = [n for n in names if not isinstance(getattr(opt, n), np.ndarray)]
         self._opt_scalars = operator.attrgetter(*scalars) if scalars else (lambda o: ())
         self._opt_values = self._opt_scalars(opt)
