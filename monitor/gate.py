@@ -980,9 +980,13 @@ def _logged_rollout(p: Any) -> Any:
     the integration state (``mjSTATE_INTEGRATION`` bytes) the rows were simulated from, the controls
     held over consecutive substeps ``((ctrl, substeps), ...)`` and the substep of the first row (a
     braking tail is simulated after its window: rows from substep ``nstep``). Anything else (a user
-    predictor's or adapter's Plan, an explicit Plan): ``"user"``, not re-simulable.
+    predictor's or adapter's Plan, an explicit Plan), or rows simulated while a global MuJoCo
+    callback (``mjcb_control``, ...: user code inside ``mj_step``) is installed: ``"user"``, not
+    re-simulable.
     """
     key = p.key if isinstance(p, (_WindowRows, _Tail)) else None
+    if key is not None and any(get() is not None for get in _CALLBACK_GETTERS):
+        return "user"
     if isinstance(p, _Tail) and key is not None:
         window, brake = key
         if window is None:
