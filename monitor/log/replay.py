@@ -254,6 +254,8 @@ _NOT_DYNAMICS = ("tex_", "bvh_", "mesh_", "skin_", "mat_", "light_", "cam_", "ke
                  "numeric_", "tuple_", "plugin_", "vis")
 """Prefixes of ``MjModel`` arrays that do not change a re-simulation (visual data, names, keyframes,
 derived bounding volumes, mesh data other than what :data:`monitor.scene.SYNC_FIELDS` watches)."""
+_NOT_DYNAMICS_SUFFIXES = ("_rgba", "_user")
+"""... and suffixes (colours; user data arrays, which MuJoCo never reads)."""
 
 
 def model_fields(model: Any) -> tuple[str, ...]:
@@ -267,7 +269,7 @@ def model_fields(model: Any) -> tuple[str, ...]:
 
     out = list(SYNC_FIELDS)
     for name in dir(model):
-        if name.startswith("_") or name.startswith(_NOT_DYNAMICS) or name in out:
+        if name.startswith(("_", *_NOT_DYNAMICS)) or name.endswith(_NOT_DYNAMICS_SUFFIXES) or name in out:
             continue
         v = getattr(model, name, None)
         if isinstance(v, np.ndarray) and v.size:
