@@ -170,16 +170,18 @@ def _recertified(model, k, times, qpos, contents):
     return {**head, **_null_unknown(cert.to_dict())}
 
 
-def test_the_red_team_forgery_of_consistent_interior_rows_is_caught(bounce, tmp_path):
-    """Red team 7: the bounce's interior rows straightened between its (kept) end rows, verdict certified."""
-    path, model, _ = bounce
+def forge_interior_rows(path, model, dst):
+    """Red team 7's forgery of ``path`` into ``dst``: the bounce's interior rows straightened between its
+    (kept) end rows, certified by the real engine, its violation messages dropped, the file re-sealed.
+
+    Returns (logged verdict, forged verdict) of the window (also used by the note's ``forge_demo.py``).
+    """
     contents = read_log(path)
     p = contents.plans_by_index()[BOUNCE_STEP]
     times, qpos = np.asarray(p["times"]), np.asarray(p["qpos"])
     s = (times - times[0]) / (times[-1] - times[0])
     forged = qpos[0] + s[:, None] * (qpos[-1] - qpos[0])  # first and last rows kept, never near the wall
     cert = _recertified(model, BOUNCE_STEP, times, forged, contents)
-    assert contents.certificates()[BOUNCE_STEP]["verdict"] == "violation" and cert["verdict"] == "certified"
 
     def msg(topic, o):
         if o.get("index") != BOUNCE_STEP:
@@ -190,8 +192,14 @@ def test_the_red_team_forgery_of_consistent_interior_rows_is_caught(bounce, tmp_
             return cert
         return None if topic in (topics.VIOLATION, topics.LOG) else o
 
-    dst = tmp_path / "forged.mcap"
     _forge(path, dst, msg=msg)
+    return contents.certificates()[BOUNCE_STEP]["verdict"], cert["verdict"]
+
+
+def test_the_red_team_forgery_of_consistent_interior_rows_is_caught(bounce, tmp_path):
+    path, model, _ = bounce
+    dst = tmp_path / "forged.mcap"
+    assert forge_interior_rows(path, model, dst) == ("violation", "certified")
     code, ver = _verify(dst)
     assert code == 1 and not ver["mismatches"]  # re-certifying the forged rows agrees with the claim
     crit = _findings(ver, "critical")
