@@ -39,7 +39,10 @@ Logs. ``log="x.mcap"`` claims the path with an exclusive ``fcntl.flock`` for as
 long as the gate writes it. A path already claimed by another live gate (in
 this or another process, e.g. the sub-envs of a vector env built with one
 ``log=`` argument) is never overwritten: the gate writes ``x.1.mcap``,
-``x.2.mcap``, ... instead (the first free one; see :attr:`Gate.log_path`).
+``x.2.mcap``, ... instead (the first free one; see :attr:`Gate.log_path`). Every window
+whose rows come from this rollout is logged with the integration state it started from and
+its substep controls (:mod:`monitor.log.replay`; ``review --verify`` re-simulates it), and
+in-place model edits are noted before every window (dynamics too: a few µs per window).
 
 This module imports mujoco and monitor only (no gymnasium, no mcap).
 """
@@ -139,6 +142,10 @@ class Rollout:
         self._key_nstep = 0  # 0: the scratch holds no complete window
         self.window_rows: np.ndarray | None = None
         """(nstep + 1, 1 + nq) rows (time, qpos) of the last :meth:`states` call, or None."""
+        self.window_key: tuple[bytes, bytes, int] | None = None
+        """(integration state at the start, ctrl (nu,), nstep) of :attr:`window_rows`: raw float64 bytes
+        (fresh per window, never overwritten), from which the rows re-simulate bit for bit (a log's
+        ``rollout``; see :func:`_logged_rollout`)."""
         self._s_ctrl = self.scratch.ctrl  # a view (an MjData's buffers never move)
         self._s_warn = _unstable_counts(self.scratch)  # a view too: the unstable-simulation counters
         self.c_tail = True
@@ -241,6 +248,7 @@ class Rollout:
                 "qpos/qvel/qacc; it resets the state): no motion to certify. Lower opt.timestep, use an "
                 "implicit integrator, or check the control and the model's gains")
         self._key_nstep = int(nstep)
+        self.window_key = (self._key_state_bytes, self._key_ctrl_bytes, self._key_nstep)
         # MuJoCo normalises free/ball quaternions when it uses them (kinematics,
         # integration); a state set by hand (e.g. a noisy reset) may not be.
         mujoco.mj_normalizeQuat(m, rows[0, 1:])  # in place (a contiguous row)
@@ -591,10 +599,12 @@ class _WindowRows:
     :attr:`StepReport.plan` build it.
     """
 
-    __slots__ = ("rows", "_model", "_mocap_pos", "_mocap_quat", "_plan")
+    __slots__ = ("rows", "_model", "_mocap_pos", "_mocap_quat", "_plan", "key")
 
-    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData,
+                 key: tuple[bytes, bytes, int] | None = None) -> None:
         self.rows = rows  # (K, 1 + nq) time (s), qpos; read-only
+        self.key = key  # the rollout's window_key for these rows (a log's ``rollout``), or None
         self._model = model
         self._mocap_pos = np.array(data.mocap_pos)
         self._mocap_quat = np.array(data.mocap_quat)
@@ -628,8 +638,8 @@ class _WindowRows:
 
 
 def _plan_of(p: Any) -> Any:
-    """A Plan from a Plan or a :class:`_WindowRows`."""
-    return p.plan if isinstance(p, _WindowRows) else p
+    """A Plan from a Plan, a :class:`_WindowRows` or a :class:`_Tail`."""
+    return p.plan if isinstance(p, (_WindowRows, _Tail)) else p
 
 
 class _LazyPlanField:
@@ -866,10 +876,12 @@ class _Tail:
     :meth:`Rollout.brake_tail` builds (same rows, mocap copied from the live data).
     """
 
-    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan", "_plan_mocap_quat")
+    __slots__ = ("rows", "qvel", "mocap_pos", "mocap_quat", "_model", "_plan", "_plan_mocap_quat", "key")
 
-    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    def __init__(self, rows: np.ndarray, model: mujoco.MjModel, data: mujoco.MjData,
+                 key: tuple[tuple[bytes, bytes, int] | None, np.ndarray] | None = None) -> None:
         nq = model.nq
+        self.key = key  # (the window's Rollout.window_key, brake ctrl (nu,)) it continues, or None
         self.rows = rows[:, :1 + nq]  # (K, 1 + nq) time, qpos
         self.qvel = rows[:, 1 + nq:].copy()  # (K, nv)
         self.mocap_pos = np.array(data.mocap_pos)  # held over the window and the tail
@@ -950,6 +962,41 @@ def _json_items(items: Any) -> Any:
 
 _MODEL_EDITS_KEY = "model_edits"
 """Run metadata key ``monitor.log.topics.MODEL_EDITS_KEY`` (spelled here: gate.py imports no mcap)."""
+_ROLLOUTS_KEY = "rollouts"
+"""Run metadata key ``monitor.log.topics.ROLLOUTS_KEY``: every window says where its rows come from."""
+
+
+def _not_replayable(*windows: Any) -> None:
+    """Forget the rollout keys of ``windows`` (their rows are logged as not re-simulable, ``"user"``)."""
+    for w in windows:
+        if isinstance(w, (_WindowRows, _Tail)):
+            w.key = None
+
+
+def _logged_rollout(p: Any) -> Any:
+    """What a log records of where the rows of window ``p`` come from (``MonitorLog.write_window(rollout=)``).
+
+    A :class:`_WindowRows` or :class:`_Tail` of the gate's own rollout: ``(state, segments, rows_from)``,
+    the integration state (``mjSTATE_INTEGRATION`` bytes) the rows were simulated from, the controls
+    held over consecutive substeps ``((ctrl, substeps), ...)`` and the substep of the first row (a
+    braking tail is simulated after its window: rows from substep ``nstep``). Anything else (a user
+    predictor's or adapter's Plan, an explicit Plan), or rows simulated while a global MuJoCo
+    callback (``mjcb_control``, ...: user code inside ``mj_step``) is installed: ``"user"``, not
+    re-simulable.
+    """
+    key = p.key if isinstance(p, (_WindowRows, _Tail)) else None
+    if key is not None and any(get() is not None for get in _CALLBACK_GETTERS):
+        return "user"
+    if isinstance(p, _Tail) and key is not None:
+        window, brake = key
+        if window is None:
+            return "user"
+        state, ctrl, n = window
+        return state, ((ctrl, n), (brake, len(p.rows) - 1)), n
+    if key is None:
+        return "user"
+    state, ctrl, n = key
+    return state, ((ctrl, n),), 0
 
 
 def _check_predictor(predictor: Any) -> Any:
@@ -1253,6 +1300,7 @@ class Gate:
         self._log_owned = False
         self._log_lock: Any = None
         self._log_path: Path | None = None  # log_path (read-only property)
+        self._predictor_label: str | None = None  # the log's "predictor" if an adapter predicts (SafetyGate)
         self.last_report: StepReport | None = None
         self.stats = {"windows": 0, "certified": 0, "violation": 0, "uncertain": 0, "replaced": 0,
                       "fallback_uncertified": 0, "brake_rejected": 0, "tail_reused": 0,
@@ -2007,6 +2055,10 @@ class Gate:
             # (before the scene is first built: `allowed="auto"` frees the pairs touching at THIS pose)
             self._reference_qpos = np.array(data.qpos)
         self._sync_scene()  # certify against the model as it is now (domain randomisation, tuning)
+        # user code in `cast` runs between the window's rollout and the note below: note before it
+        user_cast = cast is not None and not getattr(cast, "_model_untouched", False)
+        if user_cast:
+            self._note_model()
         if cast is None:
             def cast(c: Any) -> np.ndarray:
                 return np.asarray(c, dtype=np.float64)
@@ -2018,7 +2070,9 @@ class Gate:
                 return self.predict(data, c, n)
         t_win = float(data.time)
         if own_predictor:  # the rollout's window; its Plan is built only when something reads it
-            plan: Any = _WindowRows(self._rollout._window(data, ctrl, n), self.model, data)
+            # (arguments left to right: window_key is read after _window set it)
+            plan: Any = _WindowRows(self._rollout._window(data, ctrl, n), self.model, data,
+                                    self._rollout.window_key)
         else:
             plan = predict(ctrl)
         brake_on = self._brake_active(fallback)
@@ -2030,7 +2084,7 @@ class Gate:
                 data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps, self.brake_vel_tol,
                 window_fresh=True)  # states() ran just above on this data, ctrl and n
             self._rollout.check_tail()
-            tail = _Tail(rows, self.model, data)
+            tail = _Tail(rows, self.model, data, (self._rollout.window_key, brake_next))
             tail_qvel = tail.qvel
             joint = self._certify_joint(plan, self._rollout.window_rows, tail.rows, tail.mocap_pos,
                                         tail.mocap_quat)
@@ -2058,7 +2112,7 @@ class Gate:
                         data, ctrl, n, lambda d: cast(self._brake_ctrl(d)), self.brake_steps,
                         self.brake_vel_tol)
                     self._rollout.check_tail()
-                    tail = _Tail(rows, self.model, data)
+                    tail = _Tail(rows, self.model, data, (self._rollout.window_key, brake_next))
                     tail_qvel = tail.qvel
                 if joint_witness is not None and self._tail_refuted(joint_witness, tail):
                     # the joint call confirmed a violation inside the tail (see _tail_refuted)
@@ -2084,7 +2138,8 @@ class Gate:
             self._joint_hint = bool(cert.certified and not cert.stats.get("ongoing", 0)
                                     and tail is not None and brake_verdict == Verdict.CERTIFIED
                                     and not tail_cert.stats.get("ongoing", 0))
-        self._note_model()  # the model the proposal was certified on, before a fallback callable runs
+        if self._note_model() and user_cast:  # `cast` edited the model after the rollout (red team 7):
+            _not_replayable(plan, tail)  # the rows are not the logged model's re-simulation
         applied, replaced, terminated = ctrl, False, False
         fb_cert, fb_ok, applied_verdict = None, True, cert.verdict
         applied_plan = plan
@@ -2104,7 +2159,8 @@ class Gate:
                 self.stats["tail_reused"] += 1
             elif own_predictor and self._certify_is_own():
                 # the rows of predict(applied); the Plan built only when the cache cannot answer
-                win = _WindowRows(self._rollout._window(data, applied, n), self.model, data)
+                win = _WindowRows(self._rollout._window(data, applied, n), self.model, data,
+                                  self._rollout.window_key)
                 got = self._certify_static(win)  # a window with nothing moving: from the cache, no Plan
                 if got is None:
                     got = self._certify(win.plan)
@@ -2131,7 +2187,7 @@ class Gate:
         report = StepReport._trusted(cert.verdict, cert, ctrl, applied, replaced, terminated, unsafe,
                                      applied_verdict, fb_cert, fb_ok, us, t_win, plan, brake_verdict)
         self._account(report)
-        self._write_log(report, applied_plan)
+        self._write_log(report, applied_plan, plan)
         self.last_report = report
         return report
 
@@ -2206,7 +2262,10 @@ class Gate:
                     # the certify settings at open (ongoing rule, tolerances, budget, ...): request id 0;
                     # each certificate names its own (a setting changed later gets a new record)
                     "request": self.request.to_json(), **self._policy_metadata(),
-                    _MODEL_EDITS_KEY: "logged"}  # note_model before every window on an edited model
+                    _MODEL_EDITS_KEY: "logged",  # note_model before every window on an edited model
+                    _ROLLOUTS_KEY: "logged"}  # every plan says where its rows come from (write_window)
+            if self._predictor_label is not None:  # an adapter's predictor (SafetyGate predictor="plan")
+                meta["predictor"] = self._predictor_label
             self._log = MonitorLog(path, model=self.model, metadata=meta, **self._log_options)
             self._log.__enter__()
             self._log_owned = True
@@ -2217,6 +2276,8 @@ class Gate:
                 meta = self._policy_metadata()  # (requests: per certificate, by the log itself)
                 if callable(getattr(spec, "note_model", None)):
                     meta[_MODEL_EDITS_KEY] = "logged"
+                if getattr(spec, "logs_rollouts", False):
+                    meta[_ROLLOUTS_KEY] = "logged"
                 add(meta)
         return self._log
 
@@ -2238,43 +2299,60 @@ class Gate:
                 "allowed_mode": mode,
                 "reference_qpos": None if ref is None else np.asarray(ref, float).tolist()}
 
-    def _note_model(self) -> None:
+    def _note_model(self) -> bool:
         """Log the model as the next window was certified on: an in-place edit since the last note.
 
         Called by :meth:`decide` once the proposal is certified (the first window, or the scene was
         rebuilt after a model edit) and again before a fallback's record, which a fallback callable
         may have edited the model for (red team 6): review re-derives each window on its own model.
+        A log of rollouts is called every time (it records dynamics edits too; a few µs when the
+        model is unchanged), and also before the rollout when the caller's ``cast`` may edit it.
+
+        Returns:
+            whether an edit was recorded.
         """
         log = self._open_log()
         if log is None:
-            return
+            return False
         version = getattr(self._scene, "version", 0)
-        if version != self._noted_version:
+        # a log of rollouts also records dynamics edits (masses, gains, options: not in the scene
+        # version) before every window, so that review re-simulates each on its model (a few µs)
+        if version != self._noted_version or getattr(log, "logs_rollouts", False):
             self._noted_version = version
             note = getattr(log, "note_model", None)
             if callable(note):  # the log records what changed, so review re-derives on the model as certified
-                note(self.model)
+                return bool(note(self.model))
+        return False
 
-    def _write_log(self, r: StepReport, applied_plan: Any) -> None:
+    def _write_log(self, r: StepReport, applied_plan: Any, plan: Any = None) -> None:
+        """Log the step's windows; ``plan``: the proposal as :meth:`decide` made it (rows + rollout key)."""
         log = self._open_log()
         if log is None:
             return
         why = r.block_reason or None  # issue 13: proposal_violation / proposal_uncertain / brake_tail_...
+        # where each window's rows come from (only for a log that records it: a MonitorLog)
+        ro: dict[str, Any] = {}
+        if getattr(log, "logs_rollouts", False):
+            ro["rollout"] = _logged_rollout(plan)
         if not r.replaced:  # the window that ran is this one; it may commit a braking tail
             self._log_accepted = log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl,
-                                                  r.applied_ctrl, False, reason=why)
+                                                  r.applied_ctrl, False, reason=why, **ro)
             return
         fb = r.fallback_certificate
         if fb is None or not getattr(log, "logs_applied_motions", False):  # a log object of another kind
-            log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why)
+            log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why,
+                             **ro)
             if not r.fallback_certified and fb is not None:
                 self._note_model()
+                if ro:
+                    ro["rollout"] = _logged_rollout(applied_plan)
                 log.write_window(r.time, _plan_of(applied_plan), fb, r.applied_ctrl, r.applied_ctrl, True,
-                                 reason=why)
+                                 reason=why, **ro)
             return
-        self._write_applied(log, r, applied_plan, why)
+        self._write_applied(log, r, applied_plan, why, ro)
 
-    def _write_applied(self, log: Any, r: StepReport, applied_plan: Any, why: str | None) -> None:
+    def _write_applied(self, log: Any, r: StepReport, applied_plan: Any, why: str | None,
+                       ro: dict[str, Any]) -> None:
         """Log a replaced step: its proposal, naming the record of the motion that ran.
 
         That record (``applied=``, see :data:`monitor.log.topics.APPLIED_MOTIONS_KEY`) is a fresh
@@ -2290,18 +2368,20 @@ class Gate:
             rec = self._tail_record
             if rec is not None and rec[0] is fb:  # this tail is in the log already
                 log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True,
-                                 reason=why, applied_window=rec[1])
+                                 reason=why, applied_window=rec[1], **ro)
                 return
             by = self._log_accepted
             applied = {"kind": "brake_tail", "covered_by": nxt + 1 if by is None else by}
-            applied_plan = tail[0].plan if isinstance(tail[0], _Tail) else tail[0]
+            applied_plan = tail[0]  # a _Tail (its Plan below), or a Plan
             self._tail_record = (fb, nxt + 1)
         else:
             applied = {"kind": "fallback", "covered_by": nxt + 1}
         log.write_window(r.time, r.plan, r.certificate, r.proposed_ctrl, r.applied_ctrl, True, reason=why,
-                         applied_window=nxt + 1)
+                         applied_window=nxt + 1, **ro)
         self._note_model()  # the fallback's model (an edit by a fallback callable)
-        log.write_window(r.time, _plan_of(applied_plan), fb, applied=applied)
+        if ro:
+            ro["rollout"] = _logged_rollout(applied_plan)
+        log.write_window(r.time, _plan_of(applied_plan), fb, applied=applied, **ro)
 
     def close(self) -> None:
         """Finish the log if the gate opened it."""

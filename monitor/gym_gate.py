@@ -236,6 +236,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                          frame_skip=int(getattr(u, "frame_skip", 1)), log_options=self._log_options(env),
                          action_shape=inner_shape, allowed=allowed, hazards=hazards, allow=allow,
                          ongoing=ongoing, penetration_tol=penetration_tol, brake_horizon=brake_horizon)
+        if predictor != "rollout":  # the log says whose predictor made the windows (review re-simulates none)
+            self.gate._predictor_label = predictor if isinstance(predictor, str) else "callable"
         self._unwrapped = u
         self._gate_frame_skip = self.gate.frame_skip  # the count this wrapper last gave the gate
         self._obs: Any = None
@@ -594,5 +596,7 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.gate.close()
         super().close()
 
+
+SafetyGate._as_inner._model_untouched = True  # type: ignore[attr-defined]  # decide's `cast`: no model edit
 
 __all__ = ["SafetyGate"]

@@ -12,7 +12,9 @@
   recomputation uses the library defaults unless the caller passes others), and
   ``model.xml`` must describe the same model as ``model.mjb``. A failed claim is a
   *critical* finding; a window that cannot be recomputed (no plan, an error, a
-  malformed message) is an *unverifiable* finding. See :func:`verify`.
+  malformed message) is an *unverifiable* finding. The rows of a gate's own rollouts
+  are themselves re-simulated from their logged start states and controls, and the
+  steps of an episode must continue each other (:func:`_replay_findings`). See :func:`verify`.
 * :func:`render_text` and :func:`write_report` present those dicts (text table,
   self-contained HTML with embedded matplotlib PNGs).
 
@@ -812,6 +814,162 @@ def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
         return False
 
 
+def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
+                     plan_msgs: dict[int, list[dict[str, Any]]],
+                     edits: list[_Edit], edits_bad_from: int | None,
+                     find: Callable[..., None], notes: list[str]) -> dict[str, int]:
+    """Re-simulate every window whose rows come from the gate's own rollout; check the episode's continuity.
+
+    For a log whose gate records rollouts (run metadata :data:`topics.ROLLOUTS_KEY`, format 3), each
+    plan says where its rows come from (:mod:`monitor.log.replay`). Here, on the attached MJB model
+    (bit-exact) with the logged in-place edits applied in window order:
+
+    * a ``"rollout"`` plan is re-simulated from its logged integration state and controls, and its
+      rows (times, qpos, held mocap poses) must be the logged ones bit for bit; else the first
+      differing row is named;
+    * records whose rollouts start at the same time of one episode (a step's proposal, its fallback,
+      the braking tail simulated after it) must start from the same physical state (time, qpos,
+      qvel, act, ...: :func:`monitor.log.replay.physics_index`);
+    * consecutive steps of one episode: the motion that ran in step i (its window, or the applied
+      record its replaced action names), re-simulated, must reach the next step's start time in
+      the physical state the next window's rollout starts from (an edited control or state breaks
+      it; so does user code that sets the state between steps without ``gate.reset()``).
+
+    A failure is CRITICAL when the window claims ``certified`` (its certificate is about rows that
+    are not the motion), UNVERIFIABLE otherwise. A log of a rollout gate whose plan lacks ``source``
+    (stripped) is the same. Under another MuJoCo version than the logged one the re-simulation need
+    not be bit-exact: every failure is UNVERIFIABLE and a note says so (an exact match still counts).
+    Plans marked ``"user"`` are not re-simulated: a note, or UNVERIFIABLE when the run's predictor is
+    the gate's rollout (it makes no user rows). Logs without rollouts (older): a note.
+
+    Returns:
+        counts: ``replayed`` (re-simulated and identical), ``replay_user``, ``replay_failed``
+        (findings above, per window), ``continuity_checked`` (step pairs compared).
+    """
+    import mujoco
+
+    from monitor.errors import LogFormatError, MonitorError
+    from monitor.log import replay
+    from monitor.log.reader import load_model
+
+    run = contents.run
+    marked = run.get(topics.ROLLOUTS_KEY) == "logged"
+    out = {"replayed": 0, "replay_user": 0, "replay_failed": 0, "continuity_checked": 0}
+    if not marked and not any("source" in p for ps in plan_msgs.values() for p in ps):
+        if certs:
+            notes.append("no rollouts logged (a log before format 3, or not a gate's): the plans' rows are "
+                         "re-certified but not re-simulated")
+        return out
+    try:
+        model, _ = load_model(contents, "mjb")  # bit-exact (the XML keeps 6 digits)
+    except LogFormatError as exc:
+        find(UNVERIFIABLE, f"rollouts cannot be re-simulated: the MJB model does not load ({str(exc)[:200]})")
+        return out
+    exact = run.get("mujoco_version") == mujoco.__version__
+    if not exact:
+        notes.append(f"the log was written with MuJoCo {str(run.get('mujoco_version'))[:20]}, this is "
+                     f"{mujoco.__version__}: re-simulated rows need not be bit-exact, so a difference is "
+                     f"unverifiable, not critical")
+    data = mujoco.MjData(model)
+    phys = replay.physics_index(model)
+    by_index = {c["index"]: c for c in certs}
+    edits = list(edits)
+    ends: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # record -> (row times, integration states)
+    starts: dict[tuple[str, float], tuple[int, np.ndarray]] = {}  # (episode, t) -> (first record, state)
+    step_start: dict[int, np.ndarray] = {}  # window -> its start state (rows_from 0)
+    user: list[int] = []
+
+    def fail(k: int, reason: str) -> None:
+        out["replay_failed"] += 1
+        certified = by_index[k].get("verdict") == Verdict.CERTIFIED
+        find(CRITICAL if certified and exact else UNVERIFIABLE, reason, k)
+
+    for k in sorted(plan_msgs):
+        ps = plan_msgs[k]
+        if len(ps) != 1 or k not in by_index or (edits_bad_from is not None and k >= edits_bad_from):
+            continue  # duplicates / malformed certificates / unusable edits: reported by verify's loop
+        while edits and edits[0][0] <= k:
+            _apply_model_edit(model, edits.pop(0))
+        p = ps[0]
+        src = p.get("source")
+        if src == "user":
+            user.append(k)
+            continue
+        if src is None and p.get("kind", "plan") != "plan":
+            continue  # a body motion: never a gate rollout
+        if src != "rollout":
+            fail(k, "the run logs where every window's rows come from (rollouts: logged), but this plan has "
+                    + ("no source: its rollout was removed" if src is None else f"source {_short(src, 30)}")
+                    + "; its rows cannot be re-simulated")
+            continue
+        try:
+            ro = replay.decode(p.get("rollout"), model)
+            plan, states = replay.resimulate(model, data, ro)
+        except (MonitorError, ValueError, TypeError) as exc:
+            fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
+            continue
+        diff = replay.first_difference(plan, p)
+        if diff is not None:
+            fail(k, f"the logged rows are not the re-simulation of its logged rollout (start state and "
+                    f"controls) on the logged model: {diff}")
+            continue
+        out["replayed"] += 1
+        ends[k] = (plan.times, states)
+        at = (str(p.get("episode", 0)), float(ro.state[0]))
+        first = starts.setdefault(at, (k, ro.state))
+        if first[0] != k:
+            d = float(np.max(np.abs(first[1][phys] - ro.state[phys]), initial=0.0))
+            if not np.array_equal(first[1][phys], ro.state[phys]):
+                fail(k, f"its rollout starts at t = {at[1]!r} s from another physical state than window "
+                        f"{first[0]}'s (max |difference| {d:.3g}): both were simulated from the same step")
+                continue
+        if ro.rows_from == 0:
+            step_start[k] = ro.state
+    # consecutive steps: what ran in step i reaches step j's start state
+    acts = {a.get("index"): a for a in contents.topic(topics.ACTION) if _is_int(a.get("index"))}
+    steps = [c for c in certs if not is_applied_record(c)]
+    for c_i, c_j in zip(steps, steps[1:]):
+        i, j = c_i["index"], c_j["index"]
+        if str(c_i.get("episode", 0)) != str(c_j.get("episode", 0)) or j not in step_start:
+            continue
+        a = acts.get(i)
+        rec = a.get("applied_window") if a is not None and a.get("replaced") is True else i
+        if not _is_int(rec) or rec not in ends or rec not in by_index:
+            continue
+        times, states = ends[rec]
+        t_j = float(step_start[j][0])
+        hit = np.flatnonzero(times == t_j)
+        if len(hit) != 1:
+            if rec == i and float(times[-1]) != t_j:  # a gate's step window ends where the next one starts
+                find(UNVERIFIABLE, f"steps {i} and {j} of one episode do not meet (window {i} ends at "
+                                   f"t = {float(times[-1])!r} s, window {j} starts at t = {t_j!r} s): the "
+                                   f"motion in between is not in the log (a window removed, or the state "
+                                   f"stepped without the gate)", j)
+            continue  # (a replaced step's record: the applied-motion checks cover its span)
+        out["continuity_checked"] += 1
+        end, start = states[int(hit[0])][phys], step_start[j][phys]
+        if not np.array_equal(end, start):
+            d = float(np.max(np.abs(end - start), initial=0.0))
+            fail(rec, f"re-simulated, the motion that ran in step {i} reaches t = {t_j!r} s in another "
+                      f"physical state (time, qpos, qvel, act) than window {j} starts from (max |difference| "
+                      f"{d:.3g}): "
+                      f"an edited control or start state, or the state was set between steps without "
+                      f"gate.reset()")
+    out["replay_user"] = len(user)
+    if user:
+        text = (f"{len(user)} window(s) (first {user[0]}) have rows from user code (a predictor callable, an "
+                f"adapter, an explicit plan, or a `cast` that edited the model while they were simulated): "
+                f"not re-simulated")
+        if marked and run.get("predictor") == "rollout":
+            find(UNVERIFIABLE, text + ", although the run's predictor is the gate's own rollout")
+        else:
+            notes.append(text)
+    if out["replayed"]:
+        notes.append(f"{out['replayed']} window(s) re-simulated from their logged rollouts on the MJB model: "
+                     f"rows identical; {out['continuity_checked']} step-to-step state continuity check(s)")
+    return out
+
+
 def _engine() -> tuple[Any, Any]:
     """(Scene class, certify function); ImportError while the engine is not installed."""
     from monitor.certify.engine import certify
@@ -902,19 +1060,56 @@ def _pair_key(geoms: Any) -> frozenset:
     return frozenset(map(str, geoms))
 
 
+_Edit = tuple[int, dict[str, np.ndarray], int | None, dict[str, Any]]
+"""A logged model edit: (window index, array field -> new array, disableflags or None, option -> value)."""
+
+
+def _option_problem(model: Any, options: Any) -> tuple[str | None, dict[str, Any]]:
+    """(problem or None, checked options) of a model edit record's ``"options"`` (format 3)."""
+    from monitor.log.replay import option_fields
+
+    if options is None:
+        return None, {}
+    if not isinstance(options, dict):
+        return "options is not an object", {}
+    known = option_fields(model)
+    out: dict[str, Any] = {}
+    for name, val in options.items():
+        ref = getattr(model.opt, name) if name in known else None
+        if ref is None:
+            return f"option {_short(name, 40)} is not a model option", {}
+        if isinstance(ref, np.ndarray):
+            ok = isinstance(val, list) and all(map(_is_num, val))
+            arr = np.asarray(val, dtype=np.float64) if ok else None
+            if arr is None or arr.shape != ref.shape:
+                return f"option {name}: not {ref.size} finite numbers", {}
+            out[name] = arr
+        elif isinstance(ref, int) and not isinstance(ref, bool):
+            if not _is_int(val):
+                return f"option {name}: {_short(val, 30)} is not an integer", {}
+            out[name] = int(val)
+        elif not _is_num(val):
+            return f"option {name}: {_short(val, 30)} is not a finite number", {}
+        else:
+            out[name] = float(val)
+    return None, out
+
+
 def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], notes: list[str]
-                 ) -> tuple[list[tuple[int, dict[str, np.ndarray], int | None]], int | None]:
+                 ) -> tuple[list[_Edit], int | None]:
     """The logged in-place model edits (``monitor.model_edit`` records), checked against ``model``.
 
     Returns:
-        (edits in file order as (window index, field -> new array, disableflags or None),
-        the first window index from which the edits are unusable (a malformed record: those
-        windows are reported UNVERIFIABLE, never re-derived on a model the run did not certify
-        on), or None).
+        (edits in file order as (window index, field -> new array, disableflags or None,
+        option -> value), the first window index from which the edits are unusable (a malformed
+        record: those windows are reported UNVERIFIABLE, never re-derived on a model the run did
+        not certify on), or None).
     """
+    from monitor.log.replay import model_fields
     from monitor.scene import SYNC_FIELDS
 
-    out: list[tuple[int, dict[str, np.ndarray], int | None]] = []
+    editable = set(SYNC_FIELDS) | set(model_fields(model))  # format 3 also logs dynamics arrays
+    out: list[_Edit] = []
     bad_from: int | None = None
     last = 0
     for n, rec in enumerate(contents.model_edits):
@@ -927,8 +1122,9 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
         if problem is None and not isinstance(fields, dict):
             problem = "fields is not an object"
         for name, val in (fields.items() if problem is None else ()):
-            if name not in SYNC_FIELDS:
-                problem = f"field {_short(name, 40)} is not a model array a certificate depends on"
+            if name not in editable:
+                problem = f"field {_short(name, 40)} is not a model array a certificate or a simulation " \
+                          f"depends on"
                 break
             ref = getattr(model, name)
             try:
@@ -947,28 +1143,36 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
         flags = rec.get("disableflags") if isinstance(rec, dict) else None
         if problem is None and flags is not None and not _is_int(flags):
             problem = f"disableflags {_short(flags, 40)} is not an integer"
+        options: dict[str, Any] = {}
+        if problem is None:
+            problem, options = _option_problem(model, rec.get("options"))
         if problem is not None:
             find(UNVERIFIABLE, f"model edit record {n} is malformed: {problem}")
             bad_from = w if _is_int(w) and w >= last else last
             break
         last = int(w)
-        out.append((int(w), arrays, None if flags is None else int(flags)))
+        out.append((int(w), arrays, None if flags is None else int(flags), options))
     if out:
-        names = sorted({k for _, a, _ in out for k in a} | ({"opt.disableflags"} if any(
-            f is not None for _, _, f in out) else set()))
+        names = sorted({k for _, a, _, _ in out for k in a} | ({"opt.disableflags"} if any(
+            f is not None for _, _, f, _ in out) else set()) | {f"opt.{k}" for *_, o in out for k in o})
         notes.append(f"{len(out)} in-place model edit(s) logged by the run (first at window {out[0][0]}; "
                      f"fields: {', '.join(names)}): each window re-derived on the model as edited before "
                      f"it (the run's record, like its requests: a forged record reads like a genuine one)")
     return out, bad_from
 
 
-def _apply_model_edit(model: Any, edit: tuple[int, dict[str, np.ndarray], int | None]) -> None:
+def _apply_model_edit(model: Any, edit: _Edit) -> None:
     """Write one logged edit into ``model`` in place (review's own copy of the attached model)."""
-    _, arrays, flags = edit
+    _, arrays, flags, options = edit
     for name, arr in arrays.items():
         getattr(model, name)[...] = arr
     if flags is not None:
         model.opt.disableflags = flags
+    for name, value in options.items():
+        if isinstance(value, np.ndarray):
+            getattr(model.opt, name)[...] = value
+        else:
+            setattr(model.opt, name, value)
 
 
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
@@ -1008,6 +1212,12 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     that loosens margin / the ongoing rule / penetration_tol relative to request 0 (a
     setting changed during the run and an added record look the same).
 
+    Rows re-simulated (logs of format 3, :func:`_replay_findings`): every plan a gate made by its
+    own MuJoCo rollout must be, bit for bit, the re-simulation of its logged start state and
+    controls on the MJB model (with the logged edits), and consecutive steps of an episode must
+    continue each other (an edited plan, control or start state is critical when certified); a
+    plan that lost its rollout in a log that says it logs them is the same.
+
     In-place model edits the run logged (``monitor.model_edit`` records, written by a gate
     before the first window certified on the edited model) are applied in window order to
     the attached model, so each window is re-derived on the model it was certified on (flips
@@ -1041,7 +1251,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         of unverifiable findings), ``missing_plans``, ``errors`` (rows: index, error),
         ``pairs_differ``, and for applied-motion records (:func:`_applied_findings`)
         ``applied_checked`` (records re-derived, counted in ``checked`` too), ``applied_records``,
-        ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``.
+        ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``, and
+        ``replayed``, ``replay_user``, ``replay_failed``, ``continuity_checked``
+        (:func:`_replay_findings`).
 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
@@ -1170,6 +1382,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            "applied_checked": 0}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     edits, edits_bad_from = _model_edits(contents, model, find, notes)
+    replay_edits = list(edits)  # the loop below consumes edits; the re-simulation applies them again
     if edits and not trust_model_edits:
         first_edit = edits[0][0]
         n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
@@ -1293,6 +1506,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     _request_findings(used_requests, requests, find, notes, run_claims, max_penetration)
     applied = _applied_findings(contents, good, plan_msgs, find, notes)
     out.update(applied)
+    out.update(_replay_findings(contents, certs, plan_msgs, replay_edits, edits_bad_from, find, notes))
     unlogged = applied["unlogged_old"]
     if unlogged:
         notes.append(f"{unlogged} replaced action(s) (blocked proposals) ran a motion that is not in the log "
@@ -1465,6 +1679,10 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
                      f"{ver['missing_plans']} without plan, {len(ver['errors'])} error(s); "
                      f"{ver.get('unverifiable', 0)} unverifiable, {ver.get('pairs_differ', 0)} with a "
                      f"different pair set; {ver.get('windows', '?')} window(s) in the log")
+        if ver.get("replayed") or ver.get("replay_failed") or ver.get("replay_user"):
+            lines.append(f"     rollouts re-simulated: {ver.get('replayed', 0)} window(s) identical, "
+                         f"{ver.get('replay_failed', 0)} failed, {ver.get('replay_user', 0)} with rows from "
+                         f"user code; {ver.get('continuity_checked', 0)} step-to-step continuity check(s)")
         if ver.get("applied_records") or ver.get("applied_missing"):
             lines.append(f"     applied motions re-derived: {ver.get('applied_checked', 0)} record(s) of "
                          f"{ver.get('applied_records', 0)}, covering {ver.get('applied_steps', 0)} replaced "

@@ -23,6 +23,8 @@ means "no lower bound known" (read back as -inf).
 
 Version 1 logs (written before this change) used sim time for ``log_time`` and
 ``publish_time``, had no ``episode`` field and stored metadata values as JSON text.
+Version 3 adds the plan payload's ``source`` and ``rollout`` (:data:`ROLLOUTS_KEY`); a version 2
+log reads as before (review notes that its rows cannot be re-simulated).
 """
 
 from __future__ import annotations
@@ -51,7 +53,7 @@ LOG = "/monitor/log"
 """foxglove.Log (JSON encoding, no foxglove-sdk needed): one line per violation, uncertain
 window or blocked (replaced) action; level error for violations, warning otherwise."""
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 """Stored as ``format_version`` in the ``monitor.run`` metadata (absent = version 1)."""
 
 JSON_TOPICS: dict[str, tuple[str, str]] = {
@@ -85,7 +87,10 @@ tuning), written before the first window certified on the edited model:
 certificate depends on) that differs from the model as last attached or recorded, its full new
 value (row-major). ``review --verify`` applies the records in order to the attached model, so each
 window is re-derived on the model as it was certified. A gate writes ``"model_edits": "logged"``
-(:data:`MODEL_EDITS_KEY`) in the run metadata."""
+(:data:`MODEL_EDITS_KEY`) in the run metadata. Format 3 (a gate that logs rollouts,
+:data:`ROLLOUTS_KEY`): the records also hold every other changed array a re-simulation depends on
+(:func:`monitor.log.replay.model_fields`: masses, gains, damping, ...) and, under ``"options"``
+(``{name: value}``), every changed ``model.opt`` field but ``disableflags``."""
 MODEL_EDITS_KEY = "model_edits"
 """``monitor.run`` key a gate writes (value ``"logged"``): every in-place model edit the gate certified
 on is in a :data:`METADATA_MODEL_EDIT` record."""
@@ -97,6 +102,13 @@ window whose certificate payload has ``"applied": {"kind": "fallback" | "brake_t
 the braking tail's plan and certificate, written once per committed tail, ``covered_by`` = the
 accepted window certified with it). Logs without the key (older gates) log the applied motion only
 when it is not certified."""
+ROLLOUTS_KEY = "rollouts"
+"""``monitor.run`` key a gate writes (value ``"logged"``): every plan payload of its windows says
+where its rows come from, ``"source": "rollout" | "user"``, and a ``"rollout"`` plan (the gate's
+own MuJoCo rollout: proposals, fallbacks, braking tails) carries the integration state it started
+from and the control of every substep, from which ``review --verify`` re-simulates its rows bit
+for bit on the attached model (:mod:`monitor.log.replay`). A plan of such a log without
+``source`` was stripped of it."""
 METADATA_JSON_KEYS = "_json_keys"
 """Metadata key (version 2) listing, comma-separated, the keys whose values are JSON text;
 every other value is a plain string stored as is (no JSON inside JSON)."""
@@ -124,7 +136,7 @@ def schema(topic: str) -> dict[str, Any]:
 
 __all__ = [
     "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
-    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY",
+    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY", "ROLLOUTS_KEY",
     "METADATA_MODEL_EDIT", "MODEL_EDITS_KEY", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",

@@ -63,7 +63,7 @@ from mcap.writer import CompressionType, Writer
 from monitor._json import jsonable
 from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError, LogFormatError
-from monitor.log import topics
+from monitor.log import replay, topics
 from monitor.log.digest import METADATA_DIGEST, Digest
 
 MAX_MESSAGES_PER_WINDOW = 8
@@ -167,16 +167,22 @@ def package_versions() -> dict[str, str]:
 
 
 # --------------------------------------------------------------------------- model edits
-_DISABLEFLAGS = "opt.disableflags"
+_OPT = "opt."
+_DISABLEFLAGS = _OPT + "disableflags"
 
 
-def _model_fields(model: Any) -> dict[str, np.ndarray]:
-    """Copies of the model arrays a certificate depends on (``SYNC_FIELDS``) and ``opt.disableflags``."""
-    from monitor.scene import SYNC_FIELDS
+def _model_fields(model: Any, names: Any = None) -> dict[str, np.ndarray]:
+    """Copies of the model arrays a certificate or a re-simulation depends on, and of every option.
 
-    out = {k: np.array(getattr(model, k)) for k in SYNC_FIELDS}
-    out[_DISABLEFLAGS] = np.array([int(model.opt.disableflags)])
-    return out
+    ``names``: the keys to read (those of an earlier call on the attached model); default the
+    arrays of :func:`monitor.log.replay.model_fields` (``SYNC_FIELDS`` first) and ``opt.<field>``
+    for every :func:`monitor.log.replay.option_fields` entry (``opt.disableflags`` among them).
+    """
+    if names is None:
+        names = [*replay.model_fields(model), *(_OPT + n for n in replay.option_fields(model))]
+    opt = model.opt
+    return {k: np.array(getattr(opt, k[len(_OPT):]) if k.startswith(_OPT) else getattr(model, k), ndmin=1)
+            for k in names}
 
 
 # --------------------------------------------------------------------------- model export
@@ -362,6 +368,10 @@ class MonitorLog:
         ...     log.write_window(data.time, plan, cert)
     """
 
+    logs_rollouts = True
+    """:meth:`write_window` takes ``rollout=`` (a gate logs, for every window, where its rows come from
+    and, for its own MuJoCo rollouts, what re-simulates them: see :data:`monitor.log.topics.ROLLOUTS_KEY`)."""
+
     logs_applied_motions = True
     """:meth:`write_window` takes ``applied_window=`` / ``applied=`` (a gate logs, for every replaced
     action, the motion that ran: see :data:`monitor.log.topics.APPLIED_MOTIONS_KEY`)."""
@@ -394,6 +404,7 @@ class MonitorLog:
         self._closed = False
         self._model = None
         self._model_source = model_source
+        self._rollout_sizes: tuple[Any, int, int, int] | None = None  # (model, state spec, nstate, nu)
         self._scene = None
         self._want_foxglove = bool(foxglove)
         self.foxglove_enabled = False
@@ -415,7 +426,8 @@ class MonitorLog:
         if isinstance(run.get("request"), dict):
             self._requests[_request_key(run["request"])] = 0
         self.add_metadata(run)
-        self._model_base: dict[str, np.ndarray] | None = None  # SYNC_FIELDS as attached / last recorded
+        self._model_base: dict[str, np.ndarray] | None = None  # _model_fields as attached / last recorded
+        self._model_watch: replay.ModelWatch | None = None  # quick "unchanged since _model_base" test
         if model is not None:
             self._attach_model(model)
             self._model_base = _model_fields(model)
@@ -431,11 +443,15 @@ class MonitorLog:
     def note_model(self, model: Any) -> list[str]:
         """Record an in-place edit of the attached model (a ``monitor.model_edit`` record), if any.
 
-        Compares every :data:`monitor.scene.SYNC_FIELDS` array and ``opt.disableflags`` of
-        ``model`` with the attached model (or the last record) and, when some differ, writes
-        their full new values, tagged with the index of the next window (see
-        :data:`topics.METADATA_MODEL_EDIT`). Call it before writing a window certified on an
-        edited model; a gate calls it whenever its scene was rebuilt.
+        Compares every :data:`monitor.scene.SYNC_FIELDS` array, every other array a
+        re-simulation depends on (:func:`monitor.log.replay.model_fields`: masses, gains,
+        damping, ...) and every option of ``model`` with the attached model (or the last
+        record) and, when some differ, writes their full new values, tagged with the index of
+        the next window (see :data:`topics.METADATA_MODEL_EDIT`; options other than
+        ``disableflags`` under ``"options"``). Call it before writing a window certified or
+        simulated on an edited model; a gate calls it whenever its scene was rebuilt and, when
+        it logs rollouts, before every window. An unchanged model costs a few µs
+        (:class:`monitor.log.replay.ModelWatch`).
 
         Args:
             model: the ``MjModel`` the next window was certified on (the attached one, edited).
@@ -450,18 +466,33 @@ class MonitorLog:
         base = self._model_base
         if base is None:
             return []
-        now = _model_fields(model)
+        watch = self._model_watch
+        if watch is not None and watch.model is model and watch.unchanged():
+            return []
+        try:
+            now = _model_fields(model, base)
+        except AttributeError as exc:
+            raise InvalidInputError(f"model: not an MjModel like the one attached to the log "
+                                    f"({exc})") from exc
         if any(now[k].shape != v.shape for k, v in base.items()):
             raise InvalidInputError("model: its arrays do not have the shapes of the model attached to the "
                                     "log (another model, not an in-place edit)")
+        self._model_watch = replay.ModelWatch(model)
         changed = [k for k, v in base.items() if now[k].tobytes() != v.tobytes()]
         if not changed:
             return []
         fields = {k: {"shape": list(now[k].shape), "values": now[k].ravel().tolist()}
-                  for k in changed if k != _DISABLEFLAGS}
+                  for k in changed if not k.startswith(_OPT)}
         rec: dict[str, Any] = {"window": self._index, "fields": fields}
         if _DISABLEFLAGS in changed:
             rec["disableflags"] = int(now[_DISABLEFLAGS][0])
+        options = {}
+        for k in changed:
+            if k.startswith(_OPT) and k != _DISABLEFLAGS:
+                v = getattr(model.opt, k[len(_OPT):])
+                options[k[len(_OPT):]] = v.tolist() if isinstance(v, np.ndarray) else v
+        if options:
+            rec["options"] = options
         self.add_metadata(rec, name=topics.METADATA_MODEL_EDIT)
         self._model_base = now
         return changed
@@ -585,7 +616,7 @@ class MonitorLog:
                      applied_action: Any = None, replaced: bool = False,
                      wall_time: float | None = None, episode: int | None = None,
                      reason: str | None = None, request: Any = None, applied_window: int | None = None,
-                     applied: dict[str, Any] | None = None) -> int:
+                     applied: dict[str, Any] | None = None, rollout: Any = None) -> int:
         """Log one certified window; flushes the file before returning.
 
         Args:
@@ -618,6 +649,12 @@ class MonitorLog:
                 with ``i`` the index of the window whose certification covers it (a fallback:
                 this window itself; a committed braking tail: the accepted window it was
                 certified with, one step earlier). Stored in the certificate payload.
+            rollout: where the plan's rows come from (a joint-space Plan only), stored in the plan
+                payload (:mod:`monitor.log.replay`): ``(state, ((ctrl, substeps), ...), rows_from)``
+                for rows simulated by MuJoCo from ``state`` (the ``mjSTATE_INTEGRATION`` state,
+                (nstate,) float64 bytes or array) under each ctrl ((nu,) bytes or array) in turn,
+                from substep ``rows_from`` on (``source: "rollout"``, re-simulated by review);
+                ``"user"`` for rows made by user code (``source: "user"``); None: not stated.
 
         Returns:
             The window index in this log.
@@ -648,6 +685,10 @@ class MonitorLog:
                                     f"got {cert.get('verdict')!r}")
         if plan is not None:
             plan_msg = _plan_payload(plan)  # validates before anything is written
+            if rollout is not None:
+                plan_msg.update(self._rollout_payload(rollout, plan_msg, getattr(plan, "model", None)))
+        elif rollout is not None:
+            raise InvalidInputError("rollout needs the plan whose rows it made")
         if applied_window is not None and not _is_index(applied_window):
             raise InvalidInputError(f"applied_window must be a window index (int >= 0), "
                                     f"got {applied_window!r}")
@@ -700,6 +741,23 @@ class MonitorLog:
         self._last_log_ns = log_ns
         self._flush()
         return k
+
+    def _rollout_payload(self, rollout: Any, plan_msg: dict[str, Any], plan_model: Any) -> dict[str, Any]:
+        """The plan payload's ``source`` (and ``rollout``) for ``write_window(rollout=)``."""
+        if isinstance(rollout, str) and rollout == "user":
+            return {"source": "user"}
+        if plan_msg["kind"] != "plan":
+            raise InvalidInputError("rollout: only a joint-space Plan's rows come from a MuJoCo rollout")
+        model = self._model if self._model is not None else plan_model  # (attached below from the plan)
+        if model is None:
+            raise InvalidInputError("rollout needs the log's model (attached at open or from the plan)")
+        sizes = self._rollout_sizes
+        if sizes is None or sizes[0] is not model:
+            import mujoco
+
+            spec = int(mujoco.mjtState.mjSTATE_INTEGRATION)
+            sizes = self._rollout_sizes = (model, spec, mujoco.mj_stateSize(model, spec), int(model.nu))
+        return {"source": "rollout", "rollout": replay.encode(rollout, *sizes[1:])}
 
     def close(self) -> None:
         """Finish the journal, then (``index=True``) finalise it into an indexed file (idempotent).
