@@ -153,3 +153,25 @@ def test_rest_chunk():
             return False
 
     assert engine._rest_chunk(Counting(), 10, 4, 4) == 4      # a subclass keeps the chunks
+
+
+@pytest.mark.parametrize("nbody", [12, 100])
+def test_no_extrusion_route_flags(nbody):
+    """Both branches (a small tree in Python, a big one in numpy) against the rule on numpy arrays."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(nbody)
+    seen = set()
+    for _ in range(200):
+        moving = (rng.random(nbody) < 0.5).astype(np.int64)
+        rotating = moving * (rng.random(nbody) < 0.98) + (rng.random(nbody) < 0.3) * (1 - moving)
+        mov = moving.copy()
+        if rng.random() < 0.3:
+            mov[rng.integers(nbody)] ^= 1
+        mp = SimpleNamespace(body_moving=moving, body_rotating=rotating.astype(np.int64))
+        want = bool(np.array_equal(moving != 0, mov != 0) and not ((moving != 0) & (rotating == 0)).any())
+        assert engine._no_extrusion_route(mp, mov) is want
+        seen.add(want)
+    assert seen == {True, False}
+    mp = SimpleNamespace(body_moving=np.ones(nbody, np.int64), body_rotating=np.ones(nbody, np.int64))
+    assert engine._no_extrusion_route(mp, np.ones(nbody + 1, np.int64)) is False    # another body count

@@ -1199,8 +1199,17 @@ def _no_extrusion_route(mp: Any, mov: np.ndarray) -> bool:
     stage 1: ``moving[ba] == 0 and moving[bb] == 0``), so its route is never read. Every
     slot thus runs exactly what ``route`` all ones (or empty, as under ``"toleranced"``) runs.
     """
-    m = mp.body_moving
-    return bool(np.array_equal(m != 0, mov != 0) and not ((m != 0) & (mp.body_rotating == 0)).any())
+    bm, br = mp.body_moving, mp.body_rotating
+    if bm.shape != mov.shape or br.shape != mov.shape:
+        return False
+    if bm.shape[0] > 64:
+        m = bm != 0
+        return not ((m != (mov != 0)) | (m & (br == 0))).any()
+    # (Python ints of a few bodies: a handful of numpy calls on them cost ~10 us)
+    for m, r, k in zip(bm.tolist(), br.tolist(), mov.tolist()):
+        if (m != 0) != (k != 0) or (m != 0 and r == 0):
+            return False
+    return True
 
 
 def _python_decided(results: dict[int, PairResult]) -> tuple[list[PairResult], bool, bool, list[tuple]]:
