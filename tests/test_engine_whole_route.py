@@ -175,3 +175,10 @@ def test_no_extrusion_route_flags(nbody):
     assert seen == {True, False}
     mp = SimpleNamespace(body_moving=np.ones(nbody, np.int64), body_rotating=np.ones(nbody, np.int64))
     assert engine._no_extrusion_route(mp, np.ones(nbody + 1, np.int64)) is False    # another body count
+    flags = (rng.random(nbody) < 0.5).astype(np.int64)        # the three arrays equal (the Arm's case)
+    mp = SimpleNamespace(body_moving=flags, body_rotating=flags.copy())
+    assert engine._no_extrusion_route(mp, flags.copy()) is True
+    moving = flags.copy()
+    moving[np.flatnonzero(flags == 0)[0]] = 1                  # a body moving without rotating
+    mp = SimpleNamespace(body_moving=moving, body_rotating=flags.copy())
+    assert engine._no_extrusion_route(mp, moving.copy()) is False

@@ -1202,6 +1202,10 @@ def _no_extrusion_route(mp: Any, mov: np.ndarray) -> bool:
     bm, br = mp.body_moving, mp.body_rotating
     if bm.shape != mov.shape or br.shape != mov.shape:
         return False
+    if bm.dtype == br.dtype == mov.dtype:   # the common case: the three flag arrays are equal
+        b = bm.tobytes()
+        if b == br.tobytes() and b == mov.tobytes():
+            return True
     if bm.shape[0] > 64:
         m = bm != 0
         return not ((m != (mov != 0)) | (m & (br == 0))).any()
