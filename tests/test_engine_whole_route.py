@@ -87,13 +87,36 @@ def test_the_arm_certificates_are_the_previous_paths(arm, monkeypatch, name, met
         return real(*a)
 
     monkeypatch.setattr(engine, "_window_kernel", spy)
+    # any headroom is enough (the rule's clock is not under test here: test_rest_chunk)
+    monkeypatch.setattr(engine, "_CHUNK_HEADROOM", 0.0)
     fast = monitor.certify(scene, plan, method=method, epsilon=1e-3)
     monkeypatch.undo()
     ref = _oracle(monkeypatch, scene, plan, method=method, epsilon=1e-3)
     assert _key(fast) == _key(ref), name
-    S = fast.stats["pairs"] - fast.stats["pairs_culled"]
-    if S > engine._FAST_CHUNK:   # stage 0 with the first chunk, then the rest in one call
-        assert calls == [0, 1], (name, calls)
+    assert calls == [0], (name, calls)     # stage 0 and all of stage 1 in one compiled call
+    # the default headroom (a clock-dependent choice of chunks): the same certificate
+    assert _key(monitor.certify(scene, plan, method=method, epsilon=1e-3)) == _key(ref), name
+
+
+def test_a_tight_budget_keeps_the_chunks(arm, monkeypatch):
+    """With little headroom, stage 0 runs the first chunk and the rest goes chunk by chunk."""
+    m, scene = arm
+    plan = _arm_plan(m, ARM_CASES["yaw through post_a"])
+    ref = _oracle(monkeypatch, scene, plan, epsilon=1e-3)
+    assert ref.stats["pairs"] - ref.stats["pairs_culled"] == 10
+    calls = []
+    real = engine._window_kernel
+
+    def spy(*a):
+        calls.append((a[7], a[8], a[9]))        # stage, k0, k1
+        return real(*a)
+
+    monkeypatch.setattr(engine, "_window_kernel", spy)
+    monkeypatch.setattr(engine, "_CHUNK_HEADROOM", 1e12)     # no budget has that much headroom
+    fast = monitor.certify(scene, plan, epsilon=1e-3)
+    assert calls == [(0, 0, 4), (1, 4, 8), (1, 8, 10)], calls
+    monkeypatch.undo()
+    assert _key(fast) == _key(ref)
 
 
 def test_the_cases_cover_verdicts_and_long_windows(arm):

@@ -979,7 +979,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     info = np.zeros(KS.WI_SIZE)
     none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
-    first = chunk if whole else 0
+    first = 0
+    if whole:   # stage 0 runs stage 1 too: the first chunk, or every survivor (see _rest_chunk)
+        first = chunk if chunk == 1 else _rest_chunk(bud, P, 0, chunk)
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
@@ -1170,8 +1172,10 @@ def _rest_chunk(bud: Budget, S: int, done_to: int, chunk: int) -> int:
     one), the rest runs in one call: the clock would be read only to find it far from spent.
     Every survivor's result is the same either way (stage 1 decides each slot on its own from
     stage 0's arrays); only how late an exhausted budget is noticed depends on the chunk
-    (each pair's stage 1 stays capped at ``WHOLE_SHAPE_MAX_TESTS`` tests). Issue 12: on the
-    Arm's windows (9-12 survivors) this is one call instead of two or three.
+    (each pair's stage 1 stays capped at ``WHOLE_SHAPE_MAX_TESTS`` tests). Before stage 0
+    (``done_to`` 0, ``S`` the P selected pairs, any of which may survive) the pace is the whole
+    call so far per survivor. Issue 12: on the Arm's windows (9-12 of 51 pairs survive) stage 0
+    and all of stage 1 are then one compiled call instead of four.
     """
     if type(bud) is not Budget:   # a subclass may run out by its own rule (tests' poll counters)
         return chunk
