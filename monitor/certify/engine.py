@@ -1291,8 +1291,9 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
     """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
 
     None when a survivor is left to the stages after the kernel (``WK_PYTHON``, ``WK_OPEN``,
-    ``WK_UNRES``: the general tail runs). Called only when one ``window_kernel`` call ran stage 1
-    on all S survivors (``method="toleranced"``, S <= the chunk), so nothing is unfinished, no
+    ``WK_UNRES``: the general tail runs). Called only when the ``window_kernel`` calls ran stage 1
+    on all S survivors, every one on the whole-shape route (``method="toleranced"``, or ``"auto"``
+    under :func:`_no_extrusion_route`) and the budget stopped none, so nothing is unfinished, no
     Python stage and no full search runs, and the general tail's values reduce to these (same
     order of survivors, same float values read from ``res``, same dict insertion order):
     violation if any survivor is ``WK_STATIC_VIOL`` / ``WK_VIOL``, else certified; the witness
