@@ -107,14 +107,21 @@ def test_huge_joint_jump_ends_uncertain_without_overflow(arm):
 
 # ----------------------------------------------------------------------------- every stage
 
-def test_exhaustion_at_every_poll_never_certifies_the_collision(arm):
-    """Sweep the poll at which the budget runs out over every poll the call makes."""
+@pytest.mark.parametrize(("chunk", "min_polls"), [(None, 3), (1, 10)])
+def test_exhaustion_at_every_poll_never_certifies_the_collision(arm, monkeypatch, chunk, min_polls):
+    """Sweep the poll at which the budget runs out over every poll the call makes.
+
+    ``chunk``: survivors per compiled stage-1 call (None: the engine's; 1: a poll after every
+    survivor, so the sweep also stops the whole-shape stage between any two of the 10 survivors).
+    """
     m, scene = arm
+    if chunk is not None:
+        monkeypatch.setattr(engine, "_FAST_CHUNK", chunk)
     plan = _yaw(m, 1.0)  # link3 yaws through post_a
     full = PollBudget(10**9)
     assert monitor.certify(scene, plan, budget=full).verdict == "violation"
     n = full.polls
-    assert n > 5
+    assert n > min_polls
     seen = set()
     for k in range(n + 2):
         cert = monitor.certify(scene, _yaw(m, 1.0), budget=PollBudget(k))

@@ -962,6 +962,10 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     P = len(sel)
     pid, moving, fixed, mov, prm, narrow = prep
     route_all = narrow and method == "toleranced"
+    # "auto" when no moving body translates (the Arm's hinges): every survivor takes the
+    # whole-shape stage as under "toleranced" (see _no_extrusion_route), so stage 0 runs the
+    # first chunk too and no route is computed
+    whole = route_all or (narrow and method == "auto" and _no_extrusion_route(mp, mov))
     rows = _sweep_rows(scene, sp, pid)
     # the sweep leaves the pairs it does not produce untouched: zeroed (WK_UNVISITED), which for
     # a large array costs no pass over it (fresh zero pages)
@@ -975,7 +979,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     info = np.zeros(KS.WI_SIZE)
     none = _NONE
     chunk = 1 if bud.tests is not None else _FAST_CHUNK
-    first = chunk if route_all else 0
+    first = 0
+    if whole:   # stage 0 runs stage 1 too: the first chunk, or every survivor (see _rest_chunk)
+        first = chunk if chunk == 1 else _rest_chunk(bud, P, 0, chunk)
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
@@ -987,16 +993,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
         return _all_culled(sel, pid, code, gap, surv, res, info, scene.geoms, t0, t1, margin, epsilon, method,
                            bud, wall0, allowed, sc, sr, KS)
-    if route_all and done_to == S:
-        # every survivor went through the whole-shape stage in this one call: when the kernel
-        # decided them all, the certificate is the general tail's (see _kernel_decided)
-        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
-                               method, bud, wall0, allowed, sc, sr, KS)
-        if cert is not None:
-            return cert
-    route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
+    route = none if whole else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
-    if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
+    if narrow and not whole and S:   # "auto": both bodies translating -> extrusion route
         route = np.ones(S, np.int64)
         trans: dict[int, bool] = {}
         # a budget checkpoint where the plan's waypoint FK (first translation_segments) used to
@@ -1021,6 +1020,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                         route[s] = 0
         except BudgetExhausted:
             stopped = True
+    if chunk > 1 and done_to < S and not stopped:
+        chunk = _rest_chunk(bud, S, done_to, chunk)
     while done_to < S and not stopped:
         if bud.exhausted:
             stopped = True
@@ -1038,6 +1039,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
         _window_kernel(KS, sp.geoms, mp, pid, fixed, mov, np.zeros(S, np.int64), 1, done_to, S, prm, code,
                        gap, surv, res, sc, sr, rows, info)
         done_to = S
+    if whole and done_to == S and not stopped:
+        # stage 1 ran on every survivor (whole-shape route): when the kernel decided them all,
+        # the certificate is the general tail's (see _kernel_decided; no survivor is left
+        # WK_OPEN then, so _extrusion_decided below would return None)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
+                               method, bud, wall0, allowed, sc, sr, KS)
+        if cert is not None:
+            return cert
     if _EXTRUSION_DIRECT and method != "toleranced" and done_to == S and not stopped:
         # every survivor on the extrusion route (the tunnel's window): its certificate without the
         # general stages and tail (see _extrusion_decided); None leaves it to them
@@ -1147,6 +1156,70 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                                 earliest, clearance, lazy, stats, allowed)
 
 
+_CHUNK_HEADROOM = 100.0
+"""How many times the rest of stage 1, at the pace of the call so far, must fit into the budget's
+remaining seconds before :func:`_rest_chunk` runs it in one compiled call."""
+
+
+def _rest_chunk(bud: Budget, S: int, done_to: int, chunk: int) -> int:
+    """Survivors per stage-1 call for slots [done_to, S): all of them, or ``chunk``.
+
+    The budget clock can only be read between compiled calls, so stage 1 runs in chunks of
+    ``_FAST_CHUNK`` survivors. When the budget (a plain :class:`Budget`: tests and seconds
+    are its only limits) has no clock limit, or when its remaining
+    seconds exceed :data:`_CHUNK_HEADROOM` times the rest at this call's pace so far (the
+    elapsed seconds, validation, packing and stage 0 included, per survivor done, at least
+    one), the rest runs in one call: the clock would be read only to find it far from spent.
+    Every survivor's result is the same either way (stage 1 decides each slot on its own from
+    stage 0's arrays); only how late an exhausted budget is noticed depends on the chunk
+    (each pair's stage 1 stays capped at ``WHOLE_SHAPE_MAX_TESTS`` tests). Before stage 0
+    (``done_to`` 0, ``S`` the P selected pairs, any of which may survive) the pace is the whole
+    call so far per survivor. Issue 12: on the Arm's windows (9-12 of 51 pairs survive) stage 0
+    and all of stage 1 are then one compiled call instead of four.
+    """
+    if type(bud) is not Budget:   # a subclass may run out by its own rule (tests' poll counters)
+        return chunk
+    if bud.seconds is None:
+        return S
+    elapsed = bud.elapsed()
+    if bud.seconds - elapsed > _CHUNK_HEADROOM * elapsed / max(done_to, 1) * (S - done_to):
+        return S
+    return chunk
+
+
+def _no_extrusion_route(mp: Any, mov: np.ndarray) -> bool:
+    """Whether ``"auto"`` routes every survivor of this motion to the whole-shape stage.
+
+    Args:
+        mp: the motion pack (``body_moving`` / ``body_rotating`` (nbody,) flags).
+        mov: (nbody,) int64, the window kernel's ``moving`` flags (the plan's ``moving_bodies()``).
+
+    True when the two moving flags agree and every moving body also rotates. Then the route
+    :func:`_certify_fast` would compute after stage 0 is 1 (whole-shape) for every survivor the
+    kernel routes at all: a survivor slot gets 0 only when both bodies translate
+    (:func:`_translates`), and :func:`_translates` is False for a body the pack flags as moving
+    and rotating, True only for one it flags as not moving; a survivor whose two bodies do not
+    move is decided by its start-pose test before the kernel reads ``route`` (kernels.py,
+    stage 1: ``moving[ba] == 0 and moving[bb] == 0``), so its route is never read. Every
+    slot thus runs exactly what ``route`` all ones (or empty, as under ``"toleranced"``) runs.
+    """
+    bm, br = mp.body_moving, mp.body_rotating
+    if bm.shape != mov.shape or br.shape != mov.shape:
+        return False
+    if bm.dtype == br.dtype == mov.dtype:   # the common case: the three flag arrays are equal
+        b = bm.tobytes()
+        if b == br.tobytes() and b == mov.tobytes():
+            return True
+    if bm.shape[0] > 64:
+        m = bm != 0
+        return not ((m != (mov != 0)) | (m & (br == 0))).any()
+    # (Python ints of a few bodies: a handful of numpy calls on them cost ~10 us)
+    for m, r, k in zip(bm.tolist(), br.tolist(), mov.tolist()):
+        if (m != 0) != (k != 0) or (m != 0 and r == 0):
+            return False
+    return True
+
+
 def _python_decided(results: dict[int, PairResult]) -> tuple[list[PairResult], bool, bool, list[tuple]]:
     """The pairs of a window decided as :class:`PairResult` objects, in selection order.
 
@@ -1218,8 +1291,9 @@ def _kernel_decided(sel: np.ndarray, pid: np.ndarray, code: np.ndarray, gap: np.
     """The certificate :func:`_certify_fast` builds when the kernel decided every one of the S survivors.
 
     None when a survivor is left to the stages after the kernel (``WK_PYTHON``, ``WK_OPEN``,
-    ``WK_UNRES``: the general tail runs). Called only when one ``window_kernel`` call ran stage 1
-    on all S survivors (``method="toleranced"``, S <= the chunk), so nothing is unfinished, no
+    ``WK_UNRES``: the general tail runs). Called only when the ``window_kernel`` calls ran stage 1
+    on all S survivors, every one on the whole-shape route (``method="toleranced"``, or ``"auto"``
+    under :func:`_no_extrusion_route`) and the budget stopped none, so nothing is unfinished, no
     Python stage and no full search runs, and the general tail's values reduce to these (same
     order of survivors, same float values read from ``res``, same dict insertion order):
     violation if any survivor is ``WK_STATIC_VIOL`` / ``WK_VIOL``, else certified; the witness
