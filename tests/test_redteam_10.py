@@ -1,0 +1,158 @@
+"""Red team 10: the sealed waypoints, the gate's memos and shortcuts, review, huge coordinates.
+
+Oracles are independent of ``monitor``'s checkers:
+
+* a straight motion that crosses a wall: by continuity the ball's centre passes every point of its
+  segment, including one inside the wall, so a "certified" window is a proven false certificate;
+* the motion that actually ran: the ball's live ``qpos`` after each step against the wall's face, in
+  closed form (a slide joint along x: the distance is monotone within a window, so the end states
+  bound it);
+* the general (Python) path of ``certify`` as the reference for the compiled path's typed errors.
+"""
+
+from __future__ import annotations
+
+import copy
+import pickle
+
+import mujoco
+import numpy as np
+import pytest
+
+from monitor import BodyMotion, Plan, Scene, certify
+from monitor.certify.types import Verdict
+from monitor.errors import InvalidInputError
+from monitor.motion.bezier import BezierMotion, RigidBezier
+
+_WALL = """
+<mujoco>
+  <worldbody>
+    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0" contype="0" conaffinity="0"/>
+    <body name="ball">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <geom name="ball" type="sphere" size="0.02" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+_WALL_X = 0.3 - 0.01 - 0.02   # the ball's centre x at which it touches the wall's near face (m)
+
+
+@pytest.fixture(scope="module")
+def wall():
+    model = mujoco.MjModel.from_xml_string(_WALL)
+    return model, Scene.from_model(model, pairs="all", allowed=None)
+
+
+def _body_motion(x_end: float) -> BodyMotion:
+    """The ball body (index 1) translating from x = 0 to ``x_end`` in 1 s, as a BodyMotion."""
+    pos = np.zeros((2, 2, 3))
+    pos[1, 1, 0] = x_end
+    quat = np.zeros((2, 2, 4))
+    quat[..., 0] = 1.0
+    return BodyMotion([0.0, 1.0], pos, quat)
+
+
+def _reopen(arr: np.ndarray) -> np.ndarray | None:
+    """A writable array on ``arr``'s memory reached through its ``.base`` chain, or None."""
+    a = arr
+    while isinstance(a, np.ndarray):
+        try:
+            a.setflags(write=True)
+            return a
+        except ValueError:
+            a = a.base
+    return None
+
+
+# --------------------------------------------------------------------- sealed waypoints
+
+
+def _sealed_arrays() -> list[tuple[str, np.ndarray]]:
+    model = mujoco.MjModel.from_xml_string(_WALL)
+    plan = Plan([0.0, 1.0], [[0.0], [0.1]], model)
+    bm = _body_motion(0.1)
+    rb = RigidBezier([[1, 0, 0, 0], [1, 0, 0, 0]], [[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0]])
+    bz = BezierMotion([0.0, 1.0], np.zeros((2, 3)), [[1, 0, 0, 0]] * 2, {1: rb})
+    return [("plan.times", plan.times), ("plan.qpos", plan.qpos), ("bm.times", bm.times), ("bm.pos", bm.pos),
+            ("bm.quat", bm.quat), ("bm.ref_points", bm.ref_points), ("bezier.times", bz.times),
+            ("bezier.ref_points", bz.ref_points), ("rigid._T", rb._T), ("rigid._Q", rb._Q)]
+
+
+def test_sealed_waypoints_cannot_be_reopened_through_their_base():
+    """``sealed`` made a read-only view of a read-only OWNER: numpy lets an owner turn
+    ``WRITEABLE`` back on, and the view's ``.base`` hands it out (ca04081: every array below)."""
+    reopened = [name for name, arr in _sealed_arrays() if _reopen(arr) is not None]
+    assert reopened == []
+
+
+def test_a_plan_edited_through_its_base_is_not_certified_from_the_memo(wall):
+    """ca04081: certify a clear plan, push its end waypoint through the wall via ``qpos.base``:
+    the call memo and the pack answered ``certified`` for the new motion."""
+    model, scene = wall
+    plan = Plan([0.0, 1.0], [[0.0], [0.1]], model)
+    assert certify(scene, plan, margin=0.01).verdict == Verdict.CERTIFIED
+    owner = _reopen(plan.qpos)
+    if owner is None:
+        return                                     # sealed: the edit is impossible (the fix)
+    owner.reshape(-1)[-1] = 0.6                    # x: 0 -> 0.6 crosses the wall's face at 0.27
+    assert plan.qpos[-1, 0] > _WALL_X
+    assert certify(scene, plan, margin=0.01).verdict != Verdict.CERTIFIED
+
+
+@pytest.mark.parametrize("clone", ["pickle", "deepcopy"])
+def test_a_copied_plan_keeps_its_waypoints_sealed(wall, clone):
+    """ca04081: a pickle / deepcopy round trip gave a Plan with WRITABLE waypoints that still
+    carried the original's waypoint poses: edited through the wall, it was certified on its very
+    first certify (auto; the toleranced method said violation)."""
+    model, scene = wall
+    plan = Plan([0.0, 1.0], [[0.0], [0.1]], model)
+    assert certify(scene, plan, margin=0.01).verdict == Verdict.CERTIFIED
+    dup = pickle.loads(pickle.dumps(plan)) if clone == "pickle" else copy.deepcopy(plan)
+    assert not dup.qpos.flags.writeable and not dup.times.flags.writeable
+    assert _reopen(dup.qpos) is None
+    with pytest.raises(ValueError):
+        dup.qpos[-1, 0] = 0.6
+    assert certify(scene, dup, margin=0.01).verdict == Verdict.CERTIFIED   # the same clear motion
+
+
+@pytest.mark.parametrize("clone", ["pickle", "deepcopy"])
+def test_copied_body_and_bezier_motions_keep_their_arrays_sealed(clone):
+    rb = RigidBezier([[1, 0, 0, 0], [1, 0, 0, 0]], [[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0]])
+    bz = BezierMotion([0.0, 1.0], np.zeros((2, 3)), [[1, 0, 0, 0]] * 2, {1: rb})
+    dup = (lambda o: pickle.loads(pickle.dumps(o))) if clone == "pickle" else copy.deepcopy
+    bm2, bz2 = dup(_body_motion(0.1)), dup(bz)
+    for arr in (bm2.times, bm2.pos, bm2.quat, bz2.times, bz2.motions[1]._T):
+        assert _reopen(arr) is None
+
+
+def test_sealing_leaves_the_callers_arrays_alone(wall):
+    """The old ``sealed`` froze a caller's own (base None) array in place; the copy does not."""
+    model, _ = wall
+    t, q = np.array([0.0, 1.0]), np.array([[0.0], [0.1]])
+    plan = Plan(t, q, model)
+    assert t.flags.writeable and q.flags.writeable
+    t[1] = 5.0
+    assert plan.times[1] == 1.0
+
+
+# --------------------------------------------------------------------- huge coordinates
+
+
+def test_the_compiled_path_and_the_general_path_agree_on_coordinates_beyond_1e9_m(wall, monkeypatch):
+    """Red team 7: a ball 1e200 m away was certified by the compiled path (clearance -2.4e187 m)
+    where the general path raises the geometry's typed "beyond 1e9 m" error."""
+    import monitor.certify.engine as engine
+    from monitor.geometry import distance
+    from monitor.motion import kernel
+
+    assert engine._FAST_MAX_COORD == distance._MAX_COORD
+    assert (engine._PACK_TOL_SCALE, engine._PACK_TOL_QMAG) == (kernel.TOL_SCALE, kernel.TOL_QMAG)
+    model, scene = wall
+    for q in ([[-1e200], [-5e199]], [[-1e200], [-1e200]]):
+        for method in ("auto", "toleranced"):
+            with pytest.raises(InvalidInputError, match="beyond 1e\\+09 m"):
+                certify(scene, Plan([0.0, 1.0], q, model), method=method)
+    monkeypatch.setattr(engine, "_fast_inputs", lambda scene, plan: None)
+    with pytest.raises(InvalidInputError, match="beyond 1e\\+09 m"):
+        certify(scene, Plan([0.0, 1.0], [[-1e200], [-5e199]], model))
