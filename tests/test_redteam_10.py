@@ -156,3 +156,67 @@ def test_the_compiled_path_and_the_general_path_agree_on_coordinates_beyond_1e9_
     monkeypatch.setattr(engine, "_fast_inputs", lambda scene, plan: None)
     with pytest.raises(InvalidInputError, match="beyond 1e\\+09 m"):
         certify(scene, Plan([0.0, 1.0], [[-1e200], [-5e199]], model))
+
+
+# --------------------------------------------------------------------- gate: data of another model
+
+_DRIVEN = """
+<mujoco>
+  <option timestep="0.01"/>
+  <worldbody>
+    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0" contype="0" conaffinity="0"/>
+    <body name="ball">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <geom name="ball" type="sphere" size="0.02" mass="1" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+  <actuator><velocity joint="x" kv="100"/></actuator>
+</mujoco>
+"""
+
+
+def test_decide_refuses_the_data_of_an_edited_model_copy():
+    """Domain randomisation by copies: the caller's model (the wall moved to x = 0.1) and its data,
+    the gate on the original model. ca04081 checked nq / nv / nu only and certified the window of
+    its own model; the motion under the caller's model went through the caller's wall."""
+    from monitor import Gate
+
+    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    edited = copy.deepcopy(model)
+    edited.geom_pos[0] = [0.1, 0.0, 0.0]          # the caller's wall: near face at x = 0.09
+    data = mujoco.MjData(edited)
+    data.qpos[0] = 0.05
+    gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5, brake=False)
+    try:
+        report = gate.decide(data, np.array([1.0]))
+    except InvalidInputError:
+        return
+    x0 = float(data.qpos[0])
+    data.ctrl[:] = report.applied_ctrl
+    mujoco.mj_step(edited, data, nstep=5)          # the caller steps its own model
+    x1 = float(data.qpos[0])
+    # the ball's centre moves monotonically from x0 to x1; it touches the wall's face at 0.07
+    assert not (report.verdict == Verdict.CERTIFIED and x0 < 0.07 < x1), (x0, x1, report.verdict)
+
+
+def test_step_refuses_the_data_of_a_model_with_other_sizes():
+    """ca04081: ``mujoco.FatalError`` (mj_copyData) for the data of a model with one more body."""
+    from monitor import Gate
+
+    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    ball = '<body name="ball">'
+    post = '<body name="post" pos="0 1 0"><geom type="sphere" size="0.1"/></body>'
+    bigger = mujoco.MjModel.from_xml_string(_DRIVEN.replace(ball, post + ball))
+    gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
+    with pytest.raises(InvalidInputError, match="another MjModel"):
+        gate.step(mujoco.MjData(bigger), np.array([1.0]))
+
+
+def test_a_gate_accepts_the_data_of_an_identical_model_copy():
+    """The guard: a copy with the same bytes (a pickled gate and the original's data) still works."""
+    from monitor import Gate
+
+    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    data = mujoco.MjData(copy.deepcopy(model))
+    gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
+    assert gate.step(data, np.array([0.1])).verdict == Verdict.CERTIFIED
