@@ -551,19 +551,22 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         report: StepReport = self.gate.decide(u.data, action, nstep=nstep, predict=self._predict_fn(),
                                               fallback=self._fallback_fn(), cast=self._as_inner)
         hook = self._commit_ok and self.commit and "_step_mujoco_simulation" not in u.__dict__
+        # the env steps its own copy: a step that edits the action array in place (action *= k) must
+        # not edit the certified control the checks below compare with (red team 10)
+        certified = np.asarray(report.applied_ctrl, dtype=np.float64)
         if hook:  # instance attribute: shadows MujocoEnv._step_mujoco_simulation for this call only
             u._step_mujoco_simulation = self._commit_sim
-            self._expected = (np.asarray(report.applied_ctrl, dtype=np.float64), nstep, mocap_start)
+            self._expected = (certified, nstep, mocap_start)
         try:
-            obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
+            obs, reward, terminated, truncated, info = self._step_env(np.array(report.applied_ctrl))
         finally:
             if hook:
                 del u._step_mujoco_simulation
         if not (hook and self._expected is None):  # the hook did not run (it checks before simulating)
             self._check_geometry("the motion that ran was not certified")
-        self._check_applied_ctrl(report.applied_ctrl)
+        self._check_applied_ctrl(certified)
         self._check_elapsed(t_start, nstep)
-        self._check_window_ran(report.applied_ctrl, nstep, mocap_start,
+        self._check_window_ran(certified, nstep, mocap_start,
                                self.gate.stats["committed"] != committed_before)
         self._obs = obs
         info = dict(info)

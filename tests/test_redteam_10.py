@@ -220,3 +220,35 @@ def test_a_gate_accepts_the_data_of_an_identical_model_copy():
     data = mujoco.MjData(copy.deepcopy(model))
     gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
     assert gate.step(data, np.array([0.1])).verdict == Verdict.CERTIFIED
+
+
+# --------------------------------------------------------------------- SafetyGate: the action array
+
+
+@pytest.mark.parametrize("commit", [True, False])
+def test_an_env_step_that_scales_the_action_in_place_is_not_certified(commit):
+    """An env whose ``step`` scales the action array in place (``action *= 6``) before simulating.
+
+    SafetyGate's after-step checks compared ``data.ctrl`` with ``report.applied_ctrl``, the very
+    array the env had just scaled: ca04081 (``commit=False``, or any env without the commit hook)
+    reported ``certified`` while the ball ran at 6 m/s through the tunnel's wall. The wall's near
+    face is at x = -0.015 for the ball's centre; the centre moves monotonically within a step."""
+    from monitor.envs.tunnel_v0 import BALL_RADIUS, WALL_HALF_THICKNESS, TunnelEnv
+    from monitor.gym_gate import SafetyGate
+
+    class Scaled(TunnelEnv):
+        def step(self, action):
+            action *= 6.0
+            return super().step(action)
+
+    env = SafetyGate(Scaled(x0=-0.04), brake=False)
+    env.commit = commit
+    env.reset(seed=0)
+    x0 = float(env.unwrapped.data.qpos[0])
+    try:
+        info = env.step(np.array([1.0]))[4]
+    except InvalidInputError:
+        return
+    x1 = float(env.unwrapped.data.qpos[0])
+    touch = -(WALL_HALF_THICKNESS + BALL_RADIUS)
+    assert not (info["safety"]["verdict"] == "certified" and x0 < touch < x1), (x0, x1)
