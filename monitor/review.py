@@ -798,8 +798,10 @@ def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
     if not step_plans or not rec_plans or len(step_plans) > 1 or len(rec_plans) > 1:
         return True  # a missing or duplicate plan is reported by verify's window loop
     p, r = step_plans[0], rec_plans[0]
-    if p.get("kind", "plan") != "plan" or r.get("kind", "plan") != "plan":
+    if p.get("kind", "plan") != "plan":
         return True  # body motions: no joint state to compare (a gate logs joint-space plans)
+    if r.get("kind", "plan") != "plan":
+        return False  # a joint-space step's applied motion is a joint-space plan: another kind is any motion
     try:
         times = np.asarray(r["times"], np.float64)
         hit = np.flatnonzero(np.abs(times - t) <= _SPAN_TOL)

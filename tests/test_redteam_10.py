@@ -252,3 +252,44 @@ def test_an_env_step_that_scales_the_action_in_place_is_not_certified(commit):
     x1 = float(env.unwrapped.data.qpos[0])
     touch = -(WALL_HALF_THICKNESS + BALL_RADIUS)
     assert not (info["safety"]["verdict"] == "certified" and x0 < touch < x1), (x0, x1)
+
+
+# --------------------------------------------------------------------- review: applied-motion records
+
+
+def test_review_flags_an_applied_record_replaced_by_a_body_motion(tmp_path):
+    """A gate logs joint-space plans; review checks that a replaced step's applied-motion record passes
+    through the step's start state, but skipped the check when the RECORD was a body motion. A forged
+    record (the ball 5 m away, where it never was: the oracle is the live state the test recorded)
+    reviewed exit 0 with no finding on ca04081; the same forgery as a joint-space plan is CRITICAL."""
+    from mcap_rewrite import rewrite
+
+    from monitor import Gate, review
+    from monitor.log import read_log, topics
+
+    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    data = mujoco.MjData(model)
+    data.qpos[0] = 0.2
+    path = tmp_path / "run.mcap"
+    with Gate(model, pairs=[("wall", "ball")], frame_skip=5, brake=False, log=path) as gate:
+        report = gate.step(data, np.array([2.0]))      # blocked (the wall): the hold fallback ran
+    assert report.replaced and float(data.qpos[0]) == 0.2
+    acts = [a for a in read_log(path).topic(topics.ACTION) if a["replaced"]]
+    j = acts[0]["applied_window"]
+
+    def body_motion(topic, p):
+        if topic == topics.PLAN and p["index"] == j:
+            K = len(p["times"])
+            pos = np.zeros((K, 2, 3))
+            pos[:, 1, 0] = -5.0                         # not the run's x = 0.2
+            quat = np.zeros((K, 2, 4))
+            quat[..., 0] = 1.0
+            return {"index": j, "kind": "bodymotion", "times": p["times"], "pos": pos.tolist(),
+                    "quat": quat.tolist(), "interpolation": "lerp_slerp"}
+        return p
+
+    assert review.verify_exit_code(review.verify(read_log(path))) == 0
+    rewrite(path, tmp_path / "forged.mcap", msg=body_motion)
+    ver = review.verify(read_log(tmp_path / "forged.mcap"))
+    assert review.verify_exit_code(ver) == 1, ver["findings"]
+    assert any("does not pass through replaced step" in f["reason"] for f in ver["findings"])
