@@ -293,3 +293,21 @@ def test_review_flags_an_applied_record_replaced_by_a_body_motion(tmp_path):
     ver = review.verify(read_log(tmp_path / "forged.mcap"))
     assert review.verify_exit_code(ver) == 1, ver["findings"]
     assert any("does not pass through replaced step" in f["reason"] for f in ver["findings"])
+
+
+def test_review_flags_body_motion_records_that_leave_a_body_motion_step():
+    """The same check between body motions (a user's log): the record's poses at the step's start."""
+    from monitor.review import _passes_through
+
+    def bm(times, x):
+        pos = np.zeros((len(times), 2, 3))
+        pos[:, 1, 0] = x
+        quat = np.zeros((len(times), 2, 4))
+        quat[..., 0] = 1.0
+        return {"kind": "bodymotion", "times": times, "pos": pos.tolist(), "quat": quat.tolist()}
+
+    step = bm([0.0, 0.1], [0.2, 0.3])
+    assert _passes_through([step], [bm([0.0, 0.1, 0.2], [0.2, 0.2, 0.2])], 0.0)
+    assert not _passes_through([step], [bm([0.0, 0.1, 0.2], [0.7, 0.2, 0.2])], 0.0)
+    assert not _passes_through([{"kind": "plan", "times": [0.0, 0.1], "qpos": [[0.2], [0.3]]}],
+                               [bm([0.0, 0.1], [0.2, 0.2])], 0.0)
