@@ -311,3 +311,40 @@ def test_review_flags_body_motion_records_that_leave_a_body_motion_step():
     assert not _passes_through([step], [bm([0.0, 0.1, 0.2], [0.7, 0.2, 0.2])], 0.0)
     assert not _passes_through([{"kind": "plan", "times": [0.0, 0.1], "qpos": [[0.2], [0.3]]}],
                                [bm([0.0, 0.1], [0.2, 0.2])], 0.0)
+
+
+# --------------------------------------------------------------------- the pack and Plan subclasses
+
+
+class _ShiftedPlan(Plan):
+    """A Plan whose ball body runs 0.2 m further along x than its waypoints' FK (a valid trajectory:
+    a constant offset leaves the motion bounds, which are relative to the midpoint pose, valid)."""
+
+    def body_poses(self, times):
+        pos, rot = super().body_poses(times)
+        pos = pos.copy()
+        pos[..., 1, 0] += 0.2
+        return pos, rot
+
+    def translation_segments(self, body):
+        seg = super().translation_segments(body)
+        if seg is None or body != 1:
+            return seg
+        t, o = seg
+        o = np.array(o)
+        o[:, 0] += 0.2
+        return t, o
+
+
+@pytest.mark.parametrize("method", ["auto", "toleranced", "extrusion"])
+def test_a_plan_subclass_is_certified_by_its_own_motion(wall, method):
+    """ca04081: once a plain Plan of the model had verified the motion pack's tree, a Plan subclass
+    was packed from its waypoint arrays (its own ``body_poses`` ignored) and the compiled
+    whole-shape stage certified it (toleranced); its own motion runs the ball from x = 0.2 to 0.3
+    through the wall's face at 0.27 (the oracle: its ``body_poses``, continuity)."""
+    model, scene = wall
+    assert certify(scene, Plan([0.0, 1.0], [[0.0], [0.1]], model)).verdict == Verdict.CERTIFIED
+    shifted = _ShiftedPlan([0.0, 1.0], [[0.0], [0.1]], model)
+    x = shifted.body_poses(np.array([0.0, 1.0]))[0][:, 1, 0]
+    assert x[0] < _WALL_X < x[1]
+    assert certify(scene, shifted, method=method).verdict != Verdict.CERTIFIED
