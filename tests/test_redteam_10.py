@@ -348,3 +348,17 @@ def test_a_plan_subclass_is_certified_by_its_own_motion(wall, method):
     x = shifted.body_poses(np.array([0.0, 1.0]))[0][:, 1, 0]
     assert x[0] < _WALL_X < x[1]
     assert certify(scene, shifted, method=method).verdict != Verdict.CERTIFIED
+
+
+@pytest.mark.parametrize("method", ["auto", "toleranced", "extrusion"])
+def test_a_plan_subclass_built_before_a_model_edit_keeps_its_motion(method):
+    """ca04081: after an in-place model edit ``certify`` certifies ``plan.refreshed()``, which was a
+    plain Plan of the subclass's waypoints: the shifted motion through the wall (violation before the
+    edit) was ``certified`` after an edit that moves nothing (the slide joint's anchor)."""
+    model = mujoco.MjModel.from_xml_string(_WALL)
+    scene = Scene.from_model(model, pairs="all", allowed=None)
+    shifted = _ShiftedPlan([0.0, 1.0], [[0.0], [0.1]], model)
+    assert certify(scene, shifted, method=method).verdict != Verdict.CERTIFIED
+    model.jnt_pos[0] += 0.1
+    assert not shifted.is_current() and type(shifted.refreshed()) is _ShiftedPlan
+    assert certify(scene, shifted, method=method).verdict != Verdict.CERTIFIED
