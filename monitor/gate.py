@@ -2017,7 +2017,9 @@ class Gate:
         ctrl = np.asarray(ctrl)
         if self._data_checked is None or self._data_checked() is not data:  # checked once per MjData
             _check_data(self.model, data)
-            self._data_checked = weakref.ref(data)
+            # ... of the gate's own model: data of an equal copy is compared again every step (that
+            # copy may be edited in place later, e.g. a pickled gate stepping the original's data)
+            self._data_checked = weakref.ref(data) if getattr(data, "model", None) is self.model else None
         _check_ctrl(ctrl, self._fallback_shape)
         if self._scene_builds == 0 and self._reference_qpos is None:  # issue 13: first state = ACM reference
             # (before the scene is first built: `allowed="auto"` frees the pairs touching at THIS pose)

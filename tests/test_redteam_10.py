@@ -362,3 +362,27 @@ def test_a_plan_subclass_built_before_a_model_edit_keeps_its_motion(method):
     model.jnt_pos[0] += 0.1
     assert not shifted.is_current() and type(shifted.refreshed()) is _ShiftedPlan
     assert certify(scene, shifted, method=method).verdict != Verdict.CERTIFIED
+
+
+def test_a_gate_copy_refuses_the_originals_data_after_the_original_model_is_edited():
+    """A pickled gate stepping the original's data (the models are equal copies: accepted). After the
+    ORIGINAL model is edited in place (the wall moved into the ball's path) the copy still certified
+    windows of its own stale model: the once-per-MjData check had cached the data."""
+    import pickle
+
+    from monitor import Gate
+
+    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    data = mujoco.MjData(model)
+    data.qpos[0] = 0.05
+    again = pickle.loads(pickle.dumps(Gate(model, pairs=[("wall", "ball")], frame_skip=5, brake=False)))
+    assert again.decide(data, np.array([0.0])).verdict == Verdict.CERTIFIED
+    model.geom_pos[0] = [0.1, 0.0, 0.0]            # the caller's wall: near face at x = 0.09
+    try:
+        report = again.decide(data, np.array([1.0]))
+    except InvalidInputError:
+        return
+    x0 = float(data.qpos[0])
+    data.ctrl[:] = report.applied_ctrl
+    mujoco.mj_step(model, data, nstep=5)
+    assert not (report.verdict == Verdict.CERTIFIED and x0 < 0.07 < float(data.qpos[0]))
