@@ -386,3 +386,23 @@ def test_a_gate_copy_refuses_the_originals_data_after_the_original_model_is_edit
     data.ctrl[:] = report.applied_ctrl
     mujoco.mj_step(model, data, nstep=5)
     assert not (report.verdict == Verdict.CERTIFIED and x0 < 0.07 < float(data.qpos[0]))
+
+
+# --------------------------------------------------------------------- fuzz (slow)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_gate_fuzz_with_edits_between_steps(seed):
+    """docs/notes/redteam-10/gatefuzz.py: random model and data edits between Gate steps; every
+    applied window the gate calls certified, replayed from a copy of the state (the motion that ran),
+    keeps the exact gap above the margin."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "notes" / "redteam-10" / "gatefuzz.py"
+    spec = importlib.util.spec_from_file_location("rt10_gatefuzz", path)
+    fuzz = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fuzz)
+    counts = fuzz.main(seed, 80)
+    assert counts["bad"] == 0 and counts["certified"] > 20, counts
