@@ -26,13 +26,15 @@ from monitor.motion.bezier import BezierMotion, RigidBezier
 
 _WALL = """
 <mujoco>
+  <option timestep="0.01"/>
   <worldbody>
     <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0" contype="0" conaffinity="0"/>
     <body name="ball">
       <joint name="x" type="slide" axis="1 0 0"/>
-      <geom name="ball" type="sphere" size="0.02" contype="0" conaffinity="0"/>
+      <geom name="ball" type="sphere" size="0.02" mass="1" contype="0" conaffinity="0"/>
     </body>
   </worldbody>
+  <actuator><velocity joint="x" kv="100"/></actuator>
 </mujoco>
 """
 _WALL_X = 0.3 - 0.01 - 0.02   # the ball's centre x at which it touches the wall's near face (m)
@@ -160,19 +162,19 @@ def test_the_compiled_path_and_the_general_path_agree_on_coordinates_beyond_1e9_
 
 # --------------------------------------------------------------------- gate: data of another model
 
-_DRIVEN = """
-<mujoco>
-  <option timestep="0.01"/>
-  <worldbody>
-    <geom name="wall" type="box" size="0.01 0.2 0.2" pos="0.3 0 0" contype="0" conaffinity="0"/>
-    <body name="ball">
-      <joint name="x" type="slide" axis="1 0 0"/>
-      <geom name="ball" type="sphere" size="0.02" mass="1" contype="0" conaffinity="0"/>
-    </body>
-  </worldbody>
-  <actuator><velocity joint="x" kv="100"/></actuator>
-</mujoco>
-"""
+
+def _certified_through_the_callers_wall(gate, data, model) -> bool:
+    """``gate.decide`` at 1 m/s, then the caller steps ``model`` (5 substeps): True when the window was
+    certified and the ball's centre (monotone within the window) crossed x = 0.07, where it touches the
+    caller's wall (near face at 0.09); False when ``decide`` refused the data (InvalidInputError)."""
+    try:
+        report = gate.decide(data, np.array([1.0]))
+    except InvalidInputError:
+        return False
+    x0 = float(data.qpos[0])
+    data.ctrl[:] = report.applied_ctrl
+    mujoco.mj_step(model, data, nstep=5)
+    return report.verdict == Verdict.CERTIFIED and x0 < 0.07 < float(data.qpos[0])
 
 
 def test_decide_refuses_the_data_of_an_edited_model_copy():
@@ -181,32 +183,23 @@ def test_decide_refuses_the_data_of_an_edited_model_copy():
     its own model; the motion under the caller's model went through the caller's wall."""
     from monitor import Gate
 
-    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    model = mujoco.MjModel.from_xml_string(_WALL)
     edited = copy.deepcopy(model)
     edited.geom_pos[0] = [0.1, 0.0, 0.0]          # the caller's wall: near face at x = 0.09
     data = mujoco.MjData(edited)
     data.qpos[0] = 0.05
     gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5, brake=False)
-    try:
-        report = gate.decide(data, np.array([1.0]))
-    except InvalidInputError:
-        return
-    x0 = float(data.qpos[0])
-    data.ctrl[:] = report.applied_ctrl
-    mujoco.mj_step(edited, data, nstep=5)          # the caller steps its own model
-    x1 = float(data.qpos[0])
-    # the ball's centre moves monotonically from x0 to x1; it touches the wall's face at 0.07
-    assert not (report.verdict == Verdict.CERTIFIED and x0 < 0.07 < x1), (x0, x1, report.verdict)
+    assert not _certified_through_the_callers_wall(gate, data, edited)
 
 
 def test_step_refuses_the_data_of_a_model_with_other_sizes():
     """ca04081: ``mujoco.FatalError`` (mj_copyData) for the data of a model with one more body."""
     from monitor import Gate
 
-    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    model = mujoco.MjModel.from_xml_string(_WALL)
     ball = '<body name="ball">'
     post = '<body name="post" pos="0 1 0"><geom type="sphere" size="0.1"/></body>'
-    bigger = mujoco.MjModel.from_xml_string(_DRIVEN.replace(ball, post + ball))
+    bigger = mujoco.MjModel.from_xml_string(_WALL.replace(ball, post + ball))
     gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
     with pytest.raises(InvalidInputError, match="another MjModel"):
         gate.step(mujoco.MjData(bigger), np.array([1.0]))
@@ -216,7 +209,7 @@ def test_a_gate_accepts_the_data_of_an_identical_model_copy():
     """The guard: a copy with the same bytes (a pickled gate and the original's data) still works."""
     from monitor import Gate
 
-    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    model = mujoco.MjModel.from_xml_string(_WALL)
     data = mujoco.MjData(copy.deepcopy(model))
     gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
     assert gate.step(data, np.array([0.1])).verdict == Verdict.CERTIFIED
@@ -267,7 +260,7 @@ def test_review_flags_an_applied_record_replaced_by_a_body_motion(tmp_path):
     from monitor import Gate, review
     from monitor.log import read_log, topics
 
-    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    model = mujoco.MjModel.from_xml_string(_WALL)
     data = mujoco.MjData(model)
     data.qpos[0] = 0.2
     path = tmp_path / "run.mcap"
@@ -372,20 +365,13 @@ def test_a_gate_copy_refuses_the_originals_data_after_the_original_model_is_edit
 
     from monitor import Gate
 
-    model = mujoco.MjModel.from_xml_string(_DRIVEN)
+    model = mujoco.MjModel.from_xml_string(_WALL)
     data = mujoco.MjData(model)
     data.qpos[0] = 0.05
     again = pickle.loads(pickle.dumps(Gate(model, pairs=[("wall", "ball")], frame_skip=5, brake=False)))
     assert again.decide(data, np.array([0.0])).verdict == Verdict.CERTIFIED
     model.geom_pos[0] = [0.1, 0.0, 0.0]            # the caller's wall: near face at x = 0.09
-    try:
-        report = again.decide(data, np.array([1.0]))
-    except InvalidInputError:
-        return
-    x0 = float(data.qpos[0])
-    data.ctrl[:] = report.applied_ctrl
-    mujoco.mj_step(model, data, nstep=5)
-    assert not (report.verdict == Verdict.CERTIFIED and x0 < 0.07 < float(data.qpos[0]))
+    assert not _certified_through_the_callers_wall(again, data, model)
 
 
 # --------------------------------------------------------------------- fuzz (slow)
