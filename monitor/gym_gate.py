@@ -471,6 +471,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
           deterministic: the same state, control and model give the same rows); a ``step``
           that edits the model's dynamics, ``data.eq_active``, ``qfrc_applied`` or the state
           before simulating, or changes ``qpos`` after it, ran another motion.
+        * When committed: ``data.qpos`` must still be the window's last row (a ``step`` that moves
+          the state after the simulation, e.g. a teleport, ran a motion the window does not hold).
 
         Raises:
             InvalidInputError: naming what differed; the motion that ran was not certified.
@@ -484,9 +486,17 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 "after the gate certified the window with the mocap poses as they were: the motion that "
                 "ran was not certified (move mocap bodies before calling step, or use predictor='plan' "
                 "with a plan that carries them)")
-        if committed:
-            return
         ro = self.gate._rollout
+        if committed:
+            # the scratch's end state was copied in: a qpos other than the window's last row was set by
+            # the env's step after the simulation (a teleport the window never certified; red team 10)
+            rows = ro.window_rows
+            if rows is not None and d.qpos.tobytes() != rows[-1, 1:].tobytes():
+                raise InvalidInputError(
+                    f"env: after the step data.qpos = {np.array2string(d.qpos)} but the certified window "
+                    f"ends at {np.array2string(rows[-1, 1:])}: {type(self._unwrapped).__name__}.step moved "
+                    "the state after the simulation; that motion was not certified")
+            return
         rows = ro.window_rows
         c = np.asarray(applied, dtype=np.float64)
         if rows is None or len(rows) != nstep + 1 or c.tobytes() != ro._key_ctrl_bytes:

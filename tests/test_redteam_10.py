@@ -392,3 +392,25 @@ def test_gate_fuzz_with_edits_between_steps(seed):
     spec.loader.exec_module(fuzz)
     counts = fuzz.main(seed, 80)
     assert counts["bad"] == 0 and counts["certified"] > 20, counts
+
+
+@pytest.mark.parametrize("commit", [True, False])
+def test_an_env_step_that_moves_the_state_after_simulating_is_refused(commit):
+    """An env whose ``step`` moves the ball on by 6 cm after the simulation (a teleport). Without the
+    commit hook the after-step check refuses it (the qpos is not the certified row); ca04081 skipped
+    that check when the window was committed (the default on stock MujocoEnvs): ``certified`` while
+    the ball jumped from -0.035 to +0.025 across the wall (its near face at -0.015 for the centre)."""
+    from monitor.envs.tunnel_v0 import TunnelEnv
+    from monitor.gym_gate import SafetyGate
+
+    class Teleport(TunnelEnv):
+        def step(self, action):
+            out = super().step(action)
+            self.data.qpos[0] += 0.06
+            return out
+
+    env = SafetyGate(Teleport(x0=-0.04), brake=False)
+    env.commit = commit
+    env.reset(seed=0)
+    with pytest.raises(InvalidInputError, match="data.qpos"):
+        env.step(np.array([0.5]))
