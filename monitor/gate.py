@@ -1014,13 +1014,29 @@ def _check_nstep(n: Any, name: str) -> int:
 
 
 def _check_data(model: mujoco.MjModel, data: Any) -> None:
-    """InvalidInputError unless ``data`` is an ``MjData`` of ``model``'s sizes."""
+    """InvalidInputError unless ``data`` is an ``MjData`` of ``model`` (or of an identical copy of it).
+
+    ``data.model`` (the ``MjModel`` the data was made for) is ``model`` on the usual path; another
+    object must serialise to the same bytes (``mj_saveModel``: a pickled gate stepping the
+    original's data). Sizes alone let through the data of an edited copy (a moved obstacle: the
+    gate certified its own model's window, the caller's model ran another; red team 10) or of a
+    model with other array sizes (``mj_copyData`` then raised ``mujoco.FatalError``).
+    """
     if not isinstance(data, mujoco.MjData):
         raise InvalidInputError(f"data must be a mujoco.MjData, got {type(data).__name__}")
     if data.qpos.shape[0] != model.nq or data.qvel.shape[0] != model.nv or data.ctrl.shape[0] != model.nu:
         raise InvalidInputError(
             f"data has nq={data.qpos.shape[0]}, nv={data.qvel.shape[0]}, nu={data.ctrl.shape[0]} but the "
             f"gate's model has nq={model.nq}, nv={model.nv}, nu={model.nu}: MjData of another model")
+    own = getattr(data, "model", model)
+    if own is not model:
+        from monitor.scene import model_hash
+
+        if model_hash(own) != model_hash(model):
+            raise InvalidInputError(
+                "data was made for another MjModel than the gate's (data.model is not gate.model and differs "
+                "from it): the gate certifies windows of its own model; build the gate on data.model, or "
+                "edit gate.model in place (the gate re-reads it every step)")
 
 
 def _check_ctrl(ctrl: np.ndarray, shape: tuple[int, ...]) -> None:
@@ -2049,7 +2065,9 @@ class Gate:
         ctrl = np.asarray(ctrl)
         if self._data_checked is None or self._data_checked() is not data:  # checked once per MjData
             _check_data(self.model, data)
-            self._data_checked = weakref.ref(data)
+            # ... of the gate's own model: data of an equal copy is compared again every step (that
+            # copy may be edited in place later, e.g. a pickled gate stepping the original's data)
+            self._data_checked = weakref.ref(data) if getattr(data, "model", None) is self.model else None
         _check_ctrl(ctrl, self._fallback_shape)
         if self._scene_builds == 0 and self._reference_qpos is None:  # issue 13: first state = ACM reference
             # (before the scene is first built: `allowed="auto"` frees the pairs touching at THIS pose)

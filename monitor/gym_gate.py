@@ -473,6 +473,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
           deterministic: the same state, control and model give the same rows); a ``step``
           that edits the model's dynamics, ``data.eq_active``, ``qfrc_applied`` or the state
           before simulating, or changes ``qpos`` after it, ran another motion.
+        * When committed: ``data.qpos`` must still be the window's last row (a ``step`` that moves
+          the state after the simulation, e.g. a teleport, ran a motion the window does not hold).
 
         Raises:
             InvalidInputError: naming what differed; the motion that ran was not certified.
@@ -486,9 +488,17 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                 "after the gate certified the window with the mocap poses as they were: the motion that "
                 "ran was not certified (move mocap bodies before calling step, or use predictor='plan' "
                 "with a plan that carries them)")
-        if committed:
-            return
         ro = self.gate._rollout
+        if committed:
+            # the scratch's end state was copied in: a qpos other than the window's last row was set by
+            # the env's step after the simulation (a teleport the window never certified; red team 10)
+            rows = ro.window_rows
+            if rows is not None and d.qpos.tobytes() != rows[-1, 1:].tobytes():
+                raise InvalidInputError(
+                    f"env: after the step data.qpos = {np.array2string(d.qpos)} but the certified window "
+                    f"ends at {np.array2string(rows[-1, 1:])}: {type(self._unwrapped).__name__}.step moved "
+                    "the state after the simulation; that motion was not certified")
+            return
         rows = ro.window_rows
         c = np.asarray(applied, dtype=np.float64)
         if rows is None or len(rows) != nstep + 1 or c.tobytes() != ro._key_ctrl_bytes:
@@ -553,19 +563,22 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         report: StepReport = self.gate.decide(u.data, action, nstep=nstep, predict=self._predict_fn(),
                                               fallback=self._fallback_fn(), cast=self._as_inner)
         hook = self._commit_ok and self.commit and "_step_mujoco_simulation" not in u.__dict__
+        # the env steps its own copy: a step that edits the action array in place (action *= k) must
+        # not edit the certified control the checks below compare with (red team 10)
+        certified = np.asarray(report.applied_ctrl, dtype=np.float64)
         if hook:  # instance attribute: shadows MujocoEnv._step_mujoco_simulation for this call only
             u._step_mujoco_simulation = self._commit_sim
-            self._expected = (np.asarray(report.applied_ctrl, dtype=np.float64), nstep, mocap_start)
+            self._expected = (certified, nstep, mocap_start)
         try:
-            obs, reward, terminated, truncated, info = self._step_env(report.applied_ctrl)
+            obs, reward, terminated, truncated, info = self._step_env(np.array(report.applied_ctrl))
         finally:
             if hook:
                 del u._step_mujoco_simulation
         if not (hook and self._expected is None):  # the hook did not run (it checks before simulating)
             self._check_geometry("the motion that ran was not certified")
-        self._check_applied_ctrl(report.applied_ctrl)
+        self._check_applied_ctrl(certified)
         self._check_elapsed(t_start, nstep)
-        self._check_window_ran(report.applied_ctrl, nstep, mocap_start,
+        self._check_window_ran(certified, nstep, mocap_start,
                                self.gate.stats["committed"] != committed_before)
         self._obs = obs
         info = dict(info)

@@ -796,20 +796,31 @@ def _applied_findings(contents: LogContents, certs: list[dict[str, Any]],
 
 
 def _passes_through(step_plans: Any, rec_plans: Any, t: float) -> bool:
-    """The record's plan has a waypoint at ``t`` whose qpos equals the step plan's first (1e-9)."""
+    """The record's plan has a waypoint at ``t`` whose state equals the step plan's first (1e-9).
+
+    The state is the qpos of a joint-space plan, the body positions and quaternions of a body
+    motion; a record of another kind than the step's plan does not pass through it (a gate logs
+    joint-space plans: a body-motion record could be any motion; red team 10).
+    """
     if not step_plans or not rec_plans or len(step_plans) > 1 or len(rec_plans) > 1:
         return True  # a missing or duplicate plan is reported by verify's window loop
     p, r = step_plans[0], rec_plans[0]
-    if p.get("kind", "plan") != "plan" or r.get("kind", "plan") != "plan":
-        return True  # body motions: no joint state to compare (a gate logs joint-space plans)
+    kind = p.get("kind", "plan")
+    if kind not in ("plan", "bodymotion"):
+        return True  # an unknown kind: verify's window loop reports it
+    if r.get("kind", "plan") != kind:
+        return False
     try:
         times = np.asarray(r["times"], np.float64)
         hit = np.flatnonzero(np.abs(times - t) <= _SPAN_TOL)
         if len(hit) == 0:
             return False
-        q0 = np.asarray(p["qpos"][0], np.float64)
-        q1 = np.asarray(r["qpos"][int(hit[0])], np.float64)
-        return q0.shape == q1.shape and bool(np.allclose(q0, q1, rtol=0.0, atol=1e-9))
+        for key in ("qpos",) if kind == "plan" else ("pos", "quat"):
+            q0 = np.asarray(p[key][0], np.float64)
+            q1 = np.asarray(r[key][int(hit[0])], np.float64)
+            if q0.shape != q1.shape or not np.allclose(q0, q1, rtol=0.0, atol=1e-9):
+                return False
+        return True
     except (KeyError, IndexError, TypeError, ValueError):
         return False
 

@@ -96,26 +96,50 @@ class Trajectory(Protocol):
 
 
 def sealed(arr: np.ndarray) -> np.ndarray:
-    """``arr`` read-only for good: a read-only view of a read-only array that only it refers to.
+    """``arr``'s values, read-only for good: a read-only array over an immutable ``bytes`` copy.
 
-    numpy turns ``WRITEABLE`` back on only for an array whose base is writable, so a view of a
-    read-only owner stays read-only: the waypoints a trajectory exposes (``times``, ``qpos``,
-    ``pos``, ...) cannot be edited after the engine cached what it derived from them (the motion
-    pack, the per-scene call memo). An array that is itself a view is copied first: its base
-    may be a caller's writable buffer.
+    The waypoints a trajectory exposes (``times``, ``qpos``, ``pos``, ...) cannot be edited
+    after the engine cached what it derived from them (the motion pack, the per-scene call
+    memo). numpy lets an array that owns its memory turn ``WRITEABLE`` back on, and a read-only
+    view's ``.base`` hands out that owner (red team 10: ``plan.qpos.base.setflags(write=True)``
+    then edits the plan a memo answered for); an array over a ``bytes`` object refuses
+    (``ValueError``), and so does every view of it. The copy also leaves the caller's array
+    alone (its writeable flag included).
 
     Args:
         arr: any ndarray (the trajectory's own, just validated).
 
     Returns:
-        a read-only view, same dtype, shape and values.
+        a read-only C-contiguous array, same dtype, shape and values.
     """
-    owner = arr if arr.base is None else arr.copy()
-    owner.setflags(write=False)
-    return owner.view()
+    return np.frombuffer(arr.tobytes(), dtype=arr.dtype).reshape(arr.shape)
 
 
-class WindowTimes:
+class Sealed:
+    """Mixin: a pickle / ``copy.deepcopy`` round trip keeps the sealed arrays sealed.
+
+    Unpickled arrays are writable, so a copy of a trajectory could be edited while it still
+    carries the caches derived from the original's waypoints (red team 10: a copy edited
+    through a wall was certified from the copied waypoint poses). The attributes that were
+    read-only arrays are :func:`sealed` again when the copy is restored.
+    """
+
+    def __getstate__(self) -> dict:
+        """The instance dict and the names of its read-only array attributes."""
+        state = dict(self.__dict__)
+        state["_sealed_names"] = tuple(k for k, v in state.items()
+                                       if isinstance(v, np.ndarray) and not v.flags.writeable)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        """Restore ``state``, sealing the arrays that were read-only in the original."""
+        state = dict(state)
+        for k in state.pop("_sealed_names", ()):
+            state[k] = sealed(np.asarray(state[k]))
+        self.__dict__.update(state)
+
+
+class WindowTimes(Sealed):
     """Mixin for trajectories whose waypoint times are stored in ``self._times`` (K,) seconds."""
 
     _times: np.ndarray

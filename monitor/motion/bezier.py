@@ -45,7 +45,7 @@ import numpy as np
 
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, WindowTimes, sealed
+from monitor.motion.base import MotionBounds, Sealed, WindowTimes, sealed
 from monitor.tolerances import DEFAULT, Tolerances
 
 
@@ -165,7 +165,7 @@ def _rotation_form(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return M, ww + xx + yy + zz
 
 
-class RigidBezier:
+class RigidBezier(Sealed):
     """Rational Bézier motion on SE(3) over s in [0, 1] (see the module docstring).
 
     Args:

@@ -561,17 +561,22 @@ def _mocap_run(st: object) -> tuple[int, int] | None:
 def pack_trajectory(traj: object) -> MotionPack:
     """Pack a :class:`monitor.Plan` or :class:`monitor.BodyMotion` for the compiled kernels.
 
+    Exactly those classes: a subclass may override ``body_poses`` / ``motion_bounds`` (another
+    motion through the same waypoints), which the pack, built from the waypoint arrays, would
+    not follow (red team 10: a Plan subclass shifted through a wall was certified once a plain
+    Plan of the model had verified the pack's tree). Subclasses take the general path.
+
     Raises:
-        InvalidInputError: ``traj`` is neither.
+        InvalidInputError: ``traj`` is neither (a subclass included).
         UnsupportedGeometryError: a free joint that is not the only joint of a world child, or a
             BodyMotion whose interpolation is not ``"lerp_slerp"`` (e.g. ``"screw"``).
     """
-    if isinstance(traj, BodyMotion):
+    if type(traj) is BodyMotion:
         return _pack_body_motion(traj)
     # A Plan can only exist once monitor.motion.plan is imported; looking it up here keeps this
     # module free of mujoco (the algorithmic core may import it) and costs nothing per call.
     plan_mod = sys.modules.get("monitor.motion.plan")
-    if plan_mod is not None and isinstance(traj, plan_mod.Plan):
+    if plan_mod is not None and type(traj) is plan_mod.Plan:
         return _pack_plan(traj)
     raise InvalidInputError(f"traj must be a Plan or a BodyMotion, got {type(traj).__name__}")
 

@@ -681,9 +681,17 @@ class Plan(WindowTimes):
         return _structure_key(self._model) == self._st.key
 
     def refreshed(self) -> Plan:
-        """The same waypoints (times, qpos, held mocap poses) rebuilt on the live model."""
-        return Plan(self._times.copy(), self._qpos.copy(), self._model, mocap_pos=self._mocap_pos.copy(),
-                    mocap_quat=self._mocap_quat.copy(), tolerances=self._tol)
+        """The same waypoints (times, qpos, held mocap poses) rebuilt on the live model.
+
+        Of the same class: a subclass's own attributes are kept and its overrides (``body_poses``,
+        ``motion_bounds``, ...) still define the motion (a plain ``Plan`` here certified the
+        waypoints' motion instead of the subclass's after a model edit; red team 10).
+        """
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new._setup(self._model, _structure(self._model), self._times.copy(), self._qpos.copy(),
+                   self._mocap_pos.copy(), self._mocap_quat.copy(), self._tol)
+        return new
 
     @property
     def qpos(self) -> np.ndarray:
