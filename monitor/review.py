@@ -906,8 +906,10 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
         if src == "user":
             user.append(k)
             continue
-        if src is None and p.get("kind", "plan") != "plan":
-            continue  # a body motion: never a gate rollout
+        if src is None and p.get("kind", "plan") != "plan" and not marked:
+            continue  # a body motion of a log that does not mark its sources: never a gate rollout
+            # (in a marked log every plan says its source: a kind switched and the source stripped is
+            # a removed rollout, red team 10)
         if src != "rollout":
             fail(k, "the run logs where every window's rows come from (rollouts: logged), but this plan has "
                     + ("no source: its rollout was removed" if src is None else f"source {_short(src, 30)}")

@@ -228,6 +228,20 @@ def test_dropping_the_rollout_of_a_certified_window_is_critical(bounce, tmp_path
     assert ver["replayed"] == 5 and ver["continuity_checked"] == 3
 
 
+def test_a_plan_switched_to_a_body_motion_without_its_source_is_critical(bounce, tmp_path):
+    path, _, _ = bounce
+    dst = tmp_path / "kind.mcap"
+
+    def to_body_motion(o):
+        o.pop("rollout"), o.pop("source")
+        o["kind"] = "bodymotion"
+
+    _forge(path, dst, msg=_edit_plan(4, to_body_motion))
+    code, ver = _verify(dst)
+    assert code == 1
+    assert 4 in [k for k, _ in _findings(ver, "critical")]
+
+
 def test_marking_rollout_rows_as_user_rows_is_not_accepted(bounce, tmp_path):
     path, _, _ = bounce
     dst = tmp_path / "user.mcap"
