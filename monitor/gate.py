@@ -1006,10 +1006,25 @@ def _check_predictor(predictor: Any) -> Any:
     return predictor
 
 
+MAX_WINDOW_STEPS = 100_000
+"""Most substeps one window may take (``nstep``, ``frame_skip``): the rollout allocates (nstep + 1, 1 + nq)
+rows and simulates them before anything is certified, so ``nstep=10**9`` would exhaust memory or run
+for hours (red team 10) instead of failing. 100 000 substeps is 200 s at MuJoCo's default 2 ms
+timestep, far beyond any gated step; the same bound as :data:`MAX_BRAKE_STEPS`."""
+
+
 def _check_nstep(n: Any, name: str) -> int:
-    """``n`` as a substep count: an integer >= 1 (not a bool, a float or a string), else InvalidInputError."""
+    """``n`` as a substep count in [1, :data:`MAX_WINDOW_STEPS`], else InvalidInputError.
+
+    Not a bool, a float or a string.
+    """
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
         raise InvalidInputError(f"{name} must be an integer >= 1, got {n!r}")
+    if n > MAX_WINDOW_STEPS:
+        raise InvalidInputError(
+            f"{name} = {n!r} substeps is more than one window may take ({MAX_WINDOW_STEPS}; the rollout "
+            f"simulates and stores every substep before certifying): certify a long motion as "
+            f"several windows")
     return int(n)
 
 

@@ -414,3 +414,29 @@ def test_an_env_step_that_moves_the_state_after_simulating_is_refused(commit):
     env.reset(seed=0)
     with pytest.raises(InvalidInputError, match="data.qpos"):
         env.step(np.array([0.5]))
+
+
+# --------------------------------------------------------------------- window length
+
+
+@pytest.mark.parametrize("where", ["nstep", "frame_skip", "setting"])
+def test_a_window_of_a_billion_substeps_is_a_typed_error_before_any_simulation(where):
+    """Red team 10's open item: ``nstep=10**9`` allocated (nstep + 1, 1 + nq) rows and simulated them
+    before anything was certified (an out-of-memory crash or hours). Now InvalidInputError, and the
+    data is untouched (nothing simulated)."""
+    from monitor import Gate
+    from monitor.gate import MAX_WINDOW_STEPS
+
+    model = mujoco.MjModel.from_xml_string(_WALL)
+    data = mujoco.MjData(model)
+    big = 10**9
+    with pytest.raises(InvalidInputError, match="more than one window may take"):
+        if where == "frame_skip":
+            Gate(model, pairs=[("wall", "ball")], frame_skip=big)
+        gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
+        if where == "setting":
+            gate.frame_skip = big
+        gate.step(data, np.array([0.1]), nstep=big)
+    assert data.time == 0.0
+    gate = Gate(model, pairs=[("wall", "ball")], frame_skip=5)
+    assert gate.step(data, np.array([0.1]), nstep=MAX_WINDOW_STEPS // 10_000).verdict == Verdict.CERTIFIED
