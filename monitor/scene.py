@@ -92,6 +92,7 @@ from monitor.geometry.polytope import (
     sphere_shape,
 )
 from monitor.geometry.shapes import ConvexShape
+from monitor.pairsel import object_names
 from monitor.tolerances import DEFAULT, Tolerances
 
 FLAT_MESH_THICKNESS = 1e-6
@@ -261,20 +262,11 @@ def _quat_to_mat(q: np.ndarray) -> np.ndarray:
     return R.reshape(3, 3)
 
 
-def _names(model: Any, adr: np.ndarray, prefix: str) -> list[str]:
-    """MuJoCo's object names at offsets ``adr`` (n,) of ``model.names``; ``f"{prefix}{i}"`` when empty.
-
-    The same strings as ``model.geom(i).name`` / ``model.body(i).name`` (each name runs from its
-    offset to the next NUL byte of the names buffer), read in one pass over the buffer.
-    """
-    blob = model.names
-    adr = np.asarray(adr, dtype=np.int64)
-    nul = np.flatnonzero(np.frombuffer(blob, dtype=np.uint8) == 0)
-    end = nul[np.searchsorted(nul, adr)]
-    return [blob[a:e].decode() or f"{prefix}{i}" for i, (a, e) in enumerate(zip(adr.tolist(), end.tolist()))]
-
-
 _SAME = mujoco.mjtSameFrame
+_SF_BODY, _SF_INERTIA, _SF_BODYROT, _SF_INERTIAROT, _SF_NONE = (
+    int(_SAME.mjSAMEFRAME_BODY), int(_SAME.mjSAMEFRAME_INERTIA), int(_SAME.mjSAMEFRAME_BODYROT),
+    int(_SAME.mjSAMEFRAME_INERTIAROT), int(_SAME.mjSAMEFRAME_NONE))
+"""``geom_sameframe`` / ``body_sameframe`` codes as ints (numpy compares them without Python objects)."""
 
 
 def geom_frame(model: Any, g: int) -> tuple[np.ndarray, np.ndarray]:
@@ -348,18 +340,18 @@ def geom_frames(model: Any) -> tuple[np.ndarray, np.ndarray, int]:
     body = np.asarray(model.geom_bodyid, dtype=np.int64)
     R = np.broadcast_to(np.eye(3), (G, 3, 3)).copy()
     p = np.array(model.geom_pos, dtype=np.float64).reshape(G, 3)
-    own = ~np.isin(sf, (_SAME.mjSAMEFRAME_BODY, _SAME.mjSAMEFRAME_INERTIA, _SAME.mjSAMEFRAME_BODYROT,
-                        _SAME.mjSAMEFRAME_INERTIAROT))
+    own = ~np.isin(sf, (_SF_BODY, _SF_INERTIA, _SF_BODYROT,
+                        _SF_INERTIAROT))
     R[own] = _quat_mats(np.asarray(model.geom_quat)[own])
-    p[sf == _SAME.mjSAMEFRAME_BODY] = 0.0
-    inertial = (sf == _SAME.mjSAMEFRAME_INERTIA) | (sf == _SAME.mjSAMEFRAME_INERTIAROT)
+    p[sf == _SF_BODY] = 0.0
+    inertial = (sf == _SF_INERTIA) | (sf == _SF_INERTIAROT)
     bad = G
     if inertial.any():
         b = body[inertial]
         bsf = np.asarray(model.body_sameframe, dtype=np.int64)[b]
-        frame_of_body = (bsf == _SAME.mjSAMEFRAME_BODY) | (b == 0)
-        rot_of_body = ~frame_of_body & (bsf == _SAME.mjSAMEFRAME_BODYROT)
-        own_rot = ~frame_of_body & (bsf == _SAME.mjSAMEFRAME_NONE)
+        frame_of_body = (bsf == _SF_BODY) | (b == 0)
+        rot_of_body = ~frame_of_body & (bsf == _SF_BODYROT)
+        own_rot = ~frame_of_body & (bsf == _SF_NONE)
         ok = frame_of_body | rot_of_body | own_rot
         if not ok.all():
             bad = int(np.flatnonzero(inertial)[np.flatnonzero(~ok)[0]])
@@ -370,7 +362,7 @@ def geom_frames(model: Any) -> tuple[np.ndarray, np.ndarray, int]:
         keep = ok   # a bad geom keeps the body frame; the caller raises before using it
         rows = np.flatnonzero(inertial)[keep]
         R[rows] = RI[keep]
-        whole = sf[rows] == _SAME.mjSAMEFRAME_INERTIA
+        whole = sf[rows] == _SF_INERTIA
         p[rows[whole]] = pI[keep][whole]
     return R, p, bad
 
@@ -651,11 +643,11 @@ class Scene:
         nf = int(nf)
 
         ngeom = int(model.ngeom)
-        body_names = tuple(_names(model, model.name_bodyadr, "body"))
+        body_names = tuple(object_names(model, model.name_bodyadr, "body"))
         weld = np.asarray(model.body_weldid, dtype=np.int64)
         body_static = weld == 0
         body_mocap = np.asarray(model.body_mocapid, dtype=np.int64)[weld] >= 0
-        names = _names(model, model.name_geomadr, "geom")
+        names = object_names(model, model.name_geomadr, "geom")
         if len(set(names)) != ngeom:  # an explicit name like "geom3" clashing with a generated one
             seen: dict[str, int] = {}
             for g, nm in enumerate(names):
