@@ -26,6 +26,7 @@ from monitor.certify.packed import pack_scene  # noqa: E402
 
 
 def h(*parts) -> str:
+    """Short sha256 of arrays (dtype, shape, bytes) and reprs."""
     d = hashlib.sha256()
     for p in parts:
         if isinstance(p, np.ndarray):
@@ -37,6 +38,7 @@ def h(*parts) -> str:
 
 
 def digest(scene) -> dict:
+    """Digests of everything a Scene holds and of its pack."""
     out = {"pair_ids": h(scene.pair_ids), "candidate_pairs": h(scene.candidate_pairs),
            "allowed": h(scene.allowed_pairs), "approx": h(sorted(scene.approximations.items())),
            "static": h(scene.body_static), "names": h(scene.body_names)}
@@ -56,6 +58,7 @@ def digest(scene) -> dict:
 
 
 def models(quick: bool):
+    """(name, MjModel) of every model compared."""
     for p in sorted((REPO / "tests" / "assets").glob("*.xml")):
         yield f"assets/{p.name}", mujoco.MjModel.from_xml_path(str(p))
     for p in sorted((REPO / "models").glob("*/scene*.xml")):
@@ -72,8 +75,9 @@ def models(quick: bool):
 
 
 def main():
+    """Dump the digests to the JSON file named on the command line."""
     out_path, quick = sys.argv[1], "--quick" in sys.argv
-    res = {}
+    res = {"_tree": monitor.__file__}
     warnings.simplefilter("ignore")
     for name, model in models(quick):
         variants = [("mujoco", {}), ("all", {})]
