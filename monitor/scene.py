@@ -507,15 +507,19 @@ class Scene:
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
-                 tolerances: Tolerances):
+                 tolerances: Tolerances, *, pairs_sorted: bool = False):
         pair_ids.setflags(write=False)
         body_static.setflags(write=False)
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
-        self._sorted_pairs = pair_ids if lex_sorted_pairs(pair_ids, len(geoms)) else None
+        sorted_ = pairs_sorted or lex_sorted_pairs(pair_ids, len(geoms))
+        self._sorted_pairs = pair_ids if sorted_ else None
         """``pair_ids`` itself when its rows are strictly increasing (a, b) with 0 <= a < b < ngeom (the
-        engine's sweep finds rows by binary search; checked here, once per pair array), else None."""
+        engine's sweep finds rows by binary search), else None. Checked here, once per pair array, unless
+        the caller passes ``pairs_sorted=True``: only :meth:`from_model`, for the arrays it builds, which
+        are in that order by construction (:func:`_filter_pairs`' row-major cells, a sorted set of
+        explicit pairs, and row subsets of those taken by boolean masks; tested on every model)."""
         self.body_names = body_names
         self.body_static = body_static
         self.facets = facets
@@ -718,7 +722,7 @@ class Scene:
                      body_static[gbody].tolist(), body_mocap[gbody].tolist()))]
         if isinstance(pairs, str) and pairs == "all":
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
-        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances, pairs_sorted=True)
         scene.geom_frames = tuple(frames)
         scene._pairs_spec = pairs
         # rebuilds after model edits reuse the matrix resolved now ("auto" is not recomputed on an

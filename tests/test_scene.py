@@ -802,3 +802,22 @@ def test_geom_frames_inertial_and_bad_sameframe():
     with pytest.raises(UnsupportedGeometryError) as got:
         Scene.from_model(model)
     assert str(got.value) == str(want.value)
+
+
+@pytest.mark.parametrize("seed", RANDOM_SEEDS[:4])
+def test_from_model_pairs_are_in_strict_order(seed):
+    """Scene.from_model trusts its own pair arrays to be in strict (a, b) order (the sweep's binary
+    search needs it): every policy it builds is, checked row by row (explicit lists given shuffled and
+    reversed, hazards=, allow=, an ACM)."""
+    from _scene_cases import random_mjcf
+
+    model = mujoco.MjModel.from_xml_string(random_mjcf(seed))
+    rng = np.random.default_rng(seed)
+    every = Scene.from_model(model, pairs="all").pair_ids.tolist()
+    explicit = [tuple(every[k][::-1]) for k in rng.permutation(len(every))[:30]]
+    scenes = [Scene.from_model(model, pairs=p) for p in ("all", "mujoco", explicit)]
+    acm = [(scenes[0].geoms[a].name, scenes[0].geoms[b].name) for a, b in every[:5]]
+    scenes += [Scene.from_model(model, pairs="all", hazards=["g1*", "w*"], allow=[["g2*", "*"]], allowed=acm)]
+    for scene in scenes:
+        assert _strictly_increasing(scene.pair_ids) and scene._sorted_pairs is scene.pair_ids
+    assert len(scenes[2].pair_ids) == 30 and len(scenes[3].pair_ids) < len(every)
