@@ -462,27 +462,32 @@ def _brute_force_mujoco(model):
     filterparent = not model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_FILTERPARENT
     excluded = set(model.exclude_signature.tolist())
     explicit = {tuple(sorted(p)) for p in zip(model.pair_geom1.tolist(), model.pair_geom2.tolist())}
-    planeish = (int(TYPES.mjGEOM_PLANE), int(TYPES.mjGEOM_HFIELD))
     out = set()
+    for a, b in _pairs_not_both_planes(model):
+        if (a, b) in explicit:
+            out.add((a, b))
+            continue
+        ba, bb = model.geom_bodyid[a], model.geom_bodyid[b]
+        wa, wb = weld[ba], weld[bb]
+        if wa == wb or (dof[wa] == 0 and dof[wb] == 0):
+            continue
+        if filterparent and wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+            continue
+        if (min(ba, bb) << 16) + max(ba, bb) in excluded:
+            continue
+        ca, cb = model.geom_contype, model.geom_conaffinity
+        if ca[a] & cb[b] or ca[b] & cb[a]:
+            out.add((a, b))
+    return out
+
+
+def _pairs_not_both_planes(model):
+    """Every geom pair a < b, one by one, except plane/hfield pairs (no collision test)."""
+    planeish = (int(TYPES.mjGEOM_PLANE), int(TYPES.mjGEOM_HFIELD))
     for a in range(model.ngeom):
         for b in range(a + 1, model.ngeom):
-            if model.geom_type[a] in planeish and model.geom_type[b] in planeish:
-                continue
-            if (a, b) in explicit:
-                out.add((a, b))
-                continue
-            ba, bb = model.geom_bodyid[a], model.geom_bodyid[b]
-            wa, wb = weld[ba], weld[bb]
-            if wa == wb or (dof[wa] == 0 and dof[wb] == 0):
-                continue
-            if filterparent and wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
-                continue
-            if (min(ba, bb) << 16) + max(ba, bb) in excluded:
-                continue
-            ca, cb = model.geom_contype, model.geom_conaffinity
-            if ca[a] & cb[b] or ca[b] & cb[a]:
-                out.add((a, b))
-    return out
+            if not (model.geom_type[a] in planeish and model.geom_type[b] in planeish):
+                yield a, b
 
 
 @pytest.mark.parametrize("name", PAIR_SCENES)
@@ -598,18 +603,14 @@ RANDOM_SEEDS = range(10)
 def _brute_force_all(model):
     """pairs="all" before the world-children drop, pair by pair (module docstring of monitor.scene)."""
     weld, parent = model.body_weldid, model.body_parentid
-    planeish = (int(TYPES.mjGEOM_PLANE), int(TYPES.mjGEOM_HFIELD))
     out = set()
-    for a in range(model.ngeom):
-        for b in range(a + 1, model.ngeom):
-            if model.geom_type[a] in planeish and model.geom_type[b] in planeish:
-                continue
-            wa, wb = weld[model.geom_bodyid[a]], weld[model.geom_bodyid[b]]
-            if wa == wb or (wa == 0 and wb == 0):
-                continue
-            if wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
-                continue
-            out.add((a, b))
+    for a, b in _pairs_not_both_planes(model):
+        wa, wb = weld[model.geom_bodyid[a]], weld[model.geom_bodyid[b]]
+        if wa == wb or (wa == 0 and wb == 0):
+            continue
+        if wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+            continue
+        out.add((a, b))
     return out
 
 

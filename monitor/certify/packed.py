@@ -312,6 +312,9 @@ def pack_scene(scene) -> ScenePack:
     return ScenePack(pack_shapes(shapes, bodies, _curved_geoms(scene)), pid)
 
 
+_CURVE_OF_TYPE = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}
+
+
 def _curved_geoms(scene) -> list:
     """Exact cylinder / ellipsoid data of the scene's circumscribed geoms (from the model arrays).
 
@@ -330,7 +333,7 @@ def _curved_geoms(scene) -> list:
     derived = bool(getattr(scene, "derived_geoms", False))
     ngeom = len(model.geom_size)
     for g in scene.geoms:
-        code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
+        code = _CURVE_OF_TYPE.get(g.type, CURVE_NONE)
         if (code == CURVE_NONE or g.shape is None or derived or not 0 <= g.id < ngeom or frames is None
                 or len(frames) != ngeom):
             out.append(None)
