@@ -107,6 +107,9 @@ _HFIELD = int(mujoco.mjtGeom.mjGEOM_HFIELD)
 _SDF = int(mujoco.mjtGeom.mjGEOM_SDF)
 _UNSUPPORTED = (_HFIELD, _SDF)
 _CHUNK = 1 << 20  # geom pairs per vectorised filter block
+_SIGNATURE_BODIES = 1 << 16
+"""Bodies up to which MuJoCo's exclusion signature ``(b1 << 16) + b2`` names one body pair (decoded
+once by :func:`_filter_pairs`); above, the signatures are compared per block as MuJoCo computes them."""
 
 SYNC_FIELDS: tuple[str, ...] = (
     # geometry of the shapes (body frame)
@@ -880,7 +883,7 @@ def _filter_pairs(model: Any, mode: str) -> np.ndarray:
         # every pair passes the contype/conaffinity test when one bit is in every contype and conaffinity
         use_mask = int(np.bitwise_and.reduce(contype) & np.bitwise_and.reduce(conaff)) == 0
         excl = np.asarray(model.exclude_signature, dtype=np.int64)
-        if len(excl) and nbody > (1 << 16):  # signatures (min << 16) + max are ambiguous: compare them
+        if len(excl) and nbody > _SIGNATURE_BODIES:  # signatures ambiguous: compare them per block
             sig_fallback = np.sort(excl)
         elif len(excl):
             lo, hi = excl >> 16, excl & 0xFFFF  # the signature of body pair (lo, hi), lo <= hi

@@ -622,8 +622,9 @@ def _strictly_increasing(pid):
 @pytest.mark.parametrize("seed", RANDOM_SEEDS)
 def test_random_mjcf_filter_matches_rule_loops(seed, monkeypatch):
     """Seeded random MJCF (welds, mocap, planes, meshes, masks, <exclude>, <pair>, filterparent on/off):
-    the row-block filter equals the rule-by-rule loops for "mujoco" and "all" in every block size,
-    rows in strict (a, b) order, and every pair mj_collision reports is a "mujoco" candidate."""
+    the row-block filter equals the rule-by-rule loops for "mujoco" and "all" in every block size, with
+    <exclude> decoded or compared as signatures, rows in strict (a, b) order, and every pair
+    mj_collision reports is a "mujoco" candidate."""
     from _scene_cases import random_mjcf
 
     import monitor.scene as scene_mod
@@ -631,8 +632,9 @@ def test_random_mjcf_filter_matches_rule_loops(seed, monkeypatch):
     xml = random_mjcf(seed)
     model = mujoco.MjModel.from_xml_string(xml)
     want = {"mujoco": _brute_force_mujoco(model), "all": _brute_force_all(model)}
-    for chunk in (1, 7, 1 << 20):
+    for chunk, signature_bodies in ((1, 1 << 16), (7, 0), (1 << 20, 1 << 16)):  # 0: signatures compared
         monkeypatch.setattr(scene_mod, "_CHUNK", chunk)
+        monkeypatch.setattr(scene_mod, "_SIGNATURE_BODIES", signature_bodies)
         for mode in ("mujoco", "all"):
             pid = scene_mod._filter_pairs(model, mode)
             assert pid.dtype == np.int64 and pid.shape[1:] == (2,) and pid.flags.c_contiguous
