@@ -616,10 +616,11 @@ def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, all
     code = np.where(user & ((code < 0) | ~skips[code]), reasons.index(Reason.USER), code)
     drop = keep & skips[code]
     never_rows = keep & ~drop & (code == reasons.index(Reason.NEVER))
-    gn = names.geom_names
-    allowed_rows = [(gn[a], gn[b], reasons[c].value)
-                    for (a, b), c in zip(pair_ids[drop].tolist(), code[drop].tolist())]
-    never = [(gn[a], gn[b]) for a, b in pair_ids[never_rows].tolist()]
+    gn = np.array(names.geom_names, dtype=object)   # name tuples of the removed / Never rows (the output)
+    value = np.array([r.value for r in reasons], dtype=object)
+    gone, hint = pair_ids[drop], pair_ids[never_rows]
+    allowed_rows = list(zip(gn[gone[:, 0]].tolist(), gn[gone[:, 1]].tolist(), value[code[drop]].tolist()))
+    never = list(zip(gn[hint[:, 0]].tolist(), gn[hint[:, 1]].tolist()))
     keep &= ~drop
     return PairPolicy(pair_ids[keep], tuple(allowed_rows), not_hazard, tuple(never), acm)
 
