@@ -323,8 +323,8 @@ def _quat_mats(quats: np.ndarray) -> np.ndarray:
     q = np.ascontiguousarray(quats, dtype=np.float64).reshape(-1, 4)
     if not len(q):
         return np.zeros((0, 3, 3))
-    uniq, first, inverse = np.unique(q.view(np.dtype((np.void, 32))).ravel(), return_index=True,
-                                     return_inverse=True)
+    _, first, inverse = np.unique(q.view(np.dtype((np.void, 32))).ravel(), return_index=True,
+                                  return_inverse=True)
     mats = np.stack([_quat_to_mat(q[i]) for i in first.tolist()])
     return mats[inverse.reshape(-1)]
 
@@ -702,10 +702,10 @@ class Scene:
             shapes_G[key] = _geom_shape(model, g, nf, tolerances)
         if bad_frame < ngeom:
             _inertial_frame(model, int(model.geom_bodyid[bad_frame]))   # raises its error
-        kind = np.array([first_of[k] for k in keys], dtype=np.int64)  # shape of each geom, as its first geom
-        rows = np.ascontiguousarray(np.concatenate([kind.view(np.uint8).reshape(ngeom, 8),
+        shape_of = np.array([first_of[k] for k in keys], dtype=np.int64)  # first geom with the same key
+        rows = np.ascontiguousarray(np.concatenate([shape_of.view(np.uint8).reshape(ngeom, 8),
                                                     R_all.reshape(ngeom, 9).view(np.uint8),
-                                                    p_all.view(np.uint8)], axis=1))
+                                                    p_all.view(np.uint8)], axis=1))   # bytes per geom
         _, first, inverse = np.unique(rows.view(np.dtype((np.void, rows.shape[1]))).ravel(),
                                       return_index=True, return_inverse=True)
         shapes_B = []
