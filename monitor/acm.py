@@ -59,7 +59,7 @@ from __future__ import annotations
 import json
 import logging
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
@@ -549,6 +549,42 @@ class PairPolicy:
     it, so an in-place edit (domain randomisation) can never add allowed pairs."""
 
 
+def _reason_codes(geom_names: Sequence[str], pair_ids: np.ndarray, acm: ACM | None) -> np.ndarray:
+    """(P,) int64: per row of ``pair_ids``, ``list(Reason).index(acm.reason(name_a, name_b))`` or -1.
+
+    -1 where the ACM has no entry for the row's two geom names (or there is no ACM).
+
+    The ACM's entries (name pairs) are turned into geom id pairs once and the rows are found
+    among them by binary search on ``a * G + b``: no Python per candidate pair. When two geoms
+    share a name (a name pair then stands for several id pairs) the rows are looked up one by one.
+    """
+    P = len(pair_ids)
+    out = np.full(P, -1, dtype=np.int64)
+    if acm is None or not acm.entries or not P:
+        return out
+    reasons = list(Reason)
+    index = {n: g for g, n in enumerate(geom_names)}
+    if len(index) != len(geom_names):
+        for k, (a, b) in enumerate(pair_ids.tolist()):
+            r = acm.reason(geom_names[a], geom_names[b])
+            out[k] = -1 if r is None else reasons.index(r)
+        return out
+    G = max(len(geom_names), 1)
+    ent = [(index[x], index[y], reasons.index(r)) for (x, y), r in acm.entries.items()
+           if x in index and y in index]
+    if not ent:
+        return out
+    e = np.array(ent, dtype=np.int64).reshape(-1, 3)
+    ekey = np.minimum(e[:, 0], e[:, 1]) * G + np.maximum(e[:, 0], e[:, 1])
+    order = np.argsort(ekey, kind="stable")
+    ekey, ecode = ekey[order], e[order, 2]
+    key = np.minimum(pair_ids[:, 0], pair_ids[:, 1]) * G + np.maximum(pair_ids[:, 0], pair_ids[:, 1])
+    at = np.minimum(np.searchsorted(ekey, key), len(ekey) - 1)
+    hit = ekey[at] == key
+    out[hit] = ecode[at[hit]]
+    return out
+
+
 def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, allowed: Any = None,
                  hazards: Any = None, allow: Any = None, reference: np.ndarray | None = None) -> PairPolicy:
     """Split candidate pairs into monitored and allowed (see :mod:`monitor.pairsel`).
@@ -574,20 +610,18 @@ def apply_policy(model: Any, pair_ids: np.ndarray, pairs: Any = "mujoco", *, all
         keep = pair_mask(names, pair_ids, hazards, arg="hazards")
         not_hazard = int((~keep).sum())
     user = pair_mask(names, pair_ids, allow, arg="allow") if allow is not None else np.zeros(len(keep), bool)
-    allowed_rows: list[tuple[str, str, str]] = []
-    never = []
-    for k, (a, b) in enumerate(pair_ids.tolist()):
-        if not keep[k]:
-            continue
-        na, nb = names.geom_names[a], names.geom_names[b]
-        r = acm.reason(na, nb) if acm is not None else None
-        if user[k] and (r is None or not r.skips):
-            r = Reason.USER
-        if r is not None and r.skips:
-            keep[k] = False
-            allowed_rows.append((na, nb, r.value))
-        elif r is Reason.NEVER:
-            never.append((na, nb))
+    reasons = list(Reason)
+    code = _reason_codes(names.geom_names, pair_ids, acm)  # (P,) index into reasons, -1: not in the ACM
+    skips = np.array([r.skips for r in reasons] + [False])   # code -1 reads the last entry: no reason
+    code = np.where(user & ((code < 0) | ~skips[code]), reasons.index(Reason.USER), code)
+    drop = keep & skips[code]
+    never_rows = keep & ~drop & (code == reasons.index(Reason.NEVER))
+    gn = np.array(names.geom_names, dtype=object)   # name tuples of the removed / Never rows (the output)
+    value = np.array([r.value for r in reasons], dtype=object)
+    gone, hint = pair_ids[drop], pair_ids[never_rows]
+    allowed_rows = list(zip(gn[gone[:, 0]].tolist(), gn[gone[:, 1]].tolist(), value[code[drop]].tolist()))
+    never = list(zip(gn[hint[:, 0]].tolist(), gn[hint[:, 1]].tolist()))
+    keep &= ~drop
     return PairPolicy(pair_ids[keep], tuple(allowed_rows), not_hazard, tuple(never), acm)
 
 

@@ -47,6 +47,19 @@ _INDEX = re.compile(r"^(.+)/(\d+)$")
 _MAX_LISTED = 40
 
 
+def object_names(model: Any, adr: np.ndarray, prefix: str) -> list[str]:
+    """MuJoCo's object names at offsets ``adr`` (n,) of ``model.names``; ``f"{prefix}{i}"`` when empty.
+
+    The same strings as ``model.geom(i).name`` / ``model.body(i).name`` (each name runs from its
+    offset to the next NUL byte of the names buffer), read in one pass over the buffer.
+    """
+    blob = model.names
+    adr = np.asarray(adr, dtype=np.int64)
+    nul = np.flatnonzero(np.frombuffer(blob, dtype=np.uint8) == 0)
+    end = nul[np.searchsorted(nul, adr)]
+    return [blob[a:e].decode() or f"{prefix}{i}" for i, (a, e) in enumerate(zip(adr.tolist(), end.tolist()))]
+
+
 @dataclass(frozen=True)
 class ModelNames:
     """Names and tree structure of a model, as pattern resolution needs them.
@@ -68,9 +81,8 @@ class ModelNames:
     @classmethod
     def from_model(cls, model: Any) -> ModelNames:
         """Read names/tree from a ``mujoco.MjModel``."""
-        ng, nb = int(model.ngeom), int(model.nbody)
-        return cls(tuple(model.geom(g).name or f"geom{g}" for g in range(ng)),
-                   tuple(model.body(b).name or f"body{b}" for b in range(nb)),
+        return cls(tuple(object_names(model, model.name_geomadr, "geom")),
+                   tuple(object_names(model, model.name_bodyadr, "body")),
                    np.asarray(model.geom_bodyid, dtype=np.int64).copy(),
                    np.asarray(model.body_parentid, dtype=np.int64).copy(),
                    np.asarray(model.geom_group, dtype=np.int64).copy())
@@ -211,4 +223,4 @@ def geom_pairs(names: ModelNames, pair_ids: Iterable[Sequence[int]]) -> list[tup
     return [(names.geom_names[int(a)], names.geom_names[int(b)]) for a, b in pair_ids]
 
 
-__all__ = ["ModelNames", "resolve_pattern", "pair_mask", "geom_pairs"]
+__all__ = ["object_names", "ModelNames", "resolve_pattern", "pair_mask", "geom_pairs"]

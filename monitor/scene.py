@@ -92,6 +92,7 @@ from monitor.geometry.polytope import (
     sphere_shape,
 )
 from monitor.geometry.shapes import ConvexShape
+from monitor.pairsel import object_names
 from monitor.tolerances import DEFAULT, Tolerances
 
 FLAT_MESH_THICKNESS = 1e-6
@@ -106,6 +107,9 @@ _HFIELD = int(mujoco.mjtGeom.mjGEOM_HFIELD)
 _SDF = int(mujoco.mjtGeom.mjGEOM_SDF)
 _UNSUPPORTED = (_HFIELD, _SDF)
 _CHUNK = 1 << 20  # geom pairs per vectorised filter block
+_SIGNATURE_BODIES = 1 << 16
+"""Bodies up to which MuJoCo's exclusion signature ``(b1 << 16) + b2`` names one body pair (decoded
+once by :func:`_filter_pairs`); above, the signatures are compared per block as MuJoCo computes them."""
 
 SYNC_FIELDS: tuple[str, ...] = (
     # geometry of the shapes (body frame)
@@ -262,6 +266,10 @@ def _quat_to_mat(q: np.ndarray) -> np.ndarray:
 
 
 _SAME = mujoco.mjtSameFrame
+_SF_BODY, _SF_INERTIA, _SF_BODYROT, _SF_INERTIAROT, _SF_NONE = (
+    int(_SAME.mjSAMEFRAME_BODY), int(_SAME.mjSAMEFRAME_INERTIA), int(_SAME.mjSAMEFRAME_BODYROT),
+    int(_SAME.mjSAMEFRAME_INERTIAROT), int(_SAME.mjSAMEFRAME_NONE))
+"""``geom_sameframe`` / ``body_sameframe`` codes as ints (numpy compares them without Python objects)."""
 
 
 def geom_frame(model: Any, g: int) -> tuple[np.ndarray, np.ndarray]:
@@ -308,6 +316,58 @@ def _inertial_frame(model: Any, b: int) -> tuple[np.ndarray, np.ndarray]:
             f"body {b}: body_sameframe {sf} ({_SAME(sf).name}): MuJoCo's compiler never sets it for a body, "
             "so where mj_kinematics puts the body's inertial frame is not defined here")
     return _quat_to_mat(model.body_iquat[b]), np.array(model.body_ipos[b], dtype=np.float64)
+
+
+def _quat_mats(quats: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) ``mju_quat2Mat`` of (n, 4) quaternions: one call per distinct quaternion (bytes)."""
+    q = np.ascontiguousarray(quats, dtype=np.float64).reshape(-1, 4)
+    if not len(q):
+        return np.zeros((0, 3, 3))
+    _, first, inverse = np.unique(q.view(np.dtype((np.void, 32))).ravel(), return_index=True,
+                                  return_inverse=True)
+    mats = np.stack([_quat_to_mat(q[i]) for i in first.tolist()])
+    return mats[inverse.reshape(-1)]
+
+
+def geom_frames(model: Any) -> tuple[np.ndarray, np.ndarray, int]:
+    """:func:`geom_frame` of every geom at once: (R_BG (G, 3, 3), p_BG (G, 3), first bad geom).
+
+    Values are :func:`geom_frame`'s bit for bit (the same ``mju_quat2Mat`` per distinct
+    quaternion, the same copied positions). Where :func:`geom_frame` would raise (a geom placed
+    in a body's inertial frame whose ``body_sameframe`` is not one the compiler sets), that
+    geom's rows are left as the body frame and its id is returned (``G``: none), so that the
+    caller raises :func:`geom_frame`'s error in its own order.
+    """
+    G = int(model.ngeom)
+    sf = np.asarray(model.geom_sameframe, dtype=np.int64)
+    body = np.asarray(model.geom_bodyid, dtype=np.int64)
+    R = np.broadcast_to(np.eye(3), (G, 3, 3)).copy()
+    p = np.array(model.geom_pos, dtype=np.float64).reshape(G, 3)
+    own = ~np.isin(sf, (_SF_BODY, _SF_INERTIA, _SF_BODYROT,
+                        _SF_INERTIAROT))
+    R[own] = _quat_mats(np.asarray(model.geom_quat)[own])
+    p[sf == _SF_BODY] = 0.0
+    inertial = (sf == _SF_INERTIA) | (sf == _SF_INERTIAROT)
+    bad = G
+    if inertial.any():
+        b = body[inertial]
+        bsf = np.asarray(model.body_sameframe, dtype=np.int64)[b]
+        frame_of_body = (bsf == _SF_BODY) | (b == 0)
+        rot_of_body = ~frame_of_body & (bsf == _SF_BODYROT)
+        own_rot = ~frame_of_body & (bsf == _SF_NONE)
+        ok = frame_of_body | rot_of_body | own_rot
+        if not ok.all():
+            bad = int(np.flatnonzero(inertial)[np.flatnonzero(~ok)[0]])
+        RI = np.broadcast_to(np.eye(3), (len(b), 3, 3)).copy()
+        RI[own_rot] = _quat_mats(np.asarray(model.body_iquat)[b[own_rot]])
+        pI = np.array(np.asarray(model.body_ipos)[b], dtype=np.float64).reshape(-1, 3)
+        pI[frame_of_body] = 0.0
+        keep = ok   # a bad geom keeps the body frame; the caller raises before using it
+        rows = np.flatnonzero(inertial)[keep]
+        R[rows] = RI[keep]
+        whole = sf[rows] == _SF_INERTIA
+        p[rows[whole]] = pI[keep][whole]
+    return R, p, bad
 
 
 def _to_body(shape_G: ConvexShape, R_BG: np.ndarray, p_BG: np.ndarray) -> ConvexShape:
@@ -450,15 +510,19 @@ class Scene:
 
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
-                 tolerances: Tolerances):
+                 tolerances: Tolerances, *, pairs_sorted: bool = False):
         pair_ids.setflags(write=False)
         body_static.setflags(write=False)
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
-        self._sorted_pairs = pair_ids if lex_sorted_pairs(pair_ids, len(geoms)) else None
+        sorted_ = pairs_sorted or lex_sorted_pairs(pair_ids, len(geoms))
+        self._sorted_pairs = pair_ids if sorted_ else None
         """``pair_ids`` itself when its rows are strictly increasing (a, b) with 0 <= a < b < ngeom (the
-        engine's sweep finds rows by binary search; checked here, once per pair array), else None."""
+        engine's sweep finds rows by binary search), else None. Checked here, once per pair array, unless
+        the caller passes ``pairs_sorted=True``: only :meth:`from_model`, for the arrays it builds, which
+        are in that order by construction (:func:`_filter_pairs`' row-major cells, a sorted set of
+        explicit pairs, and row subsets of those taken by boolean masks; tested on every model)."""
         self.body_names = body_names
         self.body_static = body_static
         self.facets = facets
@@ -585,12 +649,12 @@ class Scene:
             raise InvalidInputError(f"facets must be an integer >= 3, got {facets!r}")
         nf = int(nf)
 
-        nbody, ngeom = int(model.nbody), int(model.ngeom)
-        body_names = tuple(model.body(b).name or f"body{b}" for b in range(nbody))
+        ngeom = int(model.ngeom)
+        body_names = tuple(object_names(model, model.name_bodyadr, "body"))
         weld = np.asarray(model.body_weldid, dtype=np.int64)
         body_static = weld == 0
         body_mocap = np.asarray(model.body_mocapid, dtype=np.int64)[weld] >= 0
-        names = [model.geom(g).name or f"geom{g}" for g in range(ngeom)]
+        names = object_names(model, model.name_geomadr, "geom")
         if len(set(names)) != ngeom:  # an explicit name like "geom3" clashing with a generated one
             seen: dict[str, int] = {}
             for g, nm in enumerate(names):
@@ -608,9 +672,11 @@ class Scene:
                                   reference=reference)
             pair_ids, allowed_rows = policy.monitored, policy.allowed
         types = np.asarray(model.geom_type, dtype=np.int64)
-        if len(pair_ids):
-            in_pair = np.unique(pair_ids.ravel())
-            bad = in_pair[np.isin(types[in_pair], _UNSUPPORTED)]
+        unsupported = np.isin(types, _UNSUPPORTED)
+        if len(pair_ids) and unsupported.any():   # the pairs are read only when such a geom exists
+            in_pair = np.zeros(ngeom, dtype=bool)
+            in_pair[pair_ids.ravel()] = True
+            bad = np.flatnonzero(in_pair & unsupported)
             if bad.size:
                 g = int(bad[0])
                 other = pair_ids[(pair_ids == g).any(axis=1)][0]
@@ -621,27 +687,45 @@ class Scene:
                     f"{names[partner]!r}). Exclude it (contype/conaffinity, <exclude>) or pass "
                     "an explicit pair list without it")
 
-        geoms = []
-        frames: list[tuple[np.ndarray, np.ndarray]] = []
-        cache: dict[tuple, ConvexShape | None] = {}  # identical primitives / meshes share a geom-frame shape
-        for g in range(ngeom):
-            b = int(model.geom_bodyid[g])
-            key = (int(types[g]), tuple(np.asarray(model.geom_size[g]).tolist()), int(model.geom_dataid[g]))
-            if key not in cache:
-                cache[key] = _geom_shape(model, g, nf, tolerances)
-            shape_G = cache[key]
-            shape_B = None
-            frames.append(geom_frame(model, g))   # where MuJoCo's kinematics put the geom (geom_sameframe)
-            if shape_G is not None:
-                shape_B = _to_body(shape_G, *frames[g])
-            geoms.append(GeomInfo(
-                name=names[g], id=g, body=body_names[b], body_id=b,
-                type=_GEOM_TYPES.get(int(types[g]), str(int(types[g]))), shape=shape_B,
-                margin=float(model.geom_margin[g]), static=bool(body_static[b]),
-                mocap=bool(body_mocap[b])))
+        # Per geom: one geom-frame shape per distinct (type, size, mesh) and one body-frame shape per
+        # distinct (geom-frame shape, frame bytes); every geom with the same inputs shares the objects.
+        R_all, p_all, bad_frame = geom_frames(model)   # where MuJoCo's kinematics put each geom
+        sizes = np.asarray(model.geom_size, dtype=np.float64).reshape(ngeom, 3)
+        keys = list(zip(types.tolist(), map(tuple, sizes.tolist()), np.asarray(model.geom_dataid).tolist()))
+        first_of: dict[tuple, int] = {}
+        for g, key in enumerate(keys):
+            first_of.setdefault(key, g)
+        shapes_G: dict[tuple, ConvexShape | None] = {}
+        for key, g in first_of.items():   # first occurrences, in geom order (errors as a geom loop)
+            if g > bad_frame:
+                break
+            shapes_G[key] = _geom_shape(model, g, nf, tolerances)
+        if bad_frame < ngeom:
+            _inertial_frame(model, int(model.geom_bodyid[bad_frame]))   # raises its error
+        shape_of = np.array([first_of[k] for k in keys], dtype=np.int64)  # first geom with the same key
+        rows = np.ascontiguousarray(np.concatenate([shape_of.view(np.uint8).reshape(ngeom, 8),
+                                                    R_all.reshape(ngeom, 9).view(np.uint8),
+                                                    p_all.view(np.uint8)], axis=1))   # bytes per geom
+        _, first, inverse = np.unique(rows.view(np.dtype((np.void, rows.shape[1]))).ravel(),
+                                      return_index=True, return_inverse=True)
+        shapes_B = []
+        for g in first.tolist():
+            s = shapes_G[keys[g]]
+            shapes_B.append(None if s is None else _to_body(s, R_all[g].copy(), p_all[g].copy()))
+        R_all.setflags(write=False)
+        p_all.setflags(write=False)
+        frames = tuple(zip(R_all, p_all))
+        gbody = np.asarray(model.geom_bodyid, dtype=np.int64)
+        geoms = [GeomInfo(name=names[g], id=g, body=body_names[b], body_id=b,
+                          type=_GEOM_TYPES.get(t, str(t)), shape=shapes_B[u], margin=m,
+                          static=s, mocap=mc)
+                 for g, (b, t, u, m, s, mc) in enumerate(zip(
+                     gbody.tolist(), types.tolist(), inverse.reshape(-1).tolist(),
+                     np.asarray(model.geom_margin, dtype=np.float64).tolist(),
+                     body_static[gbody].tolist(), body_mocap[gbody].tolist()))]
         if isinstance(pairs, str) and pairs == "all":
             pair_ids = _drop_overlapping_world_children(model, pair_ids, geoms, tolerances)
-        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances)
+        scene = cls(model, tuple(geoms), pair_ids, body_names, body_static, nf, tolerances, pairs_sorted=True)
         scene.geom_frames = tuple(frames)
         scene._pairs_spec = pairs
         # rebuilds after model edits reuse the matrix resolved now ("auto" is not recomputed on an
@@ -736,55 +820,120 @@ def model_hash(model: Any) -> str:
     return hashlib.sha256(buf.tobytes()).hexdigest()
 
 
+def _body_pair_geoms(gbody: np.ndarray, nbody: int, b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
+    """(K, 2) int64 geom pairs (min, max): every geom of body ``b1[e]`` with every geom of ``b2[e]``.
+
+    Args:
+        gbody: (G,) body id of each geom.
+        nbody: number of bodies.
+        b1, b2: (E,) body ids (``b1[e] != b2[e]``).
+    """
+    order = np.argsort(gbody, kind="stable")
+    count = np.bincount(gbody, minlength=nbody)
+    first = np.concatenate([[0], np.cumsum(count)])[:-1]
+    n1, n2 = count[b1], count[b2]
+    size = n1 * n2
+    e = np.repeat(np.arange(len(b1)), size)
+    t = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
+    ga = order[first[b1[e]] + t // n2[e]]
+    gb = order[first[b2[e]] + t % n2[e]]
+    return np.stack([np.minimum(ga, gb), np.maximum(ga, gb)], axis=1).astype(np.int64)
+
+
 def _filter_pairs(model: Any, mode: str) -> np.ndarray:
-    """Vectorised candidate filter; returns (P, 2) int64 sorted geom id pairs (see module docstring)."""
-    ngeom = int(model.ngeom)
+    """Vectorised candidate filter; returns (P, 2) int64 geom id pairs in (a, b) order, a < b.
+
+    The rules are the module docstring's, evaluated on row blocks of the upper triangle
+    (rows ``[r0, r1)``, columns ``(r0, G)``, at most :data:`_CHUNK` cells): a boolean matrix
+    per block, from per-geom vectors (weld group, its parent's weld group, plane flag, dof,
+    contype / conaffinity), with the rules that select nothing in this model skipped. The
+    sparse rules are scattered into it: ``<exclude>`` body pairs (expanded to their geom
+    pairs) cleared, then ``<pair>`` geom pairs set (``"mujoco"``). The rows come out in
+    (a, b) order: the kept cells of each block, row by row.
+    """
+    ngeom, nbody = int(model.ngeom), int(model.nbody)
     if ngeom < 2:
         return np.zeros((0, 2), np.int64)
     types = np.asarray(model.geom_type, dtype=np.int64)
     gbody = np.asarray(model.geom_bodyid, dtype=np.int64)
     weld = np.asarray(model.body_weldid, dtype=np.int64)
     parent = np.asarray(model.body_parentid, dtype=np.int64)
-    dofnum = np.asarray(model.body_dofnum, dtype=np.int64)
-    contype = np.asarray(model.geom_contype, dtype=np.int64)
-    conaff = np.asarray(model.geom_conaffinity, dtype=np.int64)
     gweld = weld[gbody]
-    wparent = weld[parent]  # weld group of each body's parent
+    gpweld = weld[parent][gweld]  # weld group of the parent of each geom's weld group
     planeish = np.isin(types, (_PLANE, _HFIELD))
     filterparent = not (int(model.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT))
-    excl = np.sort(np.asarray(model.exclude_signature, dtype=np.int64))
-    explicit = set()
-    for a, b in zip(np.asarray(model.pair_geom1).tolist(), np.asarray(model.pair_geom2).tolist()):
-        explicit.add((min(a, b), max(a, b)))
+    mujoco_mode = mode == "mujoco"
+    # parent-child weld groups, neither the world: w_a == pw_b or pw_a == w_b with both groups
+    # moving, folded into one comparison of keys that never match for a world geom
+    moving = gweld != 0
+    key_w = np.where(moving, gweld, -2)
+    key_pw = np.where(moving, gpweld, -3)
+    use_parent = (filterparent or not mujoco_mode) and bool(np.isin(key_pw, key_w).any())
+    use_plane = int(planeish.sum()) >= 2
+    dof_ok = use_dof = use_mask = None
+    cleared = np.zeros((0, 2), np.int64)
+    forced = np.zeros((0, 2), np.int64)
+    sig_fallback = None
+    if mujoco_mode:
+        dofnum = np.asarray(model.body_dofnum, dtype=np.int64)
+        contype = np.asarray(model.geom_contype, dtype=np.int64)
+        conaff = np.asarray(model.geom_conaffinity, dtype=np.int64)
+        dof_ok = dofnum[gweld] > 0
+        use_dof = not bool(dof_ok.all())
+        # every pair passes the contype/conaffinity test when one bit is in every contype and conaffinity
+        use_mask = int(np.bitwise_and.reduce(contype) & np.bitwise_and.reduce(conaff)) == 0
+        excl = np.asarray(model.exclude_signature, dtype=np.int64)
+        if len(excl) and nbody > _SIGNATURE_BODIES:  # signatures ambiguous: compare them per block
+            sig_fallback = np.sort(excl)
+        elif len(excl):
+            lo, hi = excl >> 16, excl & 0xFFFF  # the signature of body pair (lo, hi), lo <= hi
+            ok = (lo >= 0) & (lo < hi) & (hi < nbody)
+            cleared = _body_pair_geoms(gbody, nbody, lo[ok], hi[ok])
+        ex = np.stack([np.asarray(model.pair_geom1, dtype=np.int64),
+                       np.asarray(model.pair_geom2, dtype=np.int64)], axis=1).reshape(-1, 2)
+        ex = np.stack([ex.min(axis=1), ex.max(axis=1)], axis=1)
+        forced = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]]) & (ex[:, 0] != ex[:, 1])]
+    cleared = cleared[np.argsort(cleared[:, 0], kind="stable")]
+    forced = forced[np.argsort(forced[:, 0], kind="stable")]
 
-    out = []
+    index = np.arange(ngeom, dtype=np.int64)
     rows = max(1, _CHUNK // ngeom)
+    blocks: list[tuple[int, int, np.ndarray, np.ndarray]] = []
+    total = 0
     for r0 in range(0, ngeom - 1, rows):
-        ii, jj = np.meshgrid(np.arange(r0, min(r0 + rows, ngeom - 1)), np.arange(ngeom), indexing="ij")
-        upper = jj > ii
-        i, j = ii[upper], jj[upper]
-        w1, w2 = gweld[i], gweld[j]
-        keep = ~(planeish[i] & planeish[j])
-        keep &= w1 != w2
-        if mode == "mujoco":
-            keep &= (dofnum[w1] > 0) | (dofnum[w2] > 0)
-            if filterparent:
-                keep &= ~((w1 != 0) & (w2 != 0) & ((w1 == wparent[w2]) | (w2 == wparent[w1])))
-            b1, b2 = gbody[i], gbody[j]
-            sig = (np.minimum(b1, b2) << 16) + np.maximum(b1, b2)
-            if len(excl):
-                keep &= ~np.isin(sig, excl)
-            keep &= ((contype[i] & conaff[j]) != 0) | ((contype[j] & conaff[i]) != 0)
-        else:
-            keep &= ~((w1 == 0) & (w2 == 0))
-            keep &= ~((w1 != 0) & (w2 != 0) & ((w1 == wparent[w2]) | (w2 == wparent[w1])))
-        out.append(np.stack([i[keep], j[keep]], axis=1))
-    sel = np.concatenate(out).astype(np.int64)
-    if mode == "mujoco" and explicit:
-        ex = np.array(sorted(explicit), dtype=np.int64).reshape(-1, 2)
-        ex = ex[~(planeish[ex[:, 0]] & planeish[ex[:, 1]]) & (ex[:, 0] != ex[:, 1])]
-        sel = np.unique(np.concatenate([sel, ex]), axis=0)
-    return sel.reshape(-1, 2)
+        r1, c0 = min(r0 + rows, ngeom - 1), r0 + 1
+        R, C = slice(r0, r1), slice(c0, ngeom)
+        keep = gweld[R, None] != gweld[None, C]
+        nr = r1 - r0
+        keep[:, :nr] &= np.tri(nr, nr, 0, dtype=bool).T  # column c0 + j > row r0 + i  <=>  j >= i
+        if use_plane and planeish[R].any():
+            keep &= ~(planeish[R, None] & planeish[None, C])
+        if use_parent:
+            keep &= ~((key_w[R, None] == key_pw[None, C]) | (key_pw[R, None] == key_w[None, C]))
+        if mujoco_mode:
+            if use_dof:
+                keep &= dof_ok[R, None] | dof_ok[None, C]
+            if sig_fallback is not None:
+                b1, b2 = gbody[R, None], gbody[None, C]
+                keep &= ~np.isin((np.minimum(b1, b2) << 16) + np.maximum(b1, b2), sig_fallback)
+            if use_mask:
+                keep &= (((contype[R, None] & conaff[None, C]) != 0)
+                         | ((contype[None, C] & conaff[R, None]) != 0))
+            for sparse, value in ((cleared, False), (forced, True)):
+                lo, hi = np.searchsorted(sparse[:, 0], [r0, r1])
+                if hi > lo:
+                    keep[sparse[lo:hi, 0] - r0, sparse[lo:hi, 1] - c0] = value
+        count = np.count_nonzero(keep, axis=1)
+        blocks.append((r0, c0, keep, count))
+        total += int(count.sum())
+    out = np.empty((total, 2), np.int64)
+    at = 0
+    for r0, c0, keep, count in blocks:
+        n = int(count.sum())
+        out[at:at + n, 0] = np.repeat(index[r0:r0 + len(count)], count)
+        out[at:at + n, 1] = np.broadcast_to(index[c0:], keep.shape)[keep]
+        at += n
+    return out
 
 
 def _drop_overlapping_world_children(model: Any, pair_ids: np.ndarray, geoms: Sequence[GeomInfo],
@@ -799,48 +948,52 @@ def _drop_overlapping_world_children(model: Any, pair_ids: np.ndarray, geoms: Se
     at ``qpos0``). The anchor is fixed in both frames under such joints, so the
     pair overlaps for every joint value (Reacher's ``root`` vs ``link0``, a robot
     base vs its first link): planners' "always in collision" entries.
+
+    Work per scene: O(G) to find the world children with such joints (none: nothing
+    more, no pass over the pairs), then per such child the point tests of its geoms
+    and of the world geoms; the pairs are read only when some pair is to be dropped.
     """
     if not len(pair_ids):
         return pair_ids
+    nbody = int(model.nbody)
     weld = np.asarray(model.body_weldid, dtype=np.int64)
-    parent = np.asarray(model.body_parentid, dtype=np.int64)
     gweld = weld[np.asarray(model.geom_bodyid, dtype=np.int64)]
-    w1, w2 = gweld[pair_ids[:, 0]], gweld[pair_ids[:, 1]]
-    wparent = weld[parent]
-    adjacent = ((w1 == 0) & (w2 != 0) & (wparent[w2] == 0)) | ((w2 == 0) & (w1 != 0) & (wparent[w1] == 0))
-    if not adjacent.any():
+    world_child = (gweld != 0) & (weld[np.asarray(model.body_parentid, dtype=np.int64)][gweld] == 0)
+    jnt_body = np.asarray(model.jnt_bodyid, dtype=np.int64)
+    rotational = np.isin(np.asarray(model.jnt_type), (int(mujoco.mjtJoint.mjJNT_HINGE),
+                                                       int(mujoco.mjtJoint.mjJNT_BALL)))
+    njnt = np.bincount(jnt_body, minlength=nbody)
+    nrot = np.bincount(jnt_body[rotational], minlength=nbody)
+    groups = np.unique(gweld[world_child])
+    groups = groups[(njnt[groups] > 0) & (nrot[groups] == njnt[groups])]  # rotational joints only
+    if not groups.size or not (gweld == 0).any():
         return pair_ids
     from monitor.geometry.distance import point_in_shape  # pure geometry; no import cycle
 
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    rotational = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_BALL))
-    anchor_of: dict[int, np.ndarray | None] = {}
+    shaped = np.array([g.shape is not None for g in geoms], dtype=bool)
+    world_geoms = np.flatnonzero((gweld == 0) & shaped)
 
-    def anchor(w: int) -> np.ndarray | None:
-        """World anchor shared by all joints of weld group ``w`` if all are rotational."""
-        if w not in anchor_of:
-            jnts = np.flatnonzero(np.asarray(model.jnt_bodyid) == w)
-            pts = [np.array(data.xanchor[j]) for j in jnts if int(model.jnt_type[j]) in rotational]
-            ok = len(jnts) > 0 and len(pts) == len(jnts) and all(np.array_equal(p, pts[0]) for p in pts)
-            anchor_of[w] = pts[0] if ok else None
-        return anchor_of[w]
+    def inside(g: int, p: np.ndarray) -> bool:
+        b = geoms[g].body_id
+        X = (data.xmat[b].reshape(3, 3).copy(), data.xpos[b].copy())
+        return point_in_shape(geoms[g].shape, X, p, 0.0, tolerances=tolerances)
 
-    keep = np.ones(len(pair_ids), dtype=bool)
-    for k in np.flatnonzero(adjacent):
-        a, b = geoms[int(pair_ids[k, 0])], geoms[int(pair_ids[k, 1])]
-        if a.shape is None or b.shape is None:
+    drop: list[tuple[int, int]] = []
+    for w in groups.tolist():
+        pts = [np.array(data.xanchor[j]) for j in np.flatnonzero(jnt_body == w)]
+        if not all(np.array_equal(q, pts[0]) for q in pts):
             continue
-        child = int(w2[k]) if w1[k] == 0 else int(w1[k])
-        p = anchor(child)
-        if p is None:
-            continue
-        inside = all(point_in_shape(g.shape, (data.xmat[g.body_id].reshape(3, 3).copy(),
-                                               data.xpos[g.body_id].copy()), p, 0.0, tolerances=tolerances)
-                     for g in (a, b))
-        if inside:
-            keep[k] = False
-    return pair_ids[keep]
+        kids = [g for g in np.flatnonzero((gweld == w) & shaped).tolist() if inside(g, pts[0])]
+        if kids:
+            walls = [g for g in world_geoms.tolist() if inside(g, pts[0])]
+            drop += [(min(s, c), max(s, c)) for s in walls for c in kids]
+    if not drop:
+        return pair_ids
+    G = max(len(geoms), 1)
+    gone = np.array([a * G + b for a, b in drop], dtype=np.int64)
+    return pair_ids[~np.isin(pair_ids[:, 0] * G + pair_ids[:, 1], gone)]
 
 
 __all__ = ["Scene", "GeomInfo", "model_hash", "FLAT_MESH_THICKNESS", "SYNC_FIELDS"]

@@ -130,3 +130,17 @@ def test_alias_and_labels(names):
     assert names.alias(5) == "object/0" and names.alias(3) == "arm/1"
     assert names.label(5) == "geom5 (object/0)" and names.label(2) == "arm_link"
     assert np.array_equal(names.geom_body, [0, 1, 2, 2, 3, 4])
+
+
+def test_object_names_equal_mujocos_accessors():
+    """Names read from the names buffer equal model.geom(i).name / model.body(i).name, unnamed objects
+    get the generated name, non-ASCII names decode."""
+    from monitor.pairsel import object_names
+
+    xml = ('<mujoco><worldbody><geom type="plane" size="1 1 .1"/><body name="bø"><freejoint/>'
+           '<geom name="ħand" size=".1"/><geom size=".1"/></body><body><freejoint/><geom name="x" size=".1"/>'
+           '</body></worldbody></mujoco>')
+    m = mujoco.MjModel.from_xml_string(xml)
+    assert object_names(m, m.name_geomadr, "geom") == [m.geom(g).name or f"geom{g}" for g in range(m.ngeom)]
+    assert object_names(m, m.name_bodyadr, "body") == ["world", "bø", "body2"]
+    assert object_names(m, m.name_geomadr, "geom") == ["geom0", "ħand", "geom2", "x"]

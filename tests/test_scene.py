@@ -462,27 +462,32 @@ def _brute_force_mujoco(model):
     filterparent = not model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_FILTERPARENT
     excluded = set(model.exclude_signature.tolist())
     explicit = {tuple(sorted(p)) for p in zip(model.pair_geom1.tolist(), model.pair_geom2.tolist())}
-    planeish = (TYPES.mjGEOM_PLANE, TYPES.mjGEOM_HFIELD)
     out = set()
+    for a, b in _pairs_not_both_planes(model):
+        if (a, b) in explicit:
+            out.add((a, b))
+            continue
+        ba, bb = model.geom_bodyid[a], model.geom_bodyid[b]
+        wa, wb = weld[ba], weld[bb]
+        if wa == wb or (dof[wa] == 0 and dof[wb] == 0):
+            continue
+        if filterparent and wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+            continue
+        if (min(ba, bb) << 16) + max(ba, bb) in excluded:
+            continue
+        ca, cb = model.geom_contype, model.geom_conaffinity
+        if ca[a] & cb[b] or ca[b] & cb[a]:
+            out.add((a, b))
+    return out
+
+
+def _pairs_not_both_planes(model):
+    """Every geom pair a < b, one by one, except plane/hfield pairs (no collision test)."""
+    planeish = (int(TYPES.mjGEOM_PLANE), int(TYPES.mjGEOM_HFIELD))
     for a in range(model.ngeom):
         for b in range(a + 1, model.ngeom):
-            if model.geom_type[a] in planeish and model.geom_type[b] in planeish:
-                continue
-            if (a, b) in explicit:
-                out.add((a, b))
-                continue
-            ba, bb = model.geom_bodyid[a], model.geom_bodyid[b]
-            wa, wb = weld[ba], weld[bb]
-            if wa == wb or (dof[wa] == 0 and dof[wb] == 0):
-                continue
-            if filterparent and wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
-                continue
-            if (min(ba, bb) << 16) + max(ba, bb) in excluded:
-                continue
-            ca, cb = model.geom_contype, model.geom_conaffinity
-            if ca[a] & cb[b] or ca[b] & cb[a]:
-                out.add((a, b))
-    return out
+            if not (model.geom_type[a] in planeish and model.geom_type[b] in planeish):
+                yield a, b
 
 
 @pytest.mark.parametrize("name", PAIR_SCENES)
@@ -589,3 +594,233 @@ def test_all_pairs_drop_only_always_touching_world_children():
     assert ("root", "link") not in pairs  # hinge anchor inside both: always touching
     assert ("wall", "ball") in pairs      # overlaps at qpos0, but a slider can leave
     assert ("floor", "crate") in pairs and ("floor", "link") in pairs
+
+
+# --------------------------------------------------------------------------- issue 12: per-scene cost
+RANDOM_SEEDS = range(10)
+
+
+def _brute_force_all(model):
+    """pairs="all" before the world-children drop, pair by pair (module docstring of monitor.scene)."""
+    weld, parent = model.body_weldid, model.body_parentid
+    out = set()
+    for a, b in _pairs_not_both_planes(model):
+        wa, wb = weld[model.geom_bodyid[a]], weld[model.geom_bodyid[b]]
+        if wa == wb or (wa == 0 and wb == 0):
+            continue
+        if wa and wb and (weld[parent[wa]] == wb or weld[parent[wb]] == wa):
+            continue
+        out.add((a, b))
+    return out
+
+
+def _strictly_increasing(pid):
+    rows = [tuple(r) for r in pid.tolist()]
+    return all(a < b for a, b in rows) and all(r < s for r, s in zip(rows, rows[1:]))
+
+
+@pytest.mark.parametrize("seed", RANDOM_SEEDS)
+def test_random_mjcf_filter_matches_rule_loops(seed, monkeypatch):
+    """Seeded random MJCF (welds, mocap, planes, meshes, masks, <exclude>, <pair>, filterparent on/off):
+    the row-block filter equals the rule-by-rule loops for "mujoco" and "all" in every block size, with
+    <exclude> decoded or compared as signatures, rows in strict (a, b) order, and every pair
+    mj_collision reports is a "mujoco" candidate."""
+    from _scene_cases import random_mjcf
+
+    import monitor.scene as scene_mod
+
+    xml = random_mjcf(seed)
+    model = mujoco.MjModel.from_xml_string(xml)
+    want = {"mujoco": _brute_force_mujoco(model), "all": _brute_force_all(model)}
+    for chunk, signature_bodies in ((1, 1 << 16), (7, 0), (1 << 20, 1 << 16)):  # 0: signatures compared
+        monkeypatch.setattr(scene_mod, "_CHUNK", chunk)
+        monkeypatch.setattr(scene_mod, "_SIGNATURE_BODIES", signature_bodies)
+        for mode in ("mujoco", "all"):
+            pid = scene_mod._filter_pairs(model, mode)
+            assert pid.dtype == np.int64 and pid.shape[1:] == (2,) and pid.flags.c_contiguous
+            assert _strictly_increasing(pid), (mode, chunk)
+            assert {tuple(p) for p in pid.tolist()} == want[mode], (mode, chunk)
+    assert contact_pairs(xml) - {(a, a) for a in range(model.ngeom)} <= want["mujoco"]
+
+
+def test_random_mjcf_cover_the_filter_rules():
+    """The random models exercise every rule the filter has (else the test above proves little)."""
+    from _scene_cases import random_mjcf
+
+    seen = dict.fromkeys(("exclude", "pair", "plane pair", "weld child", "mocap", "filterparent off",
+                          "parent-child", "mesh", "masked"), False)
+    for seed in RANDOM_SEEDS:
+        m = mujoco.MjModel.from_xml_string(random_mjcf(seed))
+        weld, parent = m.body_weldid, m.body_parentid
+        seen["exclude"] |= m.nexclude > 0
+        seen["pair"] |= m.npair > 0
+        seen["plane pair"] |= int((m.geom_type == TYPES.mjGEOM_PLANE).sum()) >= 2
+        seen["weld child"] |= any(weld[b] not in (0, b) for b in range(m.nbody))
+        seen["mocap"] |= bool((m.body_mocapid >= 0).any())
+        seen["filterparent off"] |= bool(m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+        seen["parent-child"] |= any(weld[parent[w]] not in (0,) for w in set(weld.tolist()) - {0})
+        seen["mesh"] |= bool((m.geom_type == TYPES.mjGEOM_MESH).any())
+        seen["masked"] |= bool((m.geom_contype != 1).any())
+    assert all(seen.values()), seen
+
+
+WORLD_CHILDREN_XML = """<mujoco><worldbody>
+  <geom name="floor" type="plane" size="5 5 .1"/>
+  <geom name="post" type="box" pos="0 0 .26" size=".05 .05 .26"/>
+  <geom type="sphere" pos="0 0 .5" size=".04"/>
+  <geom name="far" type="box" pos="3 0 .5" size=".1 .1 .1"/>
+  <body name="hinged" pos="0 0 .5"><joint type="hinge" axis="0 0 1"/>
+    <geom name="h1" type="capsule" fromto="0 0 0 .3 0 0" size=".02"/>
+    <geom type="sphere" pos=".3 0 0" size=".02"/>
+    <body name="welded" pos=".1 0 0"><geom name="h2" type="box" size=".02 .02 .02"/></body></body>
+  <body name="two" pos="0 0 .5"><joint type="hinge" axis="1 0 0"/><joint type="ball"/>
+    <geom name="t1" type="sphere" size=".03"/></body>
+  <body name="apart" pos="0 0 .5"><joint type="hinge" axis="1 0 0"/><joint type="hinge" pos=".01 0 0"/>
+    <geom name="a1" type="sphere" size=".03"/></body>
+  <body name="slide" pos="0 0 .5"><joint type="hinge" axis="1 0 0"/><joint type="slide"/>
+    <geom name="s1" type="sphere" size=".03"/></body>
+  <body name="free" pos="0 0 .5"><freejoint/><geom name="f1" type="sphere" size=".03"/></body>
+</worldbody></mujoco>"""
+
+
+def _drop_oracle(scene, pair_ids):
+    """The world-children rule pair by pair: world geom vs a geom of a world child whose joints are all
+    hinge/ball with one shared anchor lying (point_in_shape) in both geoms."""
+    from monitor.geometry.distance import point_in_shape
+
+    model = scene.model
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    weld, parent = model.body_weldid, model.body_parentid
+    rot = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_BALL))
+    out = set()
+    for a, b in pair_ids:
+        ga, gb = scene.geoms[a], scene.geoms[b]
+        wa, wb = weld[ga.body_id], weld[gb.body_id]
+        if not ((wa == 0 and wb and weld[parent[wb]] == 0) or (wb == 0 and wa and weld[parent[wa]] == 0)):
+            continue
+        child = wb if wa == 0 else wa
+        jnts = [j for j in range(model.njnt) if model.jnt_bodyid[j] == child]
+        if not jnts or any(model.jnt_type[j] not in rot for j in jnts) or None in (ga.shape, gb.shape):
+            continue
+        p = data.xanchor[jnts[0]].copy()
+        if any(not np.array_equal(data.xanchor[j], p) for j in jnts):
+            continue
+        poses = [(data.xmat[g.body_id].reshape(3, 3).copy(), data.xpos[g.body_id].copy()) for g in (ga, gb)]
+        if all(point_in_shape(g.shape, X, p, 0.0) for g, X in zip((ga, gb), poses)):
+            out.add((a, b))
+    return out
+
+
+@pytest.mark.parametrize("seed", [None, *RANDOM_SEEDS])
+def test_all_pairs_world_children_drop_matches_pair_loop(seed):
+    """pairs="all" == the rule loop minus the world-children pairs the pair-by-pair oracle drops; on a
+    scene made for the rule (shared anchors, two anchors, a slider, a welded child, an unnamed geom)
+    and on the random models."""
+    from _scene_cases import random_mjcf
+
+    xml = WORLD_CHILDREN_XML if seed is None else random_mjcf(seed)
+    model = mujoco.MjModel.from_xml_string(xml)
+    scene = Scene.from_model(model, pairs="all")
+    loop = _brute_force_all(model)
+    dropped = _drop_oracle(scene, sorted(loop))
+    assert {tuple(p) for p in scene.pair_ids.tolist()} == loop - dropped
+    if seed is None:
+        names = {tuple(sorted(p)) for p in scene.candidate_pairs}
+        gone = {tuple(sorted((scene.geoms[a].name, scene.geoms[b].name))) for a, b in dropped}
+        assert gone == {("h1", "post"), ("geom2", "h1"), ("post", "t1"), ("geom2", "t1")}
+        assert ("a1", "post") in names and ("post", "s1") in names and ("f1", "post") in names
+        assert ("h2", "post") in names  # the welded child's own geom does not hold the anchor
+
+
+@pytest.mark.parametrize("seed", RANDOM_SEEDS[:5])
+def test_geoms_equal_the_per_geom_construction(seed):
+    """Every GeomInfo (name, frame, body-frame shape) equals the one-geom-at-a-time construction
+    (model.geom(g).name, geom_frame, _geom_shape + _to_body) bit for bit, shared objects or not."""
+    from _scene_cases import random_mjcf
+
+    import monitor.scene as scene_mod
+
+    model = mujoco.MjModel.from_xml_string(random_mjcf(seed))
+    scene = Scene.from_model(model, pairs="all")
+    R_all, p_all, bad = scene_mod.geom_frames(model)
+    assert bad == model.ngeom
+    for g, info in enumerate(scene.geoms):
+        assert info.name == (model.geom(g).name or f"geom{g}")
+        assert info.body == (model.body(info.body_id).name or f"body{info.body_id}")
+        R, p = scene_mod.geom_frame(model, g)
+        for got in ((R_all[g], p_all[g]), scene.geom_frames[g]):
+            assert got[0].tobytes() == R.tobytes() and got[1].tobytes() == p.tobytes()
+        shape = scene_mod._geom_shape(model, g, scene.facets, scene.tolerances)
+        if shape is None:
+            assert info.shape is None
+            continue
+        ref = scene_mod._to_body(shape, R, p)
+        assert (info.shape.kind, info.shape.radius, info.shape.approx_error) == (ref.kind, ref.radius,
+                                                                                  ref.approx_error)
+        for f in ("points", "edges", "normals", "offsets"):
+            assert getattr(info.shape, f).tobytes() == getattr(ref, f).tobytes(), (g, f)
+        assert len(info.shape.faces) == len(ref.faces)
+
+
+def test_identical_geoms_share_one_shape():
+    """Equal geoms at equal frames share one body-frame shape object (the bench's 27 equal boxes); the
+    shape is the one-geom construction's."""
+    import monitor.scene as scene_mod
+    from monitor.bench.suites import scaling_scene
+
+    model, _ = scaling_scene(27, "sparse", "translating")
+    scene = Scene.from_model(model, pairs="all")
+    assert len({id(g.shape) for g in scene.geoms}) == 1
+    ref = scene_mod._to_body(scene_mod._geom_shape(model, 5, scene.facets, scene.tolerances),
+                             *scene_mod.geom_frame(model, 5))
+    assert scene.geoms[5].shape.points.tobytes() == ref.points.tobytes()
+
+
+def test_geom_frames_inertial_and_bad_sameframe():
+    """Geoms placed in their body's inertial frame (INERTIA / INERTIAROT, body_sameframe BODY / BODYROT /
+    NONE) get geom_frame's values; an edited-in body_sameframe is refused with geom_frame's error."""
+    import monitor.scene as scene_mod
+
+    xml = """<mujoco><worldbody>
+      <body name="a" pos="0 0 1"><freejoint/><geom name="a0" type="box" size=".1 .2 .3" pos=".1 0 0"/></body>
+      <body name="b" pos="1 0 1"><freejoint/><geom name="b0" type="box" size=".1 .2 .3" pos=".1 .2 0"
+          euler="10 20 30"/></body>
+      <body name="c" pos="2 0 1"><freejoint/><geom name="c0" type="capsule" size=".1 .2" euler="0 90 0"/>
+        <geom name="c1" type="sphere" size=".1" pos=".3 0 0"/></body>
+    </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    for sf in range(5):   # every geom_sameframe value on every geom, geom_frame as the oracle
+        model.geom_sameframe[:] = sf
+        R_all, p_all, bad = scene_mod.geom_frames(model)
+        assert bad == model.ngeom
+        for g in range(model.ngeom):
+            R, p = scene_mod.geom_frame(model, g)
+            assert R_all[g].tobytes() == R.tobytes() and p_all[g].tobytes() == p.tobytes(), (sf, g)
+    model.geom_sameframe[:] = mujoco.mjtSameFrame.mjSAMEFRAME_INERTIA
+    model.body_sameframe[2] = mujoco.mjtSameFrame.mjSAMEFRAME_INERTIAROT   # never set by the compiler
+    with pytest.raises(UnsupportedGeometryError) as want:
+        scene_mod.geom_frame(model, 1)
+    assert scene_mod.geom_frames(model)[2] == 1
+    with pytest.raises(UnsupportedGeometryError) as got:
+        Scene.from_model(model)
+    assert str(got.value) == str(want.value)
+
+
+@pytest.mark.parametrize("seed", RANDOM_SEEDS[:4])
+def test_from_model_pairs_are_in_strict_order(seed):
+    """Scene.from_model trusts its own pair arrays to be in strict (a, b) order (the sweep's binary
+    search needs it): every policy it builds is, checked row by row (explicit lists given shuffled and
+    reversed, hazards=, allow=, an ACM)."""
+    from _scene_cases import random_mjcf
+
+    model = mujoco.MjModel.from_xml_string(random_mjcf(seed))
+    rng = np.random.default_rng(seed)
+    every = Scene.from_model(model, pairs="all").pair_ids.tolist()
+    explicit = [tuple(every[k][::-1]) for k in rng.permutation(len(every))[:30]]
+    scenes = [Scene.from_model(model, pairs=p) for p in ("all", "mujoco", explicit)]
+    acm = [(scenes[0].geoms[a].name, scenes[0].geoms[b].name) for a, b in every[:5]]
+    scenes += [Scene.from_model(model, pairs="all", hazards=["g1*", "w*"], allow=[["g2*", "*"]], allowed=acm)]
+    for scene in scenes:
+        assert _strictly_increasing(scene.pair_ids) and scene._sorted_pairs is scene.pair_ids
+    assert len(scenes[2].pair_ids) == 30 and len(scenes[3].pair_ids) < len(every)

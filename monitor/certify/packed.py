@@ -159,9 +159,60 @@ def _pack_one(s: ConvexShape, name: str) -> tuple:
             np.asarray(s.bounding_center, float), float(s.bounding_radius))
 
 
+_NONE_ENTRY = (np.zeros((0, 3)), np.zeros((0, 2), np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
+               KIND_NONE, 0.0, 0.0, np.inf, 0.0, np.inf, np.zeros(3), np.inf)
+""":func:`_shape_entry` of a geom without a shape."""
+
+
+def _shape_entry(s: ConvexShape | None, name: str) -> tuple:
+    """Everything one geom contributes to a :class:`GeomPack`, from its shape alone.
+
+    (verts, edges, normals, mpts, mw, kind, radius, offset, dpad, approx, rho_max, bcenter, brad);
+    :func:`_pack_one` through the per-content memo (:data:`_MEMO`).
+    """
+    if s is None:
+        return _NONE_ENTRY
+    key = _content_key(s)
+    hit = _MEMO.get(key) if key is not None else None
+    if hit is None:
+        hit = _pack_one(s, name)
+        if key is not None:
+            if len(_MEMO) >= _MEMO_MAX:
+                _MEMO.clear()
+            _MEMO[key] = hit
+    c, mp_, mw_, rho_, bc_, br_ = hit
+    return (c.P, c.E, c.N, mp_, mw_, KIND_HALFSPACE if c.code < 0 else int(c.code), float(c.radius),
+            float(c.offset), float(c.dpad), float(s.approx_error), rho_, bc_, br_)
+
+
+def _gather_rows(parts: list[np.ndarray], width: int, dtype,
+                 which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``parts[which[0]], parts[which[1]], ...`` concatenated, and their (G + 1,) offsets.
+
+    Args:
+        parts: U arrays of rows (``width`` columns).
+        width: columns per row.
+        dtype: output dtype.
+        which: (G,) int64 index into ``parts`` per geom.
+    """
+    counts_u = np.array([len(a.reshape(-1, width)) for a in parts], dtype=np.int64)
+    rows_u = _cat(parts, width, dtype)
+    counts = counts_u[which]
+    start = _starts(counts)
+    ustart = _starts(counts_u)
+    shift = np.repeat(ustart[:-1][which] - start[:-1], counts)
+    rows = rows_u[np.arange(int(start[-1]), dtype=np.int64) + shift]
+    rows = rows.reshape(-1, width) if width > 1 else rows.reshape(-1)
+    return np.ascontiguousarray(rows, dtype=dtype), start
+
+
 def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray,
                 curved: list[tuple | None] | None = None) -> GeomPack:
     """Pack shapes (body frames) with their body ids.
+
+    Each distinct shape object is packed once (:func:`_shape_entry`, first occurrence first, so
+    a bad shape is reported under its first index) and the per-geom arrays are gathered from
+    those entries with numpy: no per-geom numpy work, the same arrays as packing geom by geom.
 
     Args:
         shapes: G shapes; None for a geom without a convex shape.
@@ -176,71 +227,46 @@ def pack_shapes(shapes: list[ConvexShape | None], bodies: list[int] | np.ndarray
     bodies = np.asarray(bodies, dtype=np.int64).reshape(-1)
     if len(bodies) != len(shapes):
         raise InvalidInputError(f"bodies has {len(bodies)} entries, shapes has {len(shapes)}")
-    V, E, N, MP, MW = [], [], [], [], []
-    kind, radius, offset, dpad, approx, rho_max = [], [], [], [], [], []
     G = len(shapes)
     curve = np.zeros(G, np.int64)
     cparam = np.zeros((G, 3))
     cframe = np.tile(np.eye(3), (G, 1, 1))
     ccenter = np.zeros((G, 3))
-    bcenter = np.zeros((G, 3))
-    brad = np.full(G, np.inf)
+    checked: dict[tuple, bool] = {}   # _curved_ok of equal inputs (same shape object, same bytes)
     for i, cv in enumerate(curved or []):
         if cv is None or shapes[i] is None or shapes[i].kind != "polytope":
             continue
         code, par = int(cv[0]), np.asarray(cv[1], float)
         R_BG, c_B = np.asarray(cv[2], float), np.asarray(cv[3], float)
-        if code in (CURVE_CYLINDER, CURVE_ELLIPSOID) and np.isfinite(par).all() and (par[:2] > 0).all() \
-                and _curved_ok(shapes[i], code, par, R_BG, c_B):
-            curve[i], cparam[i], cframe[i], ccenter[i] = code, par, R_BG, c_B
-    for i, s in enumerate(shapes):
-        if s is None:
-            V.append(np.zeros((0, 3)))
-            E.append(np.zeros((0, 2), np.int64))
-            N.append(np.zeros((0, 3)))
-            MP.append(np.zeros((0, 3)))
-            MW.append(np.zeros(0))
-            kind.append(KIND_NONE)
-            radius.append(0.0)
-            offset.append(0.0)
-            dpad.append(np.inf)
-            approx.append(0.0)
-            rho_max.append(np.inf)
-            continue
-        key = _content_key(s)
-        hit = _MEMO.get(key) if key is not None else None
-        if hit is None:
-            hit = _pack_one(s, f"shapes[{i}]")
-            if key is not None:
-                if len(_MEMO) >= _MEMO_MAX:
-                    _MEMO.clear()
-                _MEMO[key] = hit
-        c, mp_, mw_, rho_, bc_, br_ = hit
-        bcenter[i] = bc_
-        brad[i] = br_
-        V.append(c.P)
-        E.append(c.E)
-        N.append(c.N)
-        kind.append(KIND_HALFSPACE if c.code < 0 else int(c.code))
-        radius.append(float(c.radius))
-        offset.append(float(c.offset))
-        dpad.append(float(c.dpad))
-        approx.append(float(s.approx_error))
-        MP.append(mp_)
-        MW.append(mw_)
-        rho_max.append(rho_)
+        if code in (CURVE_CYLINDER, CURVE_ELLIPSOID) and np.isfinite(par).all() and (par[:2] > 0).all():
+            key = (id(shapes[i]), code, par.tobytes(), R_BG.tobytes(), c_B.tobytes())
+            if key not in checked:
+                checked[key] = _curved_ok(shapes[i], code, par, R_BG, c_B)
+            if checked[key]:
+                curve[i], cparam[i], cframe[i], ccenter[i] = code, par, R_BG, c_B
+    first: dict[int, int] = {}   # id(shape) -> its distinct index (``shapes`` keeps the objects alive)
+    which = np.array([first.setdefault(id(s), len(first)) for s in shapes], dtype=np.int64)
+    at = np.unique(which, return_index=True)[1]   # first geom of each distinct shape, in geom order
+    entries = [_shape_entry(shapes[i], f"shapes[{i}]") for i in at.tolist()]
+    cols = list(zip(*entries)) if entries else [[]] * 13
+    verts, vstart = _gather_rows(list(cols[0]), 3, np.float64, which)
+    edges, estart = _gather_rows(list(cols[1]), 2, np.int64, which)
+    normals, nstart = _gather_rows(list(cols[2]), 3, np.float64, which)
+    mpts, mstart = _gather_rows(list(cols[3]), 3, np.float64, which)
+    mw, _ = _gather_rows(list(cols[4]), 1, np.float64, which)
+
+    def per_geom(k: int, dtype) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(cols[k], dtype=dtype).reshape(-1)[which])
+
     return GeomPack(
-        verts=_cat(V, 3, np.float64), vstart=_starts([len(v) for v in V]),
-        edges=_cat(E, 2, np.int64), estart=_starts([len(e) for e in E]),
-        normals=_cat(N, 3, np.float64), nstart=_starts([len(n) for n in N]),
-        kind=np.asarray(kind, np.int64), radius=np.asarray(radius, np.float64),
-        offset=np.asarray(offset, np.float64), dpad=np.asarray(dpad, np.float64),
-        approx=np.asarray(approx, np.float64), body=np.ascontiguousarray(bodies),
-        mpts=_cat(MP, 3, np.float64), mw=np.ascontiguousarray(np.concatenate(MW) if MW else np.zeros(0)),
-        mstart=_starts([len(m) for m in MP]), rho_max=np.asarray(rho_max, np.float64),
+        verts=verts, vstart=vstart, edges=edges, estart=estart, normals=normals, nstart=nstart,
+        kind=per_geom(5, np.int64), radius=per_geom(6, np.float64), offset=per_geom(7, np.float64),
+        dpad=per_geom(8, np.float64), approx=per_geom(9, np.float64), body=np.ascontiguousarray(bodies),
+        mpts=mpts, mw=mw, mstart=mstart, rho_max=per_geom(10, np.float64),
         curve=curve, cparam=np.ascontiguousarray(cparam), cframe=np.ascontiguousarray(cframe),
-        ccenter=np.ascontiguousarray(ccenter), bcenter=np.ascontiguousarray(bcenter),
-        brad=np.ascontiguousarray(brad))
+        ccenter=np.ascontiguousarray(ccenter),
+        bcenter=np.ascontiguousarray(np.asarray(cols[11], dtype=np.float64).reshape(-1, 3)[which]),
+        brad=per_geom(12, np.float64))
 
 
 class ScenePack(NamedTuple):
@@ -255,14 +281,27 @@ class ScenePack(NamedTuple):
     pair_ids: np.ndarray
 
 
+_LEX_ROWS = 1 << 16
+"""Rows per block of :func:`lex_sorted_pairs` (its temporaries stay small: no fresh pages per call)."""
+
+
 def lex_sorted_pairs(pair_ids: np.ndarray, ngeom: int) -> bool:
-    """True if the (P, 2) int rows are strictly increasing in (a, b) with 0 <= a < b < ngeom (O(P))."""
+    """True if the (P, 2) int rows are strictly increasing in (a, b) with 0 <= a < b < ngeom (O(P)).
+
+    Evaluated on blocks of :data:`_LEX_ROWS` rows, each overlapping the previous block by one row
+    (so every consecutive pair of rows is compared once).
+    """
     pid = np.asarray(pair_ids).reshape(-1, 2)
-    if len(pid) == 0:
-        return True
-    a, b = pid[:, 0].astype(np.int64), pid[:, 1].astype(np.int64)
-    lex = a * max(int(ngeom), 1) + b
-    return bool(a.min() >= 0 and b.max() < ngeom and (a < b).all() and (lex[1:] > lex[:-1]).all())
+    n = max(int(ngeom), 1)
+    for s in range(0, len(pid), _LEX_ROWS):
+        block = pid[max(s - 1, 0):s + _LEX_ROWS]
+        a, b = block[:, 0].astype(np.int64), block[:, 1].astype(np.int64)
+        if not (a.min() >= 0 and b.max() < ngeom and (a < b).all()):
+            return False
+        lex = a * n + b
+        if not (lex[1:] > lex[:-1]).all():
+            return False
+    return True
 
 
 def pack_scene(scene) -> ScenePack:
@@ -271,6 +310,9 @@ def pack_scene(scene) -> ScenePack:
     bodies = [g.body_id for g in scene.geoms]
     pid = np.ascontiguousarray(np.asarray(scene.pair_ids, np.int64).reshape(-1, 2))
     return ScenePack(pack_shapes(shapes, bodies, _curved_geoms(scene)), pid)
+
+
+_CURVE_OF_TYPE = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}
 
 
 def _curved_geoms(scene) -> list:
@@ -291,7 +333,7 @@ def _curved_geoms(scene) -> list:
     derived = bool(getattr(scene, "derived_geoms", False))
     ngeom = len(model.geom_size)
     for g in scene.geoms:
-        code = {"cylinder": CURVE_CYLINDER, "ellipsoid": CURVE_ELLIPSOID}.get(g.type, CURVE_NONE)
+        code = _CURVE_OF_TYPE.get(g.type, CURVE_NONE)
         if (code == CURVE_NONE or g.shape is None or derived or not 0 <= g.id < ngeom or frames is None
                 or len(frames) != ngeom):
             out.append(None)
