@@ -1530,7 +1530,7 @@ class Gate:
     @property
     def npairs(self) -> int:
         """Number of candidate pairs."""
-        return len(self.scene.candidate_pairs)
+        return len(self.scene.pair_ids)
 
     def predict(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int | None = None) -> Any:
         """The plan of the next window under ``ctrl`` (the configured predictor)."""
@@ -1675,7 +1675,7 @@ class Gate:
             return None
         keys = memo[1].get(win.rows[:, 1:].tobytes())
         scene = self.scene
-        if keys is None or len(keys) != len(scene.candidate_pairs):
+        if keys is None or len(keys) != len(scene.pair_ids):
             return None
         cache = self._cache
         reused = {}
@@ -1953,7 +1953,7 @@ class Gate:
             fresh_pairs = []
         results: dict[int, PairResult] = dict(zip(todo, fresh_pairs))
         results.update(reused)
-        pairs = tuple(results[i] for i in range(len(scene.candidate_pairs)))
+        pairs = tuple(results[i] for i in range(len(scene.pair_ids)))
         verdict = combine_verdicts([p.verdict for p in pairs])
         clearance = min((p.clearance for p in pairs), default=math.inf)
         stats = dict(fresh.stats) if fresh is not None else {}

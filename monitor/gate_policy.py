@@ -41,7 +41,7 @@ BLOCK_REASONS = ("proposal_violation", "proposal_uncertain", "brake_tail_uncerti
 def describe_gate(gate: Any) -> str:
     """One line: pairs monitored, allowed pairs per reason, the ongoing-contact rule."""
     scene = gate.scene
-    n = len(scene.candidate_pairs)
+    n = len(scene.pair_ids)
     counts = Counter(r for _a, _b, r in scene.allowed_pairs)
     allowed = ", ".join(f"{counts[r]} {r}" for r in sorted(counts)) or "none"
     mode = gate.pairs if isinstance(gate.pairs, str) else "list"

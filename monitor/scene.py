@@ -810,7 +810,7 @@ class Scene:
 
     def __repr__(self) -> str:
         return (f"Scene(ngeom={len(self.geoms)}, nbody={len(self.body_names)}, "
-                f"pairs={len(self.candidate_pairs)})")
+                f"pairs={len(self.pair_ids)})")
 
 
 def model_hash(model: Any) -> str:
