@@ -917,6 +917,18 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
             continue
         try:
             ro = replay.decode(p.get("rollout"), model)
+        except (MonitorError, ValueError, TypeError) as exc:
+            fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
+            continue
+        logged_rows = len(p["times"]) if isinstance(p.get("times"), list) else None
+        if logged_rows != ro.substeps - ro.rows_from + 1:
+            # before simulating: a forged substep count (up to MAX_SUBSTEPS per plan) would
+            # otherwise cost seconds of mj_step and (substeps, nstate) floats for every plan (red team 11)
+            fail(k, f"the logged rows are not the re-simulation of its logged rollout (start state and "
+                    f"controls) on the logged model: {logged_rows} logged row(s), the rollout makes "
+                    f"{ro.substeps - ro.rows_from + 1} (not re-simulated)")
+            continue
+        try:
             plan, states = replay.resimulate(model, data, ro)
         except (MonitorError, ValueError, TypeError) as exc:
             fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
