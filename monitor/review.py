@@ -930,7 +930,7 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
             continue
         try:
             plan, states = replay.resimulate(model, data, ro)
-        except (MonitorError, ValueError, TypeError) as exc:
+        except (MonitorError, ValueError, TypeError, mujoco.FatalError) as exc:  # (an option MuJoCo refuses)
             fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
             continue
         diff = replay.first_difference(plan, p)
@@ -1088,6 +1088,28 @@ def _pair_key(geoms: Any) -> frozenset:
 _Edit = tuple[int, dict[str, np.ndarray], int | None, dict[str, Any]]
 """A logged model edit: (window index, array field -> new array, disableflags or None, option -> value)."""
 
+_STRUCTURE_SUFFIXES = ("adr", "num", "id", "nnz", "colind", "diag", "signature", "plugin", "type", "history")
+"""Integer ``MjModel`` arrays (indices, addresses, counts, sparsity, object types) that a model edit
+record may not change: MuJoCo and the packed kernels index memory with them unchecked, so a record
+that moved ``jnt_qposadr`` crashed review (a segmentation fault) and one that moved ``body_parentid``
+raised a traceback (red team 11). ``geom_type`` may change among the primitives
+(:data:`_PRIMITIVE_GEOM_TYPES`), as a user's in-place edit can (``tests/test_model_edits.py``)."""
+_PRIMITIVE_GEOM_TYPES = frozenset(range(7)) - {1}
+"""mjtGeom values that need no data (plane, sphere, capsule, ellipsoid, cylinder, box; not hfield, mesh,
+sdf)."""
+
+
+def _structure_problem(name: str, ref: np.ndarray, new: np.ndarray) -> str | None:
+    """Why an edit of the integer array ``name`` from ``ref`` to ``new`` (same shape) is refused, or None."""
+    if ref.dtype.kind not in "iu" or not (name.endswith(_STRUCTURE_SUFFIXES) or name.startswith("map")):
+        return None
+    changed = new != ref
+    if not changed.any():
+        return None
+    if name == "geom_type" and set(new[changed].tolist()) <= _PRIMITIVE_GEOM_TYPES:
+        return None
+    return f"field {name}: changes model structure (an index, address, count or type), not an in-place edit"
+
 
 def _option_problem(model: Any, options: Any) -> tuple[str | None, dict[str, Any]]:
     """(problem or None, checked options) of a model edit record's ``"options"`` (format 3)."""
@@ -1164,6 +1186,9 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
             arrays[name] = arr.reshape(shape).astype(ref.dtype)
             if not np.array_equal(arrays[name], arr.reshape(shape)):
                 problem = f"field {name}: values not representable as {ref.dtype}"
+                break
+            problem = _structure_problem(name, ref, arrays[name])
+            if problem is not None:
                 break
         flags = rec.get("disableflags") if isinstance(rec, dict) else None
         if problem is None and flags is not None and not _is_int(flags):

@@ -6,10 +6,13 @@ Forgeries are made as ``tests/test_review_replay.py`` makes them (``mcap_rewrite
 
 from __future__ import annotations
 
+import mujoco
+import numpy as np
 import pytest
-from test_review_replay import _bounce_log, _edit_plan, _findings, _forge, _verify
+from test_review_replay import BOUNCE, _bounce_log, _edit_plan, _findings, _forge, _verify
 
-from monitor.log import replay
+from monitor.gate import Gate
+from monitor.log import replay, topics
 
 
 @pytest.fixture(scope="module")
@@ -45,3 +48,68 @@ def test_a_forged_substep_count_is_refused_before_it_is_simulated(bounce, tmp_pa
     crit = _findings(ver, "critical")
     assert [k for k, _ in crit] == [1], crit
     assert f"51 logged row(s), the rollout makes {substeps + 1}" in crit[0][1]
+
+
+@pytest.fixture(scope="module")
+def edited(tmp_path_factory):
+    """The bounce run with a genuine in-place edit (the ball's damping) before window 3."""
+    m = mujoco.MjModel.from_xml_string(BOUNCE)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = -0.25, 1.0
+    path = tmp_path_factory.mktemp("rt11") / "edited.mcap"
+    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn") as g:
+        for k in range(5):
+            if k == 3:
+                m.dof_damping[0] = 1e-3
+            g.step(d, np.zeros(1))
+    code, ver = _verify(path, trust_model_edits=True)
+    assert code == 0 and ver["replayed"] == 5, ver["findings"]
+    return path, m
+
+
+def _edit_record(fields=None, options=None):
+    """A forger's rewrite of the log's one model edit record."""
+    def metadata(name, values):
+        if name == topics.METADATA_MODEL_EDIT:
+            assert values["window"] == 3
+            values["fields"].update(fields or {})
+            values.setdefault("options", {}).update(options or {})
+        return values
+    return metadata
+
+
+@pytest.mark.parametrize("field, values", [
+    ("jnt_qposadr", [10**8]),          # 0453413: a segmentation fault in the motion packer
+    ("body_parentid", [0, 0, 10**6]),  # 0453413: IndexError traceback from Scene.from_model
+    ("jnt_dofadr", [-5]),
+    ("geom_type", [7, 6]),             # the wall made a mesh with no mesh data
+])
+def test_a_model_edit_record_that_moves_model_structure_is_malformed(edited, tmp_path, field, values):
+    path, m = edited
+    dst = tmp_path / "structure.mcap"
+    record = {field: {"shape": list(getattr(m, field).shape), "values": values}}
+    _forge(path, dst, metadata=_edit_record(record))
+    code, ver = _verify(dst, trust_model_edits=True)
+    assert code == 2 and not _findings(ver, "critical"), ver["findings"]
+    assert any(f"field {field}: changes model structure" in r for _, r in _findings(ver, "unverifiable"))
+
+
+def test_a_geom_type_edit_among_primitives_is_still_applied(edited, tmp_path):
+    """The legitimate in-place edit (``tests/test_model_edits.py`` makes one): the wall made a sphere."""
+    path, _ = edited
+    dst = tmp_path / "sphere.mcap"
+    _forge(path, dst, metadata=_edit_record({"geom_type": {"shape": [2], "values": [2, 2]}}))
+    code, ver = _verify(dst, trust_model_edits=True)
+    assert not any("changes model structure" in f["reason"] for f in ver["findings"]), ver["findings"]
+    assert ver["replayed"] == 5  # the sphere does not touch the ball's re-simulated path
+
+
+def test_an_option_mujoco_refuses_is_a_finding_not_a_traceback(edited, tmp_path):
+    """``integrator`` 99 in a model edit record: 0453413 let ``mujoco.FatalError`` out of review."""
+    path, _ = edited
+    dst = tmp_path / "integrator.mcap"
+    _forge(path, dst, metadata=_edit_record(options={"integrator": 99}))
+    code, ver = _verify(dst, trust_model_edits=True)
+    crit = _findings(ver, "critical")
+    assert code == 1 and [k for k, _ in crit] == [3, 4], crit
+    assert all("cannot be re-simulated: mj_step: invalid integrator" in r for _, r in crit)
