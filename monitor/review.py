@@ -1088,7 +1088,8 @@ def _pair_key(geoms: Any) -> frozenset:
 _Edit = tuple[int, dict[str, np.ndarray], int | None, dict[str, Any]]
 """A logged model edit: (window index, array field -> new array, disableflags or None, option -> value)."""
 
-_STRUCTURE_SUFFIXES = ("adr", "num", "id", "nnz", "colind", "diag", "signature", "plugin", "type", "history")
+_STRUCTURE_SUFFIXES = ("adr", "num", "id", "nnz", "colind", "diag", "signature", "plugin", "_type", "trntype",
+                       "dyntype", "gaintype", "biastype", "objtype", "reftype", "datatype", "history")
 """Integer ``MjModel`` arrays (indices, addresses, counts, sparsity, object types) that a model edit
 record may not change: MuJoCo and the packed kernels index memory with them unchecked, so a record
 that moved ``jnt_qposadr`` crashed review (a segmentation fault) and one that moved ``body_parentid``
@@ -1101,8 +1102,9 @@ sdf)."""
 
 def _structure_problem(name: str, ref: np.ndarray, new: np.ndarray) -> str | None:
     """Why an edit of the integer array ``name`` from ``ref`` to ``new`` (same shape) is refused, or None."""
-    if ref.dtype.kind not in "iu" or not (name.endswith(_STRUCTURE_SUFFIXES) or name.startswith("map")):
-        return None
+    structure = name.endswith(_STRUCTURE_SUFFIXES) or name.startswith("map") or name.startswith("pair_geom")
+    if ref.dtype.kind not in "iu" or not structure:
+        return None  # (not geom_contype / conaffinity / condim / priority / group, the *limited flags)
     changed = new != ref
     if not changed.any():
         return None
