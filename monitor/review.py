@@ -867,7 +867,13 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
     marked = run.get(topics.ROLLOUTS_KEY) == "logged"
     out = {"replayed": 0, "replay_user": 0, "replay_failed": 0, "continuity_checked": 0}
     if not marked and not any("source" in p for ps in plan_msgs.values() for p in ps):
-        if certs:
+        version = run.get("format_version")
+        if certs and "predictor" in run and _is_int(version) and version >= 3:
+            # a gate that opens its log writes "rollouts: logged" from format 3 on: stripped (red team 11)
+            find(UNVERIFIABLE, f"the log is a gate's of format {version}, which marks its rollouts "
+                               f"(rollouts: logged), but no rollout is marked: the plans' rows are "
+                               f"re-certified but not re-simulated")
+        elif certs:
             notes.append("no rollouts logged (a log before format 3, or not a gate's): the plans' rows are "
                          "re-certified but not re-simulated")
         return out

@@ -117,3 +117,25 @@ def test_an_option_mujoco_refuses_is_a_finding_not_a_traceback(edited, tmp_path)
     crit = _findings(ver, "critical")
     assert code == 1 and [k for k, _ in crit] == [3, 4], crit
     assert all("cannot be re-simulated: mj_step: invalid integrator" in r for _, r in crit)
+
+
+def test_a_format_3_gate_log_stripped_of_its_rollouts_is_unverifiable(bounce, tmp_path):
+    """Every plan's ``rollout`` and ``source`` and the run's ``rollouts`` key removed, ``format_version``
+    left at 3: on 0453413 the old-log note and exit 0 (the forger need not even claim format 2)."""
+    path, _ = bounce
+    dst = tmp_path / "stripped.mcap"
+
+    def strip(topic, o):
+        if topic == topics.PLAN:
+            o.pop("rollout"), o.pop("source")
+        return o
+
+    def unmark(name, values):
+        if name == topics.METADATA_RUN:
+            assert values.pop(topics.ROLLOUTS_KEY) == "logged" and values["format_version"] == 3
+        return values
+
+    _forge(path, dst, msg=strip, metadata=unmark)
+    code, ver = _verify(dst)
+    assert code == 2 and ver["replayed"] == 0 and not _findings(ver, "critical")
+    assert any("which marks its rollouts" in r for _, r in _findings(ver, "unverifiable"))
