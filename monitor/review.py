@@ -868,7 +868,9 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
     out = {"replayed": 0, "replay_user": 0, "replay_failed": 0, "continuity_checked": 0}
     if not marked and not any("source" in p for ps in plan_msgs.values() for p in ps):
         version = run.get("format_version")
-        if certs and "predictor" in run and _is_int(version) and version >= 3:
+        gate_owned = run.get(topics.MODEL_EDITS_KEY) == "logged" and all(
+            key in run for key in ("predictor", "on_violation", "unsafe", "frame_skip"))  # Gate._open_log's
+        if certs and gate_owned and _is_int(version) and version >= 3:
             # a gate that opens its log writes "rollouts: logged" from format 3 on: stripped (red team 11)
             find(UNVERIFIABLE, f"the log is a gate's of format {version}, which marks its rollouts "
                                f"(rollouts: logged), but no rollout is marked: the plans' rows are "
