@@ -139,3 +139,45 @@ def test_a_format_3_gate_log_stripped_of_its_rollouts_is_unverifiable(bounce, tm
     code, ver = _verify(dst)
     assert code == 2 and ver["replayed"] == 0 and not _findings(ver, "critical")
     assert any("which marks its rollouts" in r for _, r in _findings(ver, "unverifiable"))
+
+
+_FREE_BOX = """<mujoco><worldbody>
+  <geom name="wall" type="box" size="0.05 0.5 0.5" pos="0.6 0 0.5"/>
+  <body name="cart" pos="0 0 0.5"><freejoint/><geom name="box" type="box" size="0.1 0.1 0.1"/></body>
+</worldbody></mujoco>"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_fuzz_free_body_quaternion_signs_against_the_closed_form_gap(seed):
+    """A free box that only translates (x, at the wall's height) while its identity orientation is written as
+    q or -q at random per row (the same rotation: slerp takes the shortest arc), so the body may be flagged
+    rotating and take the whole-shape route. Oracle: the gap to the wall's face on the piecewise-linear x,
+    0.55 - (max x + 0.1). No method certifies a touching path or reports a violation on a clear one."""
+    from monitor.certify.engine import certify
+    from monitor.errors import InvalidInputError
+    from monitor.motion.plan import Plan
+    from monitor.scene import Scene
+
+    m = mujoco.MjModel.from_xml_string(_FREE_BOX)
+    scene = Scene.from_model(m, pairs="all", allowed=None)
+    rng = np.random.default_rng(seed)
+    seen = set()
+    for _ in range(40):
+        n = int(rng.integers(2, 6))
+        x = np.sort(rng.uniform(-0.2, 0.5, n)) if rng.random() < 0.5 else rng.uniform(0.2, 0.46, n)
+        q = np.zeros((n, 7))
+        q[:, 0], q[:, 2], q[:, 3] = x, 0.5, rng.choice([-1.0, 1.0], n)
+        gap = 0.55 - (x.max() + 0.1)  # x is linear between rows: its max is at a row
+        verdicts = {}
+        for method in ("auto", "toleranced", "extrusion"):
+            try:
+                verdicts[method] = str(certify(scene, Plan(np.linspace(0, 0.1, n), q, m), margin=0.0,
+                                               epsilon=1e-3, method=method).verdict)
+            except InvalidInputError:   # extrusion refuses a body flagged rotating
+                continue
+            assert not (verdicts[method] == "certified" and gap <= 0), (method, x, q[:, 3])
+            assert not (verdicts[method] == "violation" and gap > 1e-9), (method, x, q[:, 3])
+        seen |= set(verdicts.values())
+        assert len(set(verdicts.values()) - {"uncertain"}) <= 1, verdicts
+    assert {"certified", "violation"} <= seen
