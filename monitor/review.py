@@ -928,6 +928,17 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
         except (MonitorError, ValueError, TypeError) as exc:
             fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
             continue
+        applied = by_index[k].get("applied")
+        tail = isinstance(applied, dict) and applied.get("kind") == "brake_tail"
+        if (ro.rows_from > 0) != tail:
+            # a gate's windows (proposals, fallbacks) start their rows at the logged state, only a braking
+            # tail after its window's substeps: a step window with rows_from > 0 has no logged start state,
+            # and the continuity checks skipped it (red team 11: every window from the forged one on re-made
+            # from fabricated states one substep earlier gave exit 0)
+            fail(k, f"its rollout's rows start at substep {ro.rows_from}, but a gate's "
+                    + ("braking tail starts them after its window's substeps" if tail else
+                       "window starts them at its logged start state (substep 0)"))
+            continue
         logged_rows = len(p["times"]) if isinstance(p.get("times"), list) else None
         if logged_rows != ro.substeps - ro.rows_from + 1:
             # before simulating: a forged substep count (up to MAX_SUBSTEPS per plan) would

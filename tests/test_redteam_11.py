@@ -9,10 +9,19 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from test_review_replay import BOUNCE, _bounce_log, _edit_plan, _findings, _forge, _verify
+from test_review_replay import (
+    BOUNCE,
+    INTEGRATION,
+    _bounce_log,
+    _edit_plan,
+    _findings,
+    _forge,
+    _recertified,
+    _verify,
+)
 
 from monitor.gate import Gate
-from monitor.log import replay, topics
+from monitor.log import read_log, replay, topics
 
 
 @pytest.fixture(scope="module")
@@ -181,3 +190,44 @@ def test_fuzz_free_body_quaternion_signs_against_the_closed_form_gap(seed):
         seen |= set(verdicts.values())
         assert len(set(verdicts.values()) - {"uncertain"}) <= 1, verdicts
     assert {"certified", "violation"} <= seen
+
+
+def test_step_windows_whose_rows_skip_their_logged_start_state_are_critical(bounce, tmp_path):
+    """Windows 2..5 re-made from fabricated states one substep earlier (the ball at rest where the run's
+    window starts: 51 substeps, ``rows_from`` 1, rows re-simulated bit for bit from them, re-certified): on
+    0453413 exit 0 with window 2's violation gone, since a window with ``rows_from > 0`` gave the
+    continuity checks no start state (only 1 of 5 left). A gate's step windows start at substep 0."""
+    path, model = bounce
+    contents = read_log(path)
+    forged = {}
+    for k in range(2, 6):
+        ro = replay.decode(contents.plans_by_index()[k]["rollout"], model)
+        pre = ro.state.copy()
+        pre[0] -= model.opt.timestep
+        pre[1 + model.nq:1 + model.nq + model.nv] = 0.0
+        segments = ((ro.segments[0][0], 51),)
+        plan, _ = replay.resimulate(model, mujoco.MjData(model), replay.Rollout(pre, segments, 1))
+        assert plan.times[0] == ro.state[0]  # the rows start where the run's window starts
+        cert = _recertified(model, k, plan.times, plan.qpos, contents)
+        assert cert["verdict"] == "certified"
+        payload = replay.encode((pre, segments, 1), int(INTEGRATION), pre.size, model.nu)
+        forged[k] = ({"times": plan.times.tolist(), "qpos": plan.qpos.tolist(), "rollout": payload}, cert)
+    assert contents.certificates()[2]["verdict"] == "violation"
+
+    def msg(topic, o):
+        if o.get("index") not in forged:
+            return o
+        rows, cert = forged[o["index"]]
+        if topic == topics.PLAN:
+            return {**o, **rows}
+        if topic == topics.CERTIFICATE:
+            return cert
+        return None if topic in (topics.VIOLATION, topics.LOG) else o
+
+    dst = tmp_path / "rows_from.mcap"
+    _forge(path, dst, msg=msg)
+    code, ver = _verify(dst)
+    assert code == 1
+    crit = _findings(ver, "critical")
+    assert [k for k, _ in crit] == [2, 3, 4, 5], crit
+    assert all("rows start at substep 1" in r for _, r in crit)
