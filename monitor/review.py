@@ -989,6 +989,13 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
                                    f"t = {float(times[-1])!r} s, window {j} starts at t = {t_j!r} s): the "
                                    f"motion in between is not in the log (a window removed, or the state "
                                    f"stepped without the gate)", j)
+            elif rec != i and float(times[0]) <= t_j <= float(times[-1]):
+                # the record spans t_j but has no row there: a gate's rows are the run's substep times (the
+                # same float sums), so its start time was moved and the check would be skipped (red team 11)
+                find(UNVERIFIABLE, f"the applied motion record {rec} that ran in step {i} spans t = {t_j!r} "
+                                   f"s, where window {j} starts, without a row there (its rows are off the "
+                                   f"run's substep times): steps {i} and {j} cannot be checked to continue "
+                                   f"each other", j)
             continue  # (a replaced step's record: the applied-motion checks cover its span)
         out["continuity_checked"] += 1
         end, start = states[int(hit[0])][phys], step_start[j][phys]

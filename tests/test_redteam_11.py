@@ -231,3 +231,35 @@ def test_step_windows_whose_rows_skip_their_logged_start_state_are_critical(boun
     crit = _findings(ver, "critical")
     assert [k for k, _ in crit] == [2, 3, 4, 5], crit
     assert all("rows start at substep 1" in r for _, r in crit)
+
+
+def test_a_braking_tail_moved_off_the_substep_times_does_not_skip_the_continuity_checks(tmp_path):
+    """SafetyGate(monitor/Arm-v0) run with blocked steps: the first braking-tail record's start time moved by
+    5e-13 s (below the applied-motion checks' 1e-12 s slack), its rows re-simulated from it (bit for bit).
+    Its rows then miss the next steps' start times, and on 0453413 the continuity of the steps it ran was
+    skipped without a word (exit 0; a forger can then also edit what the tail's state holds beyond qpos)."""
+    from test_review_applied import _arm_run
+
+    from monitor.log.reader import load_model
+
+    path = tmp_path / "arm.mcap"
+    _arm_run(path, steps=12)
+    contents = read_log(path)
+    model, _ = load_model(contents, "mjb")
+    tails = [c["index"] for c in contents.certificates()
+             if (c.get("applied") or {}).get("kind") == "brake_tail"]
+    assert tails
+    k = tails[0]
+    p = contents.plans_by_index()[k]
+    ro = replay.decode(p["rollout"], model)
+    state = ro.state.copy()
+    state[0] += 5e-13
+    plan, _ = replay.resimulate(model, mujoco.MjData(model), replay.Rollout(state, ro.segments, ro.rows_from))
+    assert np.array_equal(plan.qpos, np.asarray(p["qpos"])) and not np.array_equal(plan.times, p["times"])
+    payload = replay.encode((state, ro.segments, ro.rows_from), int(INTEGRATION), state.size, model.nu)
+    dst = tmp_path / "shifted.mcap"
+    _forge(path, dst, msg=_edit_plan(k, lambda o: o.update(times=plan.times.tolist(), rollout=payload)))
+    code, ver = _verify(dst)
+    assert code == 2 and not _findings(ver, "critical"), ver["findings"]
+    off = [r for _, r in _findings(ver, "unverifiable") if f"applied motion record {k} that ran in step" in r]
+    assert off and all("without a row there" in r for r in off)
