@@ -935,9 +935,11 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
             # tail after its window's substeps: a step window with rows_from > 0 has no logged start state,
             # and the continuity checks skipped it (red team 11: every window from the forged one on re-made
             # from fabricated states one substep earlier gave exit 0)
-            fail(k, f"its rollout's rows start at substep {ro.rows_from}, but a gate's "
-                    + ("braking tail starts them after its window's substeps" if tail else
-                       "window starts them at its logged start state (substep 0)"))
+            out["replay_failed"] += 1  # unverifiable, like a gap: no claim failed, the record fits no run
+            find(UNVERIFIABLE, f"its rollout's rows start at substep {ro.rows_from}, but a gate's "
+                 + ("braking tail starts them after its window's substeps" if tail else
+                    "window starts them at its logged start state (substep 0): its continuity with the "
+                    "steps around it cannot be checked"), k)
             continue
         logged_rows = len(p["times"]) if isinstance(p.get("times"), list) else None
         if logged_rows != ro.substeps - ro.rows_from + 1:
