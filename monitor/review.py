@@ -867,7 +867,15 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
     marked = run.get(topics.ROLLOUTS_KEY) == "logged"
     out = {"replayed": 0, "replay_user": 0, "replay_failed": 0, "continuity_checked": 0}
     if not marked and not any("source" in p for ps in plan_msgs.values() for p in ps):
-        if certs:
+        version = run.get("format_version")
+        gate_owned = run.get(topics.MODEL_EDITS_KEY) == "logged" and all(
+            key in run for key in ("predictor", "on_violation", "unsafe", "frame_skip"))  # Gate._open_log's
+        if certs and gate_owned and _is_int(version) and version >= 3:
+            # a gate that opens its log writes "rollouts: logged" from format 3 on: stripped (red team 11)
+            find(UNVERIFIABLE, f"the log is a gate's of format {version}, which marks its rollouts "
+                               f"(rollouts: logged), but no rollout is marked: the plans' rows are "
+                               f"re-certified but not re-simulated")
+        elif certs:
             notes.append("no rollouts logged (a log before format 3, or not a gate's): the plans' rows are "
                          "re-certified but not re-simulated")
         return out
@@ -917,8 +925,33 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
             continue
         try:
             ro = replay.decode(p.get("rollout"), model)
-            plan, states = replay.resimulate(model, data, ro)
         except (MonitorError, ValueError, TypeError) as exc:
+            fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
+            continue
+        applied = by_index[k].get("applied")
+        tail = isinstance(applied, dict) and applied.get("kind") == "brake_tail"
+        if (ro.rows_from > 0) != tail:
+            # a gate's windows (proposals, fallbacks) start their rows at the logged state, only a braking
+            # tail after its window's substeps: a step window with rows_from > 0 has no logged start state,
+            # and the continuity checks skipped it (red team 11: every window from the forged one on re-made
+            # from fabricated states one substep earlier gave exit 0)
+            out["replay_failed"] += 1  # unverifiable, like a gap: no claim failed, the record fits no run
+            find(UNVERIFIABLE, f"its rollout's rows start at substep {ro.rows_from}, but a gate's "
+                 + ("braking tail starts them after its window's substeps" if tail else
+                    "window starts them at its logged start state (substep 0): its continuity with the "
+                    "steps around it cannot be checked"), k)
+            continue
+        logged_rows = len(p["times"]) if isinstance(p.get("times"), list) else None
+        if logged_rows != ro.substeps - ro.rows_from + 1:
+            # before simulating: a forged substep count (up to MAX_SUBSTEPS per plan) would
+            # otherwise cost seconds of mj_step and (substeps, nstate) floats for every plan (red team 11)
+            fail(k, f"the logged rows are not the re-simulation of its logged rollout (start state and "
+                    f"controls) on the logged model: {logged_rows} logged row(s), the rollout makes "
+                    f"{ro.substeps - ro.rows_from + 1} (not re-simulated)")
+            continue
+        try:
+            plan, states = replay.resimulate(model, data, ro)
+        except (MonitorError, ValueError, TypeError, mujoco.FatalError) as exc:  # (an option MuJoCo refuses)
             fail(k, f"its logged rollout cannot be re-simulated: {str(exc)[:200]}")
             continue
         diff = replay.first_difference(plan, p)
@@ -958,6 +991,13 @@ def _replay_findings(contents: LogContents, certs: list[dict[str, Any]],
                                    f"t = {float(times[-1])!r} s, window {j} starts at t = {t_j!r} s): the "
                                    f"motion in between is not in the log (a window removed, or the state "
                                    f"stepped without the gate)", j)
+            elif rec != i and float(times[0]) <= t_j <= float(times[-1]):
+                # the record spans t_j but has no row there: a gate's rows are the run's substep times (the
+                # same float sums), so its start time was moved and the check would be skipped (red team 11)
+                find(UNVERIFIABLE, f"the applied motion record {rec} that ran in step {i} spans t = {t_j!r} "
+                                   f"s, where window {j} starts, without a row there (its rows are off the "
+                                   f"run's substep times): steps {i} and {j} cannot be checked to continue "
+                                   f"each other", j)
             continue  # (a replaced step's record: the applied-motion checks cover its span)
         out["continuity_checked"] += 1
         end, start = states[int(hit[0])][phys], step_start[j][phys]
@@ -1076,6 +1116,30 @@ def _pair_key(geoms: Any) -> frozenset:
 _Edit = tuple[int, dict[str, np.ndarray], int | None, dict[str, Any]]
 """A logged model edit: (window index, array field -> new array, disableflags or None, option -> value)."""
 
+_STRUCTURE_SUFFIXES = ("adr", "num", "id", "nnz", "colind", "diag", "signature", "plugin", "_type", "trntype",
+                       "dyntype", "gaintype", "biastype", "objtype", "reftype", "datatype", "history")
+"""Integer ``MjModel`` arrays (indices, addresses, counts, sparsity, object types) that a model edit
+record may not change: MuJoCo and the packed kernels index memory with them unchecked, so a record
+that moved ``jnt_qposadr`` crashed review (a segmentation fault) and one that moved ``body_parentid``
+raised a traceback (red team 11). ``geom_type`` may change among the primitives
+(:data:`_PRIMITIVE_GEOM_TYPES`), as a user's in-place edit can (``tests/test_model_edits.py``)."""
+_PRIMITIVE_GEOM_TYPES = frozenset(range(7)) - {1}
+"""mjtGeom values that need no data (plane, sphere, capsule, ellipsoid, cylinder, box; not hfield, mesh,
+sdf)."""
+
+
+def _structure_problem(name: str, ref: np.ndarray, new: np.ndarray) -> str | None:
+    """Why an edit of the integer array ``name`` from ``ref`` to ``new`` (same shape) is refused, or None."""
+    structure = name.endswith(_STRUCTURE_SUFFIXES) or name.startswith("map") or name.startswith("pair_geom")
+    if ref.dtype.kind not in "iu" or not structure:
+        return None  # (not geom_contype / conaffinity / condim / priority / group, the *limited flags)
+    changed = new != ref
+    if not changed.any():
+        return None
+    if name == "geom_type" and set(new[changed].tolist()) <= _PRIMITIVE_GEOM_TYPES:
+        return None
+    return f"field {name}: changes model structure (an index, address, count or type), not an in-place edit"
+
 
 def _option_problem(model: Any, options: Any) -> tuple[str | None, dict[str, Any]]:
     """(problem or None, checked options) of a model edit record's ``"options"`` (format 3)."""
@@ -1152,6 +1216,9 @@ def _model_edits(contents: LogContents, model: Any, find: Callable[..., None], n
             arrays[name] = arr.reshape(shape).astype(ref.dtype)
             if not np.array_equal(arrays[name], arr.reshape(shape)):
                 problem = f"field {name}: values not representable as {ref.dtype}"
+                break
+            problem = _structure_problem(name, ref, arrays[name])
+            if problem is not None:
                 break
         flags = rec.get("disableflags") if isinstance(rec, dict) else None
         if problem is None and flags is not None and not _is_int(flags):
