@@ -558,10 +558,6 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     return cert
 
 
-
-_FAST_CHUNK = 4
-"""Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
-
 SWEEP_MIN_GEOMS = 400
 """Geoms from which stage 0 of the window kernel sweeps (sort-and-sweep on the swept boxes) instead of
 visiting every selected pair: on the scaling scenes the sweep wins from ~60 geoms when sparse, from
@@ -950,8 +946,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     One compiled call culls every selected pair (static-static, swept spheres), tests the
     survivors' start poses and runs the whole-shape stage on the pairs of the toleranced
     route (``method="toleranced"``, or ``"auto"`` for pairs that do not both translate);
-    further compiled calls of ``_FAST_CHUNK`` survivors each follow when there are more
-    (the budget is checked between calls). Pairs the kernel leaves open (whole-shape
+    further compiled calls follow when one stopped after ``kernels.CALL_TESTS`` whole-shape
+    tests (under a test budget: one survivor per call; the budget is checked between calls:
+    numba has no clock). Pairs the kernel leaves open (whole-shape
     unresolved, the extrusion route, static pairs not proven clear, unsupported kinds) go
     through the Python stages 3-5 exactly as in :func:`_certify`. Results stay arrays;
     ``cert.pairs`` is built on first read (:class:`_WindowPairs`).
@@ -974,26 +971,20 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     sr = np.empty((_NSUB, G))
     info = np.zeros(KS.WI_SIZE)
     none = _NONE
-    chunk = 1 if bud.tests is not None else _FAST_CHUNK
+    # without a test budget, each call stops by itself after kernels.CALL_TESTS whole-shape tests
+    chunk = 1 if bud.tests is not None else P
     first = chunk if route_all else 0
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, rows, info))
-    done_to = min(first, S)
+    done_to = int(info[KS.WI_DONE])
     charged = info.item(KS.WI_TESTS)
     if charged:
         bud.charge(int(charged))
     if S == 0:   # every selected pair culled (the gate's common window): nothing for the stages below
         return _all_culled(sel, pid, code, gap, surv, res, info, scene.geoms, t0, t1, margin, epsilon, method,
                            bud, wall0, allowed, sc, sr, KS)
-    if route_all and done_to == S:
-        # every survivor went through the whole-shape stage in this one call: when the kernel
-        # decided them all, the certificate is the general tail's (see _kernel_decided)
-        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
-                               method, bud, wall0, allowed, sc, sr, KS)
-        if cert is not None:
-            return cert
     route = none if route_all else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
     if narrow and not route_all and S:   # "auto": both bodies translating -> extrusion route
@@ -1030,7 +1021,14 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                        sc, sr, rows, info)
         bud.charge(int(info[KS.WI_TESTS] - charged))
         charged = info[KS.WI_TESTS]
-        done_to = k1
+        done_to = int(info[KS.WI_DONE])
+    if route_all and done_to == S:
+        # every survivor went through the whole-shape stage in these calls: when the kernel
+        # decided them all, the certificate is the general tail's (see _kernel_decided)
+        cert = _kernel_decided(sel, pid, code, gap, surv, res, info, S, scene.geoms, t0, t1, margin, epsilon,
+                               method, bud, wall0, allowed, sc, sr, KS)
+        if cert is not None:
+            return cert
     if done_to < S and stopped:
         # budget spent: the rest get their start-pose test only (the Python pipeline tests every
         # start pose before any checker runs; start tests are not charged), then go on to the

@@ -539,7 +539,8 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
     mva, mvb = mp.body_moving[ba] != 0, mp.body_moving[bb] != 0
     if mva or mvb:
-        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws)
+        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws,
+                                            1)
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
     hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
@@ -671,6 +672,17 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 stack, res):
     """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
 
+    :func:`_pair_search` with its scratch allocated for this call (arguments and result there).
+    """
+    return _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
+                        stack, res, pair_workspace(mp), np.empty(mp.times.shape[0]))
+
+
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
+                 stack, res, pws, cum):
+    """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
+
     Args:
         gp: :class:`monitor.certify.packed.GeomPack`.
         mp: :class:`monitor.motion.pack.MotionPack` (poses and bounds: :mod:`monitor.motion.kernel`).
@@ -692,6 +704,10 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             witness time / point / upper bound,
             clearance lower bound, tests, max depth, unresolved count, first unresolved
             time, paper-ball wins, and the resumable state.
+        pws: :func:`monitor.motion.kernel.pair_workspace` scratch (contents on entry do not
+            matter), so that :func:`window_kernel` allocates it once for all its pairs.
+        cum: (K,) scratch for the step control's motion profile (:func:`_path_profile`),
+            filled on its first use in this call only (most searches never retry a prefix).
 
     Returns:
         The verdict code (also in ``res[R_VERDICT]``).
@@ -706,11 +722,8 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
-    pws = pair_workspace(mp)
     times = mp.times
-    cum = np.empty(times.shape[0])      # step control only (see _path_profile)
-    _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum, mp.jnt_type, mp.jnt_qposadr,
-                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
+    cum_ready = False                   # cum: step control only (see _path_profile), filled when first read
     approx = gp.approx[ga] + gp.approx[gb]
     levers = np.zeros(2)
     # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
@@ -911,6 +924,11 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 prof = False
                 Aa, ratio = 0.0, np.nan
                 if ia < times.shape[0] and times[ia] < b:
+                    if not cum_ready:
+                        _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum,
+                                      mp.jnt_type, mp.jnt_qposadr, mp.jnt_track, mp.qpos, mp.qt_phi,
+                                      gp.body[ga], gp.body[gb], cum)
+                        cum_ready = True
                     Aa = _profile_at(times, cum, a)
                     Ab = _profile_at(times, cum, b)
                     ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
@@ -995,10 +1013,14 @@ WK_UNRES = 9
 WP_T0, WP_T1, WP_MARGIN, WP_EPS, WP_REL, WP_ABS, WP_SCALE_PAD, WP_MAX_DEPTH, WP_MAX_TESTS = range(9)
 WP_SIZE = 9
 """Layout of the float parameter vector of :func:`window_kernel`."""
-WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH = range(5)
-WI_SIZE = 5
+WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH, WI_DONE = range(6)
+WI_SIZE = 6
 """Layout of the info vector of :func:`window_kernel`: sphere-gap pad (m), smallest culled gap
-computed (m), tests spent, survivors, deepest level."""
+computed (m), tests spent, survivors, deepest level, end of the survivor slots processed."""
+CALL_TESTS = 64
+"""Whole-shape tests after which one stage-1 :func:`window_kernel` call stops (after the pair
+that reached them; ``info[WI_DONE]`` says where), so the engine checks its budget clock at least
+every CALL_TESTS tests plus one pair's search, however many survivor slots it asked for."""
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -1275,7 +1297,10 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             lexicographically, a < b per row): stage 0 then visits only the pairs a
             sort-and-sweep of the boxes produces (see "Sweep" below); ``code`` must come zeroed
             (``WK_UNVISITED`` marks the rest).
-        info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth.
+        info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth, and ``WI_DONE``: the
+            end of the survivor slots this call processed (``k1``, or less when the whole-shape
+            searches of this call spent :data:`CALL_TESTS` tests first: the caller continues
+            from there; start-pose tests do not count).
 
     Broad phase (stage 0, O(G T + P)): per geom the swept spheres and their AABB (one
     ``tree_bounds`` per sub-interval for all bodies). Per pair: static-static -> ``WK_SS``;
@@ -1326,7 +1351,8 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     ``ta_f`` is clear.
 
     Returns:
-        S (stage 0) or the number of survivor slots processed (stage 1).
+        S (stage 0) or the number of survivor slots processed (stage 1); ``info[WI_DONE]`` is
+        the end of the slots processed in both cases.
     """
     # (one function body, no helper taking the packs: each function typed on the two packs
     # costs about a second of cold compile)
@@ -1551,93 +1577,117 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             k0 = 0
             k1 = min(k1, S)
     # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
-    stack = np.empty((max_depth + 2, 3))
-    out = np.empty(OUT_SIZE)
-    w = np.empty(3)
-    pA = np.empty(3)
-    pB = np.empty(3)
-    RA = np.empty((3, 3))
-    RB = np.empty((3, 3))
-    for s in range(k0, k1):
-        k = surv[s]
-        if code[k] != WK_OPEN:
-            continue
-        ga, gb = pairs[k, 0], pairs[k, 1]
-        ba, bb = gp.body[ga], gp.body[gb]
-        row = res[s]
-        for j in range(R_SIZE):
-            row[j] = 0.0
-        row[R_WTIME] = np.nan
-        row[R_FIRST_UNRES] = np.nan
-        body_pose(mp, ba, t0, pA, RA)
-        body_pose(mp, bb, t0, pB, RB)
-        lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
-        info[WI_TESTS] += 1.0
-        row[R_START_LO] = lo_d
-        approx = gp.approx[ga] + gp.approx[gb]
-        if up_d + approx < margin:
-            code[k] = WK_STATIC_VIOL
-            row[R_VERDICT] = VIOLATION
-            row[R_WTIME] = t0
+    done = k1
+    if k1 > k0:   # (nothing allocated for a window every pair of which was culled)
+        call_tests = 0.0               # whole-shape tests of this call (see CALL_TESTS)
+        stack = np.empty((max_depth + 2, 3))
+        pws = pair_workspace(mp)           # the searches' scratch, once per call (see _pair_search)
+        cum = np.empty(mp.times.shape[0])
+        out = np.empty(OUT_SIZE)
+        w = np.empty(3)
+        pA = np.empty(3)
+        pB = np.empty(3)
+        RA = np.empty((3, 3))
+        RB = np.empty((3, 3))
+        nbody = mp.body_parent.shape[0]
+        have0 = np.zeros(nbody, np.int64)      # body poses at t0 computed in this call (pos0, rot0)
+        pos0 = np.empty((nbody, 3))
+        rot0 = np.empty((nbody, 3, 3))
+        for s in range(k0, k1):
+            k = surv[s]
+            if code[k] != WK_OPEN:
+                continue
+            ga, gb = pairs[k, 0], pairs[k, 1]
+            ba, bb = gp.body[ga], gp.body[gb]
+            row = res[s]
+            for j in range(R_SIZE):
+                row[j] = 0.0
+            row[R_WTIME] = np.nan
+            row[R_FIRST_UNRES] = np.nan
+            # start poses, each body's computed once per call (body_pose's numbers: a body's
+            # FK reads only its own ancestors, so the pose does not depend on the pair)
+            for b in (ba, bb):
+                if have0[b] == 0:
+                    body_pose(mp, b, t0, pos0[b], rot0[b])
+                    have0[b] = 1
             for r in range(3):
-                row[R_WPOINT + r] = w[r]
-            row[R_WUPPER] = up_d + approx
-            row[R_CLEAR] = -np.inf
-            continue
-        if moving[ba] == 0 and moving[bb] == 0:
-            if lo_d > margin:
-                code[k] = WK_STATIC_CERT
-                row[R_VERDICT] = CERTIFIED
-                row[R_CLEAR] = lo_d
-            else:
-                code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
-            continue
-        if route.shape[0] > 0 and route[s] == 0:
-            continue                   # extrusion route: the Python pipeline
-        row[R_STARTED] = 2.0
-        # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
-        # windows): only the span from the first to the last sub-range where they are not goes
-        # to the narrow phase (see the docstring: "Stage 1").
-        ta_s, tb_s, sph = t0, t1, np.inf
-        if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
-            T = sc.shape[0]
-            step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
-            jf, jl = -1, -1
-            gaps = np.empty(T)
-            for t in range(T):
-                d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
-                            sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
-                gaps[t] = d
-                if not (d > margin and d < np.inf):
-                    if jf < 0:
-                        jf = t
-                    jl = t
-            if jf >= 0:
-                ta_s = t0 if jf == 0 else jf * step + t0
-                tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                pA[r] = pos0[ba, r]
+                pB[r] = pos0[bb, r]
+                for c in range(3):
+                    RA[r, c] = rot0[ba, r, c]
+                    RB[r, c] = rot0[bb, r, c]
+            lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+            info[WI_TESTS] += 1.0
+            row[R_START_LO] = lo_d
+            approx = gp.approx[ga] + gp.approx[gb]
+            if up_d + approx < margin:
+                code[k] = WK_STATIC_VIOL
+                row[R_VERDICT] = VIOLATION
+                row[R_WTIME] = t0
+                for r in range(3):
+                    row[R_WPOINT + r] = w[r]
+                row[R_WUPPER] = up_d + approx
+                row[R_CLEAR] = -np.inf
+                continue
+            if moving[ba] == 0 and moving[bb] == 0:
+                if lo_d > margin:
+                    code[k] = WK_STATIC_CERT
+                    row[R_VERDICT] = CERTIFIED
+                    row[R_CLEAR] = lo_d
+                else:
+                    code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
+                continue
+            if route.shape[0] > 0 and route[s] == 0:
+                continue                   # extrusion route: the Python pipeline
+            row[R_STARTED] = 2.0
+            # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
+            # windows): only the span from the first to the last sub-range where they are not goes
+            # to the narrow phase (see the docstring: "Stage 1").
+            ta_s, tb_s, sph = t0, t1, np.inf
+            if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
+                T = sc.shape[0]
+                step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
+                jf, jl = -1, -1
+                gaps = np.empty(T)
                 for t in range(T):
-                    if (t < jf or t > jl) and gaps[t] < sph:
-                        sph = gaps[t]
-        v = pair_window(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
-                        rel_pad, abs_pad, stack, row)
-        if v == CERTIFIED and sph < row[R_CLEAR]:
-            row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
-        info[WI_TESTS] += row[R_TESTS]
-        row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
-        if row[R_DEPTH] > info[WI_DEPTH]:
-            info[WI_DEPTH] = row[R_DEPTH]
-        if v == CERTIFIED:
-            code[k] = WK_CERT
-        elif v == VIOLATION:
-            code[k] = WK_VIOL
-            fu = row[R_FIRST_UNRES]
-            if not (fu <= row[R_WTIME]):
-                row[R_FIRST_UNRES] = row[R_WTIME]
-        else:
-            code[k] = WK_UNRES
+                    d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
+                                sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
+                    gaps[t] = d
+                    if not (d > margin and d < np.inf):
+                        if jf < 0:
+                            jf = t
+                        jl = t
+                if jf >= 0:
+                    ta_s = t0 if jf == 0 else jf * step + t0
+                    tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                    for t in range(T):
+                        if (t < jf or t > jl) and gaps[t] < sph:
+                            sph = gaps[t]
+            v = _pair_search(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests,
+                             MODE_CERTIFY_ONLY, rel_pad, abs_pad, stack, row, pws, cum)
+            if v == CERTIFIED and sph < row[R_CLEAR]:
+                row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
+            info[WI_TESTS] += row[R_TESTS]
+            call_tests += row[R_TESTS]
+            row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
+            if row[R_DEPTH] > info[WI_DEPTH]:
+                info[WI_DEPTH] = row[R_DEPTH]
+            if v == CERTIFIED:
+                code[k] = WK_CERT
+            elif v == VIOLATION:
+                code[k] = WK_VIOL
+                fu = row[R_FIRST_UNRES]
+                if not (fu <= row[R_WTIME]):
+                    row[R_FIRST_UNRES] = row[R_WTIME]
+            else:
+                code[k] = WK_UNRES
+            if call_tests >= CALL_TESTS and s + 1 < k1:
+                done = s + 1               # the budget clock is the caller's: it continues from here
+                break
+    info[WI_DONE] = done
     if stage == 0:
         return S
-    return k1 - k0
+    return done - k0
 
 
 def new_result() -> np.ndarray:
