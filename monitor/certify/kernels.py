@@ -675,12 +675,30 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
     :func:`_pair_search` with its scratch allocated for this call (arguments and result there).
     """
     return _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
-                        stack, res, pair_workspace(mp), np.empty(mp.times.shape[0]))
+                        stack, res, _search_workspace(gp, mp))
+
+
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def _search_workspace(gp, mp):
+    """Scratch of :func:`_pair_search` for any pair of ``gp`` under ``mp`` (a tuple; see there).
+
+    (pws, cum, out, w, pA, pB, RA, RB, stats, levers, W4, IA, IB, lam, v, vn, X, VA, VB, dref):
+    :func:`monitor.motion.kernel.pair_workspace`, (K,) profile, the posed-distance and GJK work
+    arrays, and VA, VB (n, 3), dref (4, n) with n the largest vertex / mass-point count of a geom
+    (each search takes the leading rows of its geoms' sizes: the same shapes as its own arrays).
+    """
+    n = 1
+    for g in range(gp.kind.shape[0]):
+        n = max(n, gp.vstart[g + 1] - gp.vstart[g], gp.mstart[g + 1] - gp.mstart[g])
+    return (pair_workspace(mp), np.empty(mp.times.shape[0]), np.empty(OUT_SIZE), np.empty(3), np.empty(3),
+            np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.zeros(1), np.zeros(2), np.zeros((4, 3)),
+            np.zeros(4, np.int64), np.zeros(4, np.int64), np.zeros(4), np.empty(3), np.empty(3),
+            np.empty((5, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((4, n)))
 
 
 @njit(cache=True, no_cfunc_wrapper=True, inline="always")
 def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
-                 stack, res, pws, cum):
+                 stack, res, sw):
     """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
 
     Args:
@@ -704,35 +722,37 @@ def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, 
             witness time / point / upper bound,
             clearance lower bound, tests, max depth, unresolved count, first unresolved
             time, paper-ball wins, and the resumable state.
-        pws: :func:`monitor.motion.kernel.pair_workspace` scratch (contents on entry do not
-            matter), so that :func:`window_kernel` allocates it once for all its pairs.
-        cum: (K,) scratch for the step control's motion profile (:func:`_path_profile`),
+        sw: :func:`_search_workspace` (contents on entry do not matter: what must start at
+            zero is zeroed here), so that :func:`window_kernel` allocates it once for all its
+            pairs. Its (K,) profile array for the step control (:func:`_path_profile`) is
             filled on its first use in this call only (most searches never retry a prefix).
 
     Returns:
         The verdict code (also in ``res[R_VERDICT]``).
     """
-    out = np.empty(OUT_SIZE)
-    w = np.empty(3)
-    pA = np.empty(3)
-    pB = np.empty(3)
-    RA = np.empty((3, 3))
-    RB = np.empty((3, 3))
-    stats = np.zeros(1)
+    pws, cum, out, w, pA, pB, RA, RB, stats, levers, W4, IA, IB, lam, v, vn, X, VAbuf, VBbuf, dbuf = sw
+    stats[0] = 0.0
+    levers[0] = 0.0
+    levers[1] = 0.0
+    for i in range(4):                 # (the GJK work arrays start at zero, as fresh np.zeros)
+        IA[i] = 0
+        IB[i] = 0
+        lam[i] = 0.0
+        for r in range(3):
+            W4[i, r] = 0.0
     if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
     times = mp.times
     cum_ready = False                   # cum: step control only (see _path_profile), filled when first read
     approx = gp.approx[ga] + gp.approx[gb]
-    levers = np.zeros(2)
     # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
     refA, refB = mp.ref_points[gp.body[ga]], mp.ref_points[gp.body[gb]]
     PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
     PmA = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
     PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
     PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
-    dref = (np.empty(PvA.shape[0]), np.empty(PmA.shape[0]), np.empty(PvB.shape[0]), np.empty(PmB.shape[0]))
+    dref = (dbuf[0, :PvA.shape[0]], dbuf[1, :PmA.shape[0]], dbuf[2, :PvB.shape[0]], dbuf[3, :PmB.shape[0]])
     lv_a = _lever(PvA, refA, dref[0])
     _lever(PmA, refA, dref[1])
     lv_b = _lever(PvB, refB, dref[2])
@@ -743,15 +763,9 @@ def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, 
         levers[1] = lv_b
     lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
     rsum = gp.radius[ga] + gp.radius[gb]
-    VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
-    VB = np.empty((max(gp.vstart[gb + 1] - gp.vstart[gb], 1), 3))
-    W4 = np.zeros((4, 3))
-    IA = np.zeros(4, np.int64)
-    IB = np.zeros(4, np.int64)
-    lam = np.zeros(4)
-    v = np.empty(3)
-    vn = np.empty(3)
-    X = np.empty((5, 3))           # row 4: separated_beyond's resumable state
+    VA = VAbuf[:max(gp.vstart[ga + 1] - gp.vstart[ga], 1)]
+    VB = VBbuf[:max(gp.vstart[gb + 1] - gp.vstart[gb], 1)]
+    # X: row 4 is separated_beyond's resumable state
     spent = 0
     sp = int(res[R_SP])
     mem = stack.shape[0] - 1       # last stack row: the step controller's memory (m, gap, valid)
@@ -1581,8 +1595,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     if k1 > k0:   # (nothing allocated for a window every pair of which was culled)
         call_tests = 0.0               # whole-shape tests of this call (see CALL_TESTS)
         stack = np.empty((max_depth + 2, 3))
-        pws = pair_workspace(mp)           # the searches' scratch, once per call (see _pair_search)
-        cum = np.empty(mp.times.shape[0])
+        sw = _search_workspace(gp, mp)     # the searches' scratch, once per call (see _pair_search)
         out = np.empty(OUT_SIZE)
         w = np.empty(3)
         pA = np.empty(3)
@@ -1664,7 +1677,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         if (t < jf or t > jl) and gaps[t] < sph:
                             sph = gaps[t]
             v = _pair_search(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests,
-                             MODE_CERTIFY_ONLY, rel_pad, abs_pad, stack, row, pws, cum)
+                             MODE_CERTIFY_ONLY, rel_pad, abs_pad, stack, row, sw)
             if v == CERTIFIED and sph < row[R_CLEAR]:
                 row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
             info[WI_TESTS] += row[R_TESTS]
