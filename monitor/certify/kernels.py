@@ -1037,6 +1037,28 @@ that reached them; ``info[WI_DONE]`` says where), so the engine checks its budge
 every CALL_TESTS tests plus one pair's search, however many survivor slots it asked for."""
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
+def _moving_base(body_parent, body_moving, ba, bb, mark, stamp):
+    """The deepest common ancestor of bodies ba and bb if it is not the world and moves, else 0.
+
+    (Each body is its own ancestor.) The frame :func:`monitor.motion.kernel.pair_bound` freezes
+    with ``relative=1``. ``mark``: (nbody,) int64 scratch; ``stamp``: a value that no entry of
+    ``mark`` holds unless written for the same pair before.
+    """
+    c = ba
+    while True:
+        mark[c] = stamp
+        if c == 0:
+            break
+        c = body_parent[c]
+    c = bb
+    while mark[c] != stamp:
+        c = body_parent[c]
+    if c != 0 and body_moving[c] != 0:
+        return c
+    return 0
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def sphere_gap(sc, sr, ga, gb, pad):
     """Min over sub-intervals of |c_a - c_b| - r_a - r_b, minus ``pad`` (-inf if not all finite)."""
@@ -1328,6 +1350,18 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     margin, none can be culled and the other sub-ranges are skipped (early survival; the
     argument is in stage 0's comment; not for long windows, which read every sub-range).
 
+    Relative spheres (issue 12, hand30): a pair of cores the world spheres leave within the
+    margin whose bodies have a common ancestor C that moves (not the world; C may be one of the
+    two bodies) gets a second test: each geom's sphere over the whole window [t0, t1] (the same
+    expressions as the sub-range spheres) from :func:`monitor.motion.kernel.pair_bound` with
+    ``relative=1``, i.e. the bounds of the motion X_WC(m) X_WC(t)^-1 X_Wb(t) (m = the window's
+    middle). That map moves both geoms by the same rigid transform at each t, so their distance
+    is the real one; when these spheres are apart by more than the margin (after the rounding pad,
+    the larger of ``pad`` and the same formula on these centres' magnitude) the pair is culled
+    with that certified gap (``gap[k]``, and ``info[WI_BEST]`` if smallest). Two fingers of one
+    moving hand: the hand's own motion no longer keeps them. The early survival below is not
+    taken when a selected pair has such an ancestor.
+
     Sweep (issue 12, sparse scaling; ``rows`` given): :func:`sweep_rows` produces the pairs
     whose boxes are within ``thr = (margin + pad + 1e-12 smax)(1 + 1e-9) + 1e-12`` on every
     axis (``smax`` >= 1 and >= every finite box coordinate, so >= each pair's ``scale``);
@@ -1413,6 +1447,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         tb = t1 if tq == T - 1 else (tq + 1) * step + t0
         _bounds_core(mp, ta, tb, need_all, pos[tq], rot[tq], trans[tq], ang[tq], ws)
         grow_f = 1.0 + 8.0 * rel_pad
+        mark = np.zeros(nbody, np.int64)     # _moving_base's scratch (stamps: pair index + 1)
         all_open = pairs.shape[0] > 0 and not long_window
         if all_open:
             # this sub-range's share of the full path's ``mag`` (NaN propagates: then nothing is proven)
@@ -1423,8 +1458,9 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             for k in range(pairs.shape[0]):
                 ga, gb = pairs[k, 0], pairs[k, 1]
                 both_fixed = fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0
-                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0:
-                    all_open = False
+                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0 or _moving_base(
+                        mp.body_parent, mp.body_moving, gp.body[ga], gp.body[gb], mark, k + 1) != 0:
+                    all_open = False     # (a pair the relative sphere below may cull)
                     break
                 for j in range(2):
                     g = ga if j == 0 else gb
@@ -1514,6 +1550,14 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         lo[g, r] = -np.inf
                         hi[g, r] = np.inf
             info[WI_PAD] = pad
+            # relative spheres (see the docstring): scratch allocated on first use
+            rneed = np.empty(0, np.int64)
+            rpos = np.empty((0, 3))
+            rrot = np.empty((0, 3, 3))
+            rtrans = np.empty(0)
+            rang = np.empty(0)
+            rc = np.empty((2, 3))
+            rR = np.empty((2, 3, 3))
             # -- which pairs: all of them, or the sweep's (sorted rows in surv[:nrows]) -----------
             nrows = pairs.shape[0]
             swept = False
@@ -1573,6 +1617,43 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         code[k] = WK_CULLED
                         continue
                     g = sphere_gap(sc, sr, ga, gb, pad)
+                    if not g > margin:
+                        ba, bb = gp.body[ga], gp.body[gb]
+                        if _moving_base(mp.body_parent, mp.body_moving, ba, bb, mark, k + 1) != 0:
+                            if rneed.shape[0] == 0:
+                                rneed = np.empty(nbody, np.int64)
+                                rpos = np.empty((nbody, 3))
+                                rrot = np.empty((nbody, 3, 3))
+                                rtrans = np.zeros(nbody)
+                                rang = np.zeros(nbody)
+                            TA, aA, TB, aB = pair_bound(mp, ba, bb, t0, t1, rc[0], rR[0], rc[1], rR[1],
+                                                        (rneed, rpos, rrot, rtrans, rang, ws), 1)
+                            # the broad phase's sphere of each geom over [t0, t1], in the common
+                            # ancestor's frame at the window's middle (same expressions)
+                            d = 0.0
+                            magr = 1.0
+                            for j in range(2):
+                                gg = ga if j == 0 else gb
+                                b = ba if j == 0 else bb
+                                tr, an = (TA, aA) if j == 0 else (TB, aB)
+                                rad = gp.brad[gg]
+                                cg = gp.bcenter[gg]
+                                ref = mp.ref_points[b]
+                                lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+                                rr = rad + (tr + 2.0 * math.sin(0.5 * min(an, math.pi)) * lever) * grow_f
+                                if not rr >= 0.0:
+                                    rr = np.inf
+                                d -= rr
+                                R = rR[j]
+                                for r in range(3):
+                                    magr = max(magr, abs(rc[j, r]) + 1.0)
+                                    x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + rc[j, r]
+                                    rc[j, r] = x       # (the origin is not read again)
+                            padr = max(pad, rel_pad * magr + abs_pad + prm[WP_SCALE_PAD] * magr)
+                            gr = _norm3(rc[0, 0] - rc[1, 0], rc[0, 1] - rc[1, 1], rc[0, 2] - rc[1, 2])
+                            gr = gr + d - padr
+                            if gr > margin:
+                                g = gr
                 if g > margin:
                     code[k] = WK_CULLED
                     gap[k] = g
