@@ -467,7 +467,8 @@ def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray
 
     The float scratch is one array carved into C-contiguous views (two allocations instead of
     ten; the views have the types of the former arrays, so ``_fk`` keeps one specialisation;
-    issue 12, kernel cost: ``window_kernel`` calls this twice per surviving pair).
+    issue 12, kernel cost: ``window_kernel`` calls this once per body of its surviving pairs
+    per call, for their start poses).
     """
     nbody = mp.body_parent.shape[0]
     njnt = mp.jnt_type.shape[0]
