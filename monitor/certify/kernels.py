@@ -1031,6 +1031,8 @@ WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH, WI_DONE = range(6)
 WI_SIZE = 6
 """Layout of the info vector of :func:`window_kernel`: sphere-gap pad (m), smallest culled gap
 computed (m), tests spent, survivors, deepest level, end of the survivor slots processed."""
+_REL_SLOTS = 4
+"""Common ancestors whose relative bounds stage 0 keeps at a time (see window_kernel)."""
 CALL_TESTS = 64
 """Whole-shape tests after which one stage-1 :func:`window_kernel` call stops (after the pair
 that reached them; ``info[WI_DONE]`` says where), so the engine checks its budget clock at least
@@ -1353,11 +1355,14 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     Relative spheres (issue 12, hand30): a pair of cores the world spheres leave within the
     margin whose bodies have a common ancestor C that moves (not the world; C may be one of the
     two bodies) gets a second test: each geom's sphere over the whole window [t0, t1] (the same
-    expressions as the sub-range spheres) from :func:`monitor.motion.kernel.pair_bound` with
-    ``relative=1``, i.e. the bounds of the motion X_WC(m) X_WC(t)^-1 X_Wb(t) (m = the window's
-    middle). That map moves both geoms by the same rigid transform at each t, so their distance
-    is the real one; when these spheres are apart by more than the margin (after the rounding pad,
-    the larger of ``pad`` and the same formula on these centres' magnitude) the pair is culled
+    expressions as the sub-range spheres) from the bounds of
+    :func:`monitor.motion.kernel.pair_bound` with ``relative=1``, i.e. of the motion
+    X_WC(m) X_WC(t)^-1 X_Wb(t) (m = the window's middle; one ``_bounds_core`` pass per C for
+    all of C's descendants, the last ``_REL_SLOTS`` kept: the same numbers, as a body's bound
+    reads only its own ancestors). That map moves both geoms by the same rigid transform at
+    each t, so their distance is the real one; when these spheres are apart by more than the
+    margin (after the rounding pad, the larger of ``pad`` and the same formula on these
+    centres' magnitude) the pair is culled
     with that certified gap (``gap[k]``, and ``info[WI_BEST]`` if smallest). Two fingers of one
     moving hand: the hand's own motion no longer keeps them. The early survival below is not
     taken when a selected pair has such an ancestor.
@@ -1551,13 +1556,16 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         hi[g, r] = np.inf
             info[WI_PAD] = pad
             # relative spheres (see the docstring): scratch allocated on first use
+            # (the bounds relative to one common ancestor, for all its descendants at once, kept
+            # for the last _REL_SLOTS ancestors: pairs come sorted, so the same few recur)
             rneed = np.empty(0, np.int64)
-            rpos = np.empty((0, 3))
-            rrot = np.empty((0, 3, 3))
-            rtrans = np.empty(0)
-            rang = np.empty(0)
+            rpos = np.empty((0, 0, 3))
+            rrot = np.empty((0, 0, 3, 3))
+            rtrans = np.empty((0, 0))
+            rang = np.empty((0, 0))
+            rbase = np.full(_REL_SLOTS, -1, np.int64)
+            rnext = 0
             rc = np.empty((2, 3))
-            rR = np.empty((2, 3, 3))
             # -- which pairs: all of them, or the sweep's (sorted rows in surv[:nrows]) -----------
             nrows = pairs.shape[0]
             swept = False
@@ -1619,15 +1627,40 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                     g = sphere_gap(sc, sr, ga, gb, pad)
                     if not g > margin:
                         ba, bb = gp.body[ga], gp.body[gb]
-                        if _moving_base(mp.body_parent, mp.body_moving, ba, bb, mark, k + 1) != 0:
+                        cb = _moving_base(mp.body_parent, mp.body_moving, ba, bb, mark, k + 1)
+                        if cb != 0:
                             if rneed.shape[0] == 0:
                                 rneed = np.empty(nbody, np.int64)
-                                rpos = np.empty((nbody, 3))
-                                rrot = np.empty((nbody, 3, 3))
-                                rtrans = np.zeros(nbody)
-                                rang = np.zeros(nbody)
-                            TA, aA, TB, aB = pair_bound(mp, ba, bb, t0, t1, rc[0], rR[0], rc[1], rR[1],
-                                                        (rneed, rpos, rrot, rtrans, rang, ws), 1)
+                                rpos = np.empty((_REL_SLOTS, nbody, 3))
+                                rrot = np.empty((_REL_SLOTS, nbody, 3, 3))
+                                rtrans = np.zeros((_REL_SLOTS, nbody))
+                                rang = np.zeros((_REL_SLOTS, nbody))
+                            sl = -1
+                            for j in range(_REL_SLOTS):
+                                if rbase[j] == cb:
+                                    sl = j
+                            if sl < 0:
+                                # pair_bound(relative=1)'s numbers for every descendant of cb in one
+                                # pass: a body's bound and pose read only its own ancestors' need
+                                sl = rnext
+                                rnext = (rnext + 1) % _REL_SLOTS
+                                rbase[sl] = cb
+                                for b in range(nbody):
+                                    c = b
+                                    while c != 0 and c != cb:
+                                        c = mp.body_parent[c]
+                                    rneed[b] = 1 if c == cb and b != cb else 0
+                                c = cb
+                                while True:
+                                    rneed[c] = 2
+                                    if c == 0:
+                                        break
+                                    c = mp.body_parent[c]
+                                _bounds_core(mp, t0, t1, rneed, rpos[sl], rrot[sl], rtrans[sl], rang[sl], ws)
+                            TA, aA, TB, aB = rtrans[sl, ba], rang[sl, ba], rtrans[sl, bb], rang[sl, bb]
+                            for r in range(3):
+                                rc[0, r] = rpos[sl, ba, r]
+                                rc[1, r] = rpos[sl, bb, r]
                             # the broad phase's sphere of each geom over [t0, t1], in the common
                             # ancestor's frame at the window's middle (same expressions)
                             d = 0.0
@@ -1644,7 +1677,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                                 if not rr >= 0.0:
                                     rr = np.inf
                                 d -= rr
-                                R = rR[j]
+                                R = rrot[sl, b]
                                 for r in range(3):
                                     magr = max(magr, abs(rc[j, r]) + 1.0)
                                     x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + rc[j, r]
