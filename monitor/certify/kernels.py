@@ -107,6 +107,7 @@ from monitor.motion.kernel import (
     _search_right,
     body_pose,
     bounds_workspace,
+    mark_ancestors,
     pair_bound,
     pair_workspace,
 )
@@ -1047,12 +1048,7 @@ def _moving_base(body_parent, body_moving, ba, bb, mark, stamp):
     with ``relative=1``. ``mark``: (nbody,) int64 scratch; ``stamp``: a value that no entry of
     ``mark`` holds unless written for the same pair before.
     """
-    c = ba
-    while True:
-        mark[c] = stamp
-        if c == 0:
-            break
-        c = body_parent[c]
+    mark_ancestors(body_parent, ba, mark, stamp)
     c = bb
     while mark[c] != stamp:
         c = body_parent[c]
@@ -1650,12 +1646,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                                     while c != 0 and c != cb:
                                         c = mp.body_parent[c]
                                     rneed[b] = 1 if c == cb and b != cb else 0
-                                c = cb
-                                while True:
-                                    rneed[c] = 2
-                                    if c == 0:
-                                        break
-                                    c = mp.body_parent[c]
+                                mark_ancestors(mp.body_parent, cb, rneed, 2)
                                 _bounds_core(mp, t0, t1, rneed, rpos[sl], rrot[sl], rtrans[sl], rang[sl], ws)
                             TA, aA, TB, aB = rtrans[sl, ba], rang[sl, ba], rtrans[sl, bb], rang[sl, bb]
                             for r in range(3):

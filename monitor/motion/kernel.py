@@ -449,16 +449,22 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
          xmat[b, 2, 0], xmat[b, 2, 1], xmat[b, 2, 2]) = _quat_mat9(w, x, y, z)
 
 
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
+def mark_ancestors(body_parent: np.ndarray, body: int, need: np.ndarray, value: int) -> None:
+    """need[c] = value for body and every ancestor (world included); 2: a frozen base (_bounds_core)."""
+    c = body
+    while True:
+        need[c] = value
+        if c == 0:
+            break
+        c = body_parent[c]
+
+
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
     """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
     need[:] = 0
-    c = body
-    while True:
-        need[c] = 1
-        if c == 0:
-            break
-        c = body_parent[c]
+    mark_ancestors(body_parent, body, need, 1)
 
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
@@ -958,12 +964,7 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
                     break
                 c = mp.body_parent[c]
     if relative != 0 and ba >= 0 and bb >= 0 and base != 0 and mp.body_moving[base] != 0:
-        c = base
-        while True:
-            need[c] = 2
-            if c == 0:
-                break
-            c = mp.body_parent[c]
+        mark_ancestors(mp.body_parent, base, need, 2)
     _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle, ws)
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
     if ba >= 0:
