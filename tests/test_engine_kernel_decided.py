@@ -1,7 +1,7 @@
 """engine._kernel_decided and engine._window_kernel (issue 12, the pair-window floor).
 
 When one ``window_kernel`` call decided every surviving pair (``method="toleranced"``, at most
-``_FAST_CHUNK`` survivors), ``_certify_fast`` builds the certificate from the result rows
+``kernels.CALL_TESTS`` whole-shape tests), ``_certify_fast`` builds the certificate from the result rows
 directly instead of running its general tail. Oracle: the general tail itself (the same
 engine with ``_kernel_decided`` patched to return None): verdict, witness, earliest time,
 clearance, stats and every PairResult must be identical. Scenes mix a moving pair (colliding,

@@ -377,6 +377,8 @@ def test_kernel_and_pack_do_not_import_mujoco():
 def test_pair_bound_equals_two_body_bounds():
     """pair_bound (one pass over both chains, reused workspace) == two body_bound calls, bit for bit.
 
+    (``relative=0``: the absolute bounds; a single body, index -1 for the other, with ``relative=1``.)
+
     Random hinge/slide/ball/free trees with mocap; random body pairs (also a body with itself,
     an ancestor with its descendant, the world) and intervals; one workspace reused across all
     calls of a tree, so left-over scratch contents from a previous call would show. A skipped
@@ -393,7 +395,7 @@ def test_pair_bound_equals_two_body_bounds():
             for _ in range(3):
                 ba, bb = (int(x) for x in rng.integers(0, m.nbody, 2))
                 pa, Ra, pb, Rb = np.empty(3), np.empty((3, 3)), np.empty(3), np.empty((3, 3))
-                got = KN.pair_bound(mp, ba, bb, ta[i], tb[i], pa, Ra, pb, Rb, pws)
+                got = KN.pair_bound(mp, ba, bb, ta[i], tb[i], pa, Ra, pb, Rb, pws, 0)
                 p1, R1, p2, R2 = np.empty(3), np.empty((3, 3)), np.empty(3), np.empty((3, 3))
                 want = KN.body_bound(mp, ba, ta[i], tb[i], p1, R1)
                 want += KN.body_bound(mp, bb, ta[i], tb[i], p2, R2)
@@ -402,11 +404,73 @@ def test_pair_bound_equals_two_body_bounds():
                     np.testing.assert_array_equal(x, y)
                 n += 1
             keep = np.full(3, 7.0)
-            got = KN.pair_bound(mp, -1, ba, ta[i], tb[i], keep, np.empty((3, 3)), pb, Rb, pws)
+            got = KN.pair_bound(mp, -1, ba, ta[i], tb[i], keep, np.empty((3, 3)), pb, Rb, pws, 1)
             assert got[:2] == (0.0, 0.0) and (keep == 7.0).all()
             assert got[2:] == KN.body_bound(mp, ba, ta[i], tb[i], p1, R1)
     assert n > 500
 
+
+
+def _ancestors_of(m, b):
+    out = [b]
+    while b != 0:
+        b = int(m.body_parentid[b])
+        out.append(b)
+    return out
+
+
+def test_pair_bound_relative_to_the_common_ancestor_holds_on_dense_samples():
+    """pair_bound(relative=1) bounds each body's motion relative to the pair's deepest common ancestor.
+
+    Oracle: MuJoCo FK (``mj_kinematics``) at the oracle's interpolated qpos (``_oracle_qpos``) at the
+    midpoint m and on dense samples t of [ta, tb]; the common ancestor C (from ``body_parentid``, not
+    the pack) maps each sample by X_WC(m) X_WC(t)^-1 (one rigid map per time for both bodies, which
+    keeps every distance between them); the mapped deviations from the pose at m must stay within
+    ``trans + chord(angle) |x - ref|`` (``_check_samples``: near and far points). Where C is the world,
+    the numbers must be the absolute ones bit for bit; where C moves, the relative bound is checked
+    to be the smaller one on most pairs (it drops the common chain's motion).
+    """
+    rng = np.random.default_rng(20261128)
+    n_rel = n_abs = n_smaller = 0
+    for tree in range(60):
+        m, times, plan = _random_plan(rng)
+        if m.nbody < 3:
+            continue
+        mp = pack_trajectory(plan)
+        ta, tb = _intervals(rng, times)
+        pws = KN.pair_workspace(mp)
+        ref = plan.ref_points
+        for i in range(ta.shape[0]):
+            ba, bb = (int(x) for x in rng.integers(1, m.nbody, 2))
+            anc_b = _ancestors_of(m, bb)
+            C = next(c for c in _ancestors_of(m, ba) if c in anc_b)
+            pa, Ra, pb, Rb = np.empty(3), np.empty((3, 3)), np.empty(3), np.empty((3, 3))
+            got = KN.pair_bound(mp, ba, bb, ta[i], tb[i], pa, Ra, pb, Rb, pws, 1)
+            absolute = KN.pair_bound(mp, ba, bb, ta[i], tb[i], np.empty(3), np.empty((3, 3)), np.empty(3),
+                                     np.empty((3, 3)), pws, 0)
+            if C == 0 or mp.body_moving[C] == 0:
+                assert got == absolute, (tree, i, ba, bb, got, absolute)
+                n_abs += 1
+                continue
+            ts = np.concatenate([np.linspace(ta[i], tb[i], 60), rng.uniform(ta[i], tb[i], 20)])
+            Q = _oracle_qpos(m, times, plan.qpos, np.concatenate([[0.5 * (ta[i] + tb[i])], ts]))
+            pos, mat = _mocap_poses(m, Q, plan)
+            np.testing.assert_allclose(pa, pos[0, ba], rtol=0, atol=1e-12)   # world poses at m
+            np.testing.assert_allclose(pb, pos[0, bb], rtol=0, atol=1e-12)
+            # X_WC(m) X_WC(t)^-1 applied to every body at every sample (index 0: m, the identity)
+            G = np.einsum("ij,tkj->tik", mat[0, C], mat[:, C])
+            mpos = np.einsum("tij,tnj->tni", G, pos - pos[:, C, None, :]) + pos[0, C]
+            mmat = np.einsum("tij,tnjk->tnik", G, mat)
+            trans, angle = np.zeros(m.nbody), np.zeros(m.nbody)
+            trans[ba], angle[ba] = got[0], got[1]
+            trans[bb], angle[bb] = got[2], got[3]
+            keep = [0, ba, bb]
+            _check_samples(mpos[:, keep], mmat[:, keep], ref[keep], trans[keep], angle[keep], rng,
+                           tag=f"tree {tree} iv {i} pair {ba},{bb} base {C}")
+            n_rel += 1
+            n_smaller += got[0] + got[2] < absolute[0] + absolute[2]
+    assert n_rel > 60 and n_abs > 60, (n_rel, n_abs)
+    assert n_smaller > 0.5 * n_rel, (n_smaller, n_rel)
 
 def test_rounding_scale_equals_its_definition_with_static_bodies():
     """The pack's rounding scale (``tol[TOL_SCALE]``, ``batch(BATCH_SCALE)``) is exactly its

@@ -385,3 +385,62 @@ def test_early_survival_gives_the_full_broad_phase_outcome(monkeypatch):
         if lone.verdict == "violation":
             assert (both.witness.time, both.witness.distance) == (lone.witness.time, lone.witness.distance)
     assert early >= 4 and full_only >= 4, (early, full_only)
+
+
+_HAND_XML = """<mujoco><worldbody>
+  <body name="base"><joint name="x" type="slide" axis="1 0 0"/><joint name="yaw" type="hinge" axis="0 0 1"/>
+    <geom name="palm" type="box" size="0.09 0.02 0.01"/>
+    <body name="f1" pos="{half} 0 -0.02"><joint name="j1" type="hinge" axis="0 1 0"/>
+      <geom name="g1" type="capsule" fromto="0 0 0 0 0 -0.08" size="0.008"/></body>
+    <body name="f2" pos="-{half} 0 -0.02"><joint name="j2" type="hinge" axis="0 1 0"/>
+      <geom name="g2" type="capsule" fromto="0 0 0 0 0 -0.08" size="0.008"/></body>
+  </body>
+</worldbody></mujoco>"""
+
+
+def _fingers(half: float, bend: float):
+    """Two fingers on a base that slides 0.8 m and yaws 1 rad; each finger bends by +-bend (rad)."""
+    m = mujoco.MjModel.from_xml_string(_HAND_XML.format(half=half))
+    t = np.linspace(0.0, 0.3, 16)
+    s = t / t[-1]
+    q = np.stack([0.8 * s, 1.0 * s, bend * s, -bend * s], axis=1)     # f1 bends towards -x, f2 towards +x
+    return m, monitor.Scene.from_model(m, pairs=[("g1", "g2")]), monitor.Plan(t, q, m)
+
+
+def _sampled_min_distance(m, plan, n=400):
+    d = mujoco.MjData(m)
+    a, b = (mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, g) for g in ("g1", "g2"))
+    out = np.inf
+    for q in plan.qpos_at(np.linspace(plan.t0, plan.t1, n)):
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        out = min(out, mujoco.mj_geomDistance(m, d, a, b, 1.0, None))
+    return out
+
+
+@pytest.mark.parametrize("bend", [0.02, 0.1])
+def test_fingers_of_one_moving_base_are_culled_by_their_relative_spheres(bend):
+    """Stage 0 culls a pair whose geoms' swept spheres in their common ancestor's frame are apart
+    (issue 12, hand30). Oracles: the numpy swept-sphere broad phase on the world motion does NOT
+    cull the pair (the base moves 0.8 m), so the relative spheres did; MuJoCo's distance on dense
+    samples stays above the culled pair's certified gap."""
+    m, scene, plan = _fingers(0.07, bend)
+    cert = monitor.certify(scene, plan, epsilon=1e-3, method="toleranced")
+    shapes = [g.shape for g in scene.geoms]
+    sph = swept_geom_spheres(plan, shapes, np.array([g.body_id for g in scene.geoms]), (plan.t0, plan.t1), 8)
+    names = [g.name for g in scene.geoms]
+    absolute = float(sphere_pair_gaps(sph, np.array([names.index("g1")]), np.array([names.index("g2")]))[0])
+    assert absolute < 0.0
+    (p,) = cert.pairs
+    assert cert.verdict == "certified" and p.method == "culled", p
+    assert 0.0 < p.clearance <= _sampled_min_distance(m, plan), p.clearance
+
+
+def test_fingers_of_one_moving_base_that_touch_are_not_culled():
+    """The same fingers bent into each other: the relative spheres overlap, the pair goes on to the
+    whole-shape stage and its collision is found (oracle: MuJoCo's distance on dense samples < 0)."""
+    m, scene, plan = _fingers(0.05, 1.2)
+    assert _sampled_min_distance(m, plan) < 0.0
+    cert = monitor.certify(scene, plan, epsilon=1e-3, method="toleranced")
+    assert cert.verdict == "violation" and cert.witness.geoms == ("g1", "g2")
+    assert cert.pairs[0].method != "culled"

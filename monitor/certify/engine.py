@@ -558,10 +558,6 @@ def _certify(scene: Any, plan: Any, margin: float, epsilon: float, method: str, 
     return cert
 
 
-
-_FAST_CHUNK = 4
-"""Survivors per compiled stage-1 call: the budget clock is checked between calls (numba has no clock)."""
-
 SWEEP_MIN_GEOMS = 400
 """Geoms from which stage 0 of the window kernel sweeps (sort-and-sweep on the swept boxes) instead of
 visiting every selected pair: on the scaling scenes the sweep wins from ~60 geoms when sparse, from
@@ -968,8 +964,9 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     One compiled call culls every selected pair (static-static, swept spheres), tests the
     survivors' start poses and runs the whole-shape stage on the pairs of the toleranced
     route (``method="toleranced"``, or ``"auto"`` for pairs that do not both translate);
-    further compiled calls of ``_FAST_CHUNK`` survivors each follow when there are more
-    (the budget is checked between calls). Pairs the kernel leaves open (whole-shape
+    further compiled calls follow when one stopped after ``kernels.CALL_TESTS`` whole-shape
+    tests (under a test budget: one survivor per call; the budget is checked between calls:
+    numba has no clock). Pairs the kernel leaves open (whole-shape
     unresolved, the extrusion route, static pairs not proven clear, unsupported kinds) go
     through the Python stages 3-5 exactly as in :func:`_certify`. Results stay arrays;
     ``cert.pairs`` is built on first read (:class:`_WindowPairs`).
@@ -996,15 +993,15 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     sr = np.empty((_NSUB, G))
     info = np.zeros(KS.WI_SIZE)
     none = _NONE
-    chunk = 1 if bud.tests is not None else _FAST_CHUNK
-    first = 0
-    if whole:   # stage 0 runs stage 1 too: the first chunk, or every survivor (see _rest_chunk)
-        first = chunk if chunk == 1 else _rest_chunk(bud, P, 0, chunk)
+    # without a test budget, each call stops by itself after kernels.CALL_TESTS whole-shape tests
+    # (the budget is polled between calls); with "whole", stage 0 runs stage 1 too
+    chunk = 1 if bud.tests is not None else P
+    first = chunk if whole else 0
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
     S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, rows, info))
-    done_to = min(first, S)
+    done_to = int(info[KS.WI_DONE])
     charged = info.item(KS.WI_TESTS)
     if charged:
         bud.charge(int(charged))
@@ -1038,8 +1035,6 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                         route[s] = 0
         except BudgetExhausted:
             stopped = True
-    if chunk > 1 and done_to < S and not stopped:
-        chunk = _rest_chunk(bud, S, done_to, chunk)
     while done_to < S and not stopped:
         if bud.exhausted:
             stopped = True
@@ -1049,7 +1044,7 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                        sc, sr, rows, info)
         bud.charge(int(info[KS.WI_TESTS] - charged))
         charged = info[KS.WI_TESTS]
-        done_to = k1
+        done_to = int(info[KS.WI_DONE])
     if done_to < S and stopped:
         # budget spent: the rest get their start-pose test only (the Python pipeline tests every
         # start pose before any checker runs; start tests are not charged), then go on to the
@@ -1172,37 +1167,6 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
                                 earliest, clearance, lazy, stats, allowed)
-
-
-_CHUNK_HEADROOM = 100.0
-"""How many times the rest of stage 1, at the pace of the call so far, must fit into the budget's
-remaining seconds before :func:`_rest_chunk` runs it in one compiled call."""
-
-
-def _rest_chunk(bud: Budget, S: int, done_to: int, chunk: int) -> int:
-    """Survivors per stage-1 call for slots [done_to, S): all of them, or ``chunk``.
-
-    The budget clock can only be read between compiled calls, so stage 1 runs in chunks of
-    ``_FAST_CHUNK`` survivors. When the budget (a plain :class:`Budget`: tests and seconds
-    are its only limits) has no clock limit, or when its remaining
-    seconds exceed :data:`_CHUNK_HEADROOM` times the rest at this call's pace so far (the
-    elapsed seconds, validation, packing and stage 0 included, per survivor done, at least
-    one), the rest runs in one call: the clock would be read only to find it far from spent.
-    Every survivor's result is the same either way (stage 1 decides each slot on its own from
-    stage 0's arrays); only how late an exhausted budget is noticed depends on the chunk
-    (each pair's stage 1 stays capped at ``WHOLE_SHAPE_MAX_TESTS`` tests). Before stage 0
-    (``done_to`` 0, ``S`` the P selected pairs, any of which may survive) the pace is the whole
-    call so far per survivor. Issue 12: on the Arm's windows (9-12 of 51 pairs survive) stage 0
-    and all of stage 1 are then one compiled call instead of four.
-    """
-    if type(bud) is not Budget:   # a subclass may run out by its own rule (tests' poll counters)
-        return chunk
-    if bud.seconds is None:
-        return S
-    elapsed = bud.elapsed()
-    if bud.seconds - elapsed > _CHUNK_HEADROOM * elapsed / max(done_to, 1) * (S - done_to):
-        return S
-    return chunk
 
 
 def _no_extrusion_route(mp: Any, mov: np.ndarray) -> bool:

@@ -107,6 +107,7 @@ from monitor.motion.kernel import (
     _search_right,
     body_pose,
     bounds_workspace,
+    mark_ancestors,
     pair_bound,
     pair_workspace,
 )
@@ -539,7 +540,8 @@ def interval_bound(gp, mp, ga, gb, ta, tb, pA, RA, pB, RB, levers, stats, rel_pa
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
     mva, mvb = mp.body_moving[ba] != 0, mp.body_moving[bb] != 0
     if mva or mvb:
-        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws)
+        TA, angA, TB, angB = pair_bound(mp, ba if mva else -1, bb if mvb else -1, ta, tb, pA, RA, pB, RB, pws,
+                                            1)
     chA, chB = _chord(angA), _chord(angB)
     cA, cB = mp.ref_points[ba], mp.ref_points[bb]
     hsA, hsB = gp.kind[ga] == -1, gp.kind[gb] == -1
@@ -671,6 +673,35 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 stack, res):
     """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
 
+    :func:`_pair_search` with its scratch allocated for this call (arguments and result there).
+    """
+    return _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
+                        stack, res, _search_workspace(gp, mp))
+
+
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def _search_workspace(gp, mp):
+    """Scratch of :func:`_pair_search` for any pair of ``gp`` under ``mp`` (a tuple; see there).
+
+    (pws, cum, out, w, pA, pB, RA, RB, stats, levers, W4, IA, IB, lam, v, vn, X, VA, VB, dref):
+    :func:`monitor.motion.kernel.pair_workspace`, (K,) profile, the posed-distance and GJK work
+    arrays, and VA, VB (n, 3), dref (4, n) with n the largest vertex / mass-point count of a geom
+    (each search takes the leading rows of its geoms' sizes: the same shapes as its own arrays).
+    """
+    n = 1
+    for g in range(gp.kind.shape[0]):
+        n = max(n, gp.vstart[g + 1] - gp.vstart[g], gp.mstart[g + 1] - gp.mstart[g])
+    return (pair_workspace(mp), np.empty(mp.times.shape[0]), np.empty(OUT_SIZE), np.empty(3), np.empty(3),
+            np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.zeros(1), np.zeros(2), np.zeros((4, 3)),
+            np.zeros(4, np.int64), np.zeros(4, np.int64), np.zeros(4), np.empty(3), np.empty(3),
+            np.empty((5, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((4, n)))
+
+
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
+                 stack, res, sw):
+    """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
+
     Args:
         gp: :class:`monitor.certify.packed.GeomPack`.
         mp: :class:`monitor.motion.pack.MotionPack` (poses and bounds: :mod:`monitor.motion.kernel`).
@@ -692,34 +723,37 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
             witness time / point / upper bound,
             clearance lower bound, tests, max depth, unresolved count, first unresolved
             time, paper-ball wins, and the resumable state.
+        sw: :func:`_search_workspace` (contents on entry do not matter: what must start at
+            zero is zeroed here), so that :func:`window_kernel` allocates it once for all its
+            pairs. Its (K,) profile array for the step control (:func:`_path_profile`) is
+            filled on its first use in this call only (most searches never retry a prefix).
 
     Returns:
         The verdict code (also in ``res[R_VERDICT]``).
     """
-    out = np.empty(OUT_SIZE)
-    w = np.empty(3)
-    pA = np.empty(3)
-    pB = np.empty(3)
-    RA = np.empty((3, 3))
-    RB = np.empty((3, 3))
-    stats = np.zeros(1)
+    pws, cum, out, w, pA, pB, RA, RB, stats, levers, W4, IA, IB, lam, v, vn, X, VAbuf, VBbuf, dbuf = sw
+    stats[0] = 0.0
+    levers[0] = 0.0
+    levers[1] = 0.0
+    for i in range(4):                 # (the GJK work arrays start at zero, as fresh np.zeros)
+        IA[i] = 0
+        IB[i] = 0
+        lam[i] = 0.0
+        for r in range(3):
+            W4[i, r] = 0.0
     if gp.kind[ga] < -1 or gp.kind[gb] < -1 or (gp.kind[ga] == -1 and gp.kind[gb] == -1):
         res[R_VERDICT] = UNSUPPORTED
         return UNSUPPORTED
-    pws = pair_workspace(mp)
     times = mp.times
-    cum = np.empty(times.shape[0])      # step control only (see _path_profile)
-    _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum, mp.jnt_type, mp.jnt_qposadr,
-                  mp.jnt_track, mp.qpos, mp.qt_phi, gp.body[ga], gp.body[gb], cum)
+    cum_ready = False                   # cum: step control only (see _path_profile), filled when first read
     approx = gp.approx[ga] + gp.approx[gb]
-    levers = np.zeros(2)
     # |v - ref| of every vertex / mass point of A and B (interval_bound's lever arms), once per search
     refA, refB = mp.ref_points[gp.body[ga]], mp.ref_points[gp.body[gb]]
     PvA = gp.verts[gp.vstart[ga]:gp.vstart[ga + 1]]
     PmA = gp.mpts[gp.mstart[ga]:gp.mstart[ga + 1]]
     PvB = gp.verts[gp.vstart[gb]:gp.vstart[gb + 1]]
     PmB = gp.mpts[gp.mstart[gb]:gp.mstart[gb + 1]]
-    dref = (np.empty(PvA.shape[0]), np.empty(PmA.shape[0]), np.empty(PvB.shape[0]), np.empty(PmB.shape[0]))
+    dref = (dbuf[0, :PvA.shape[0]], dbuf[1, :PmA.shape[0]], dbuf[2, :PvB.shape[0]], dbuf[3, :PmB.shape[0]])
     lv_a = _lever(PvA, refA, dref[0])
     _lever(PmA, refA, dref[1])
     lv_b = _lever(PvB, refB, dref[2])
@@ -730,15 +764,9 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
         levers[1] = lv_b
     lean = gp.kind[ga] >= 0 and gp.kind[gb] >= 0
     rsum = gp.radius[ga] + gp.radius[gb]
-    VA = np.empty((max(gp.vstart[ga + 1] - gp.vstart[ga], 1), 3))
-    VB = np.empty((max(gp.vstart[gb + 1] - gp.vstart[gb], 1), 3))
-    W4 = np.zeros((4, 3))
-    IA = np.zeros(4, np.int64)
-    IB = np.zeros(4, np.int64)
-    lam = np.zeros(4)
-    v = np.empty(3)
-    vn = np.empty(3)
-    X = np.empty((5, 3))           # row 4: separated_beyond's resumable state
+    VA = VAbuf[:max(gp.vstart[ga + 1] - gp.vstart[ga], 1)]
+    VB = VBbuf[:max(gp.vstart[gb + 1] - gp.vstart[gb], 1)]
+    # X: row 4 is separated_beyond's resumable state
     spent = 0
     sp = int(res[R_SP])
     mem = stack.shape[0] - 1       # last stack row: the step controller's memory (m, gap, valid)
@@ -911,6 +939,11 @@ def pair_window(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, m
                 prof = False
                 Aa, ratio = 0.0, np.nan
                 if ia < times.shape[0] and times[ia] < b:
+                    if not cum_ready:
+                        _path_profile(mp.body_parent, mp.body_moving, mp.body_jntadr, mp.body_jntnum,
+                                      mp.jnt_type, mp.jnt_qposadr, mp.jnt_track, mp.qpos, mp.qt_phi,
+                                      gp.body[ga], gp.body[gb], cum)
+                        cum_ready = True
                     Aa = _profile_at(times, cum, a)
                     Ab = _profile_at(times, cum, b)
                     ratio = bound / (Ab - Aa) if Ab > Aa else np.nan
@@ -995,10 +1028,33 @@ WK_UNRES = 9
 WP_T0, WP_T1, WP_MARGIN, WP_EPS, WP_REL, WP_ABS, WP_SCALE_PAD, WP_MAX_DEPTH, WP_MAX_TESTS = range(9)
 WP_SIZE = 9
 """Layout of the float parameter vector of :func:`window_kernel`."""
-WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH = range(5)
-WI_SIZE = 5
+WI_PAD, WI_BEST, WI_TESTS, WI_SURV, WI_DEPTH, WI_DONE = range(6)
+WI_SIZE = 6
 """Layout of the info vector of :func:`window_kernel`: sphere-gap pad (m), smallest culled gap
-computed (m), tests spent, survivors, deepest level."""
+computed (m), tests spent, survivors, deepest level, end of the survivor slots processed."""
+_REL_SLOTS = 4
+"""Common ancestors whose relative bounds stage 0 keeps at a time (see window_kernel)."""
+CALL_TESTS = 64
+"""Whole-shape tests after which one stage-1 :func:`window_kernel` call stops (after the pair
+that reached them; ``info[WI_DONE]`` says where), so the engine checks its budget clock at least
+every CALL_TESTS tests plus one pair's search, however many survivor slots it asked for."""
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
+def _moving_base(body_parent, body_moving, ba, bb, mark, stamp):
+    """The deepest common ancestor of bodies ba and bb if it is not the world and moves, else 0.
+
+    (Each body is its own ancestor.) The frame :func:`monitor.motion.kernel.pair_bound` freezes
+    with ``relative=1``. ``mark``: (nbody,) int64 scratch; ``stamp``: a value that no entry of
+    ``mark`` holds unless written for the same pair before.
+    """
+    mark_ancestors(body_parent, ba, mark, stamp)
+    c = bb
+    while mark[c] != stamp:
+        c = body_parent[c]
+    if c != 0 and body_moving[c] != 0:
+        return c
+    return 0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -1275,7 +1331,10 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             lexicographically, a < b per row): stage 0 then visits only the pairs a
             sort-and-sweep of the boxes produces (see "Sweep" below); ``code`` must come zeroed
             (``WK_UNVISITED`` marks the rest).
-        info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth.
+        info: (WI_SIZE,) pad, smallest culled gap, tests, S, max depth, and ``WI_DONE``: the
+            end of the survivor slots this call processed (``k1``, or less when the whole-shape
+            searches of this call spent :data:`CALL_TESTS` tests first: the caller continues
+            from there; start-pose tests do not count).
 
     Broad phase (stage 0, O(G T + P)): per geom the swept spheres and their AABB (one
     ``tree_bounds`` per sub-interval for all bodies). Per pair: static-static -> ``WK_SS``;
@@ -1288,6 +1347,21 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     sub-range is bounded first: when it alone shows every selected pair of cores within the
     margin, none can be culled and the other sub-ranges are skipped (early survival; the
     argument is in stage 0's comment; not for long windows, which read every sub-range).
+
+    Relative spheres (issue 12, hand30): a pair of cores the world spheres leave within the
+    margin whose bodies have a common ancestor C that moves (not the world; C may be one of the
+    two bodies) gets a second test: each geom's sphere over the whole window [t0, t1] (the same
+    expressions as the sub-range spheres) from the bounds of
+    :func:`monitor.motion.kernel.pair_bound` with ``relative=1``, i.e. of the motion
+    X_WC(m) X_WC(t)^-1 X_Wb(t) (m = the window's middle; one ``_bounds_core`` pass per C for
+    all of C's descendants, the last ``_REL_SLOTS`` kept: the same numbers, as a body's bound
+    reads only its own ancestors). That map moves both geoms by the same rigid transform at
+    each t, so their distance is the real one; when these spheres are apart by more than the
+    margin (after the rounding pad, the larger of ``pad`` and the same formula on these
+    centres' magnitude) the pair is culled
+    with that certified gap (``gap[k]``, and ``info[WI_BEST]`` if smallest). Two fingers of one
+    moving hand: the hand's own motion no longer keeps them. The early survival below is not
+    taken when a selected pair has such an ancestor.
 
     Sweep (issue 12, sparse scaling; ``rows`` given): :func:`sweep_rows` produces the pairs
     whose boxes are within ``thr = (margin + pad + 1e-12 smax)(1 + 1e-9) + 1e-12`` on every
@@ -1326,7 +1400,8 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
     ``ta_f`` is clear.
 
     Returns:
-        S (stage 0) or the number of survivor slots processed (stage 1).
+        S (stage 0) or the number of survivor slots processed (stage 1); ``info[WI_DONE]`` is
+        the end of the slots processed in both cases.
     """
     # (one function body, no helper taking the packs: each function typed on the two packs
     # costs about a second of cold compile)
@@ -1373,6 +1448,7 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
         tb = t1 if tq == T - 1 else (tq + 1) * step + t0
         _bounds_core(mp, ta, tb, need_all, pos[tq], rot[tq], trans[tq], ang[tq], ws)
         grow_f = 1.0 + 8.0 * rel_pad
+        mark = np.zeros(nbody, np.int64)     # _moving_base's scratch (stamps: pair index + 1)
         all_open = pairs.shape[0] > 0 and not long_window
         if all_open:
             # this sub-range's share of the full path's ``mag`` (NaN propagates: then nothing is proven)
@@ -1383,8 +1459,9 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             for k in range(pairs.shape[0]):
                 ga, gb = pairs[k, 0], pairs[k, 1]
                 both_fixed = fixed[gp.body[ga]] != 0 and fixed[gp.body[gb]] != 0
-                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0:
-                    all_open = False
+                if both_fixed or gp.kind[ga] < 0 or gp.kind[gb] < 0 or _moving_base(
+                        mp.body_parent, mp.body_moving, gp.body[ga], gp.body[gb], mark, k + 1) != 0:
+                    all_open = False     # (a pair the relative sphere below may cull)
                     break
                 for j in range(2):
                     g = ga if j == 0 else gb
@@ -1474,6 +1551,17 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         lo[g, r] = -np.inf
                         hi[g, r] = np.inf
             info[WI_PAD] = pad
+            # relative spheres (see the docstring): scratch allocated on first use
+            # (the bounds relative to one common ancestor, for all its descendants at once, kept
+            # for the last _REL_SLOTS ancestors: pairs come sorted, so the same few recur)
+            rneed = np.empty(0, np.int64)
+            rpos = np.empty((0, 0, 3))
+            rrot = np.empty((0, 0, 3, 3))
+            rtrans = np.empty((0, 0))
+            rang = np.empty((0, 0))
+            rbase = np.full(_REL_SLOTS, -1, np.int64)
+            rnext = 0
+            rc = np.empty((2, 3))
             # -- which pairs: all of them, or the sweep's (sorted rows in surv[:nrows]) -----------
             nrows = pairs.shape[0]
             swept = False
@@ -1533,6 +1621,63 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
                         code[k] = WK_CULLED
                         continue
                     g = sphere_gap(sc, sr, ga, gb, pad)
+                    if not g > margin:
+                        ba, bb = gp.body[ga], gp.body[gb]
+                        cb = _moving_base(mp.body_parent, mp.body_moving, ba, bb, mark, k + 1)
+                        if cb != 0:
+                            if rneed.shape[0] == 0:
+                                rneed = np.empty(nbody, np.int64)
+                                rpos = np.empty((_REL_SLOTS, nbody, 3))
+                                rrot = np.empty((_REL_SLOTS, nbody, 3, 3))
+                                rtrans = np.zeros((_REL_SLOTS, nbody))
+                                rang = np.zeros((_REL_SLOTS, nbody))
+                            sl = -1
+                            for j in range(_REL_SLOTS):
+                                if rbase[j] == cb:
+                                    sl = j
+                            if sl < 0:
+                                # pair_bound(relative=1)'s numbers for every descendant of cb in one
+                                # pass: a body's bound and pose read only its own ancestors' need
+                                sl = rnext
+                                rnext = (rnext + 1) % _REL_SLOTS
+                                rbase[sl] = cb
+                                for b in range(nbody):
+                                    c = b
+                                    while c != 0 and c != cb:
+                                        c = mp.body_parent[c]
+                                    rneed[b] = 1 if c == cb and b != cb else 0
+                                mark_ancestors(mp.body_parent, cb, rneed, 2)
+                                _bounds_core(mp, t0, t1, rneed, rpos[sl], rrot[sl], rtrans[sl], rang[sl], ws)
+                            TA, aA, TB, aB = rtrans[sl, ba], rang[sl, ba], rtrans[sl, bb], rang[sl, bb]
+                            for r in range(3):
+                                rc[0, r] = rpos[sl, ba, r]
+                                rc[1, r] = rpos[sl, bb, r]
+                            # the broad phase's sphere of each geom over [t0, t1], in the common
+                            # ancestor's frame at the window's middle (same expressions)
+                            d = 0.0
+                            magr = 1.0
+                            for j in range(2):
+                                gg = ga if j == 0 else gb
+                                b = ba if j == 0 else bb
+                                tr, an = (TA, aA) if j == 0 else (TB, aB)
+                                rad = gp.brad[gg]
+                                cg = gp.bcenter[gg]
+                                ref = mp.ref_points[b]
+                                lever = _norm3(cg[0] - ref[0], cg[1] - ref[1], cg[2] - ref[2]) + rad
+                                rr = rad + (tr + 2.0 * math.sin(0.5 * min(an, math.pi)) * lever) * grow_f
+                                if not rr >= 0.0:
+                                    rr = np.inf
+                                d -= rr
+                                R = rrot[sl, b]
+                                for r in range(3):
+                                    magr = max(magr, abs(rc[j, r]) + 1.0)
+                                    x = R[r, 0] * cg[0] + R[r, 1] * cg[1] + R[r, 2] * cg[2] + rc[j, r]
+                                    rc[j, r] = x       # (the origin is not read again)
+                            padr = max(pad, rel_pad * magr + abs_pad + prm[WP_SCALE_PAD] * magr)
+                            gr = _norm3(rc[0, 0] - rc[1, 0], rc[0, 1] - rc[1, 1], rc[0, 2] - rc[1, 2])
+                            gr = gr + d - padr
+                            if gr > margin:
+                                g = gr
                 if g > margin:
                     code[k] = WK_CULLED
                     gap[k] = g
@@ -1551,93 +1696,116 @@ def window_kernel(gp, mp, pairs, fixed, moving, route, stage, k0, k1, prm, code,
             k0 = 0
             k1 = min(k1, S)
     # -- stage 1: start pose and whole-shape stage on survivor slots [k0, k1) ----------------
-    stack = np.empty((max_depth + 2, 3))
-    out = np.empty(OUT_SIZE)
-    w = np.empty(3)
-    pA = np.empty(3)
-    pB = np.empty(3)
-    RA = np.empty((3, 3))
-    RB = np.empty((3, 3))
-    for s in range(k0, k1):
-        k = surv[s]
-        if code[k] != WK_OPEN:
-            continue
-        ga, gb = pairs[k, 0], pairs[k, 1]
-        ba, bb = gp.body[ga], gp.body[gb]
-        row = res[s]
-        for j in range(R_SIZE):
-            row[j] = 0.0
-        row[R_WTIME] = np.nan
-        row[R_FIRST_UNRES] = np.nan
-        body_pose(mp, ba, t0, pA, RA)
-        body_pose(mp, bb, t0, pB, RB)
-        lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
-        info[WI_TESTS] += 1.0
-        row[R_START_LO] = lo_d
-        approx = gp.approx[ga] + gp.approx[gb]
-        if up_d + approx < margin:
-            code[k] = WK_STATIC_VIOL
-            row[R_VERDICT] = VIOLATION
-            row[R_WTIME] = t0
+    done = k1
+    if k1 > k0:   # (nothing allocated for a window every pair of which was culled)
+        call_tests = 0.0               # whole-shape tests of this call (see CALL_TESTS)
+        stack = np.empty((max_depth + 2, 3))
+        sw = _search_workspace(gp, mp)     # the searches' scratch, once per call (see _pair_search)
+        out = np.empty(OUT_SIZE)
+        w = np.empty(3)
+        pA = np.empty(3)
+        pB = np.empty(3)
+        RA = np.empty((3, 3))
+        RB = np.empty((3, 3))
+        nbody = mp.body_parent.shape[0]
+        have0 = np.zeros(nbody, np.int64)      # body poses at t0 computed in this call (pos0, rot0)
+        pos0 = np.empty((nbody, 3))
+        rot0 = np.empty((nbody, 3, 3))
+        for s in range(k0, k1):
+            k = surv[s]
+            if code[k] != WK_OPEN:
+                continue
+            ga, gb = pairs[k, 0], pairs[k, 1]
+            ba, bb = gp.body[ga], gp.body[gb]
+            row = res[s]
+            for j in range(R_SIZE):
+                row[j] = 0.0
+            row[R_WTIME] = np.nan
+            row[R_FIRST_UNRES] = np.nan
+            # start poses, each body's computed once per call (body_pose's numbers: a body's
+            # FK reads only its own ancestors, so the pose does not depend on the pair)
+            for b in (ba, bb):
+                if have0[b] == 0:
+                    body_pose(mp, b, t0, pos0[b], rot0[b])
+                    have0[b] = 1
             for r in range(3):
-                row[R_WPOINT + r] = w[r]
-            row[R_WUPPER] = up_d + approx
-            row[R_CLEAR] = -np.inf
-            continue
-        if moving[ba] == 0 and moving[bb] == 0:
-            if lo_d > margin:
-                code[k] = WK_STATIC_CERT
-                row[R_VERDICT] = CERTIFIED
-                row[R_CLEAR] = lo_d
-            else:
-                code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
-            continue
-        if route.shape[0] > 0 and route[s] == 0:
-            continue                   # extrusion route: the Python pipeline
-        row[R_STARTED] = 2.0
-        # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
-        # windows): only the span from the first to the last sub-range where they are not goes
-        # to the narrow phase (see the docstring: "Stage 1").
-        ta_s, tb_s, sph = t0, t1, np.inf
-        if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
-            T = sc.shape[0]
-            step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
-            jf, jl = -1, -1
-            gaps = np.empty(T)
-            for t in range(T):
-                d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
-                            sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
-                gaps[t] = d
-                if not (d > margin and d < np.inf):
-                    if jf < 0:
-                        jf = t
-                    jl = t
-            if jf >= 0:
-                ta_s = t0 if jf == 0 else jf * step + t0
-                tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                pA[r] = pos0[ba, r]
+                pB[r] = pos0[bb, r]
+                for c in range(3):
+                    RA[r, c] = rot0[ba, r, c]
+                    RB[r, c] = rot0[bb, r, c]
+            lo_d, up_d = posed_distance(gp, ga, RA, pA, gb, RB, pB, rel_pad, abs_pad, out, w)
+            info[WI_TESTS] += 1.0
+            row[R_START_LO] = lo_d
+            approx = gp.approx[ga] + gp.approx[gb]
+            if up_d + approx < margin:
+                code[k] = WK_STATIC_VIOL
+                row[R_VERDICT] = VIOLATION
+                row[R_WTIME] = t0
+                for r in range(3):
+                    row[R_WPOINT + r] = w[r]
+                row[R_WUPPER] = up_d + approx
+                row[R_CLEAR] = -np.inf
+                continue
+            if moving[ba] == 0 and moving[bb] == 0:
+                if lo_d > margin:
+                    code[k] = WK_STATIC_CERT
+                    row[R_VERDICT] = CERTIFIED
+                    row[R_CLEAR] = lo_d
+                else:
+                    code[k] = WK_PYTHON    # "uncertain" unless the Python start test (depth LP) confirms
+                continue
+            if route.shape[0] > 0 and route[s] == 0:
+                continue                   # extrusion route: the Python pipeline
+            row[R_STARTED] = 2.0
+            # Sub-ranges of the window where the pair's swept spheres are apart (issue 12, long
+            # windows): only the span from the first to the last sub-range where they are not goes
+            # to the narrow phase (see the docstring: "Stage 1").
+            ta_s, tb_s, sph = t0, t1, np.inf
+            if long_window and gp.kind[ga] >= 0 and gp.kind[gb] >= 0:
+                T = sc.shape[0]
+                step = (t1 - t0) / T      # the sub-range edges of stage 0, bit for bit
+                jf, jl = -1, -1
+                gaps = np.empty(T)
                 for t in range(T):
-                    if (t < jf or t > jl) and gaps[t] < sph:
-                        sph = gaps[t]
-        v = pair_window(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests, MODE_CERTIFY_ONLY,
-                        rel_pad, abs_pad, stack, row)
-        if v == CERTIFIED and sph < row[R_CLEAR]:
-            row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
-        info[WI_TESTS] += row[R_TESTS]
-        row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
-        if row[R_DEPTH] > info[WI_DEPTH]:
-            info[WI_DEPTH] = row[R_DEPTH]
-        if v == CERTIFIED:
-            code[k] = WK_CERT
-        elif v == VIOLATION:
-            code[k] = WK_VIOL
-            fu = row[R_FIRST_UNRES]
-            if not (fu <= row[R_WTIME]):
-                row[R_FIRST_UNRES] = row[R_WTIME]
-        else:
-            code[k] = WK_UNRES
+                    d = (_norm3(sc[t, ga, 0] - sc[t, gb, 0], sc[t, ga, 1] - sc[t, gb, 1],
+                                sc[t, ga, 2] - sc[t, gb, 2]) - sr[t, ga] - sr[t, gb]) - info[WI_PAD]
+                    gaps[t] = d
+                    if not (d > margin and d < np.inf):
+                        if jf < 0:
+                            jf = t
+                        jl = t
+                if jf >= 0:
+                    ta_s = t0 if jf == 0 else jf * step + t0
+                    tb_s = t1 if jl == T - 1 else (jl + 1) * step + t0
+                    for t in range(T):
+                        if (t < jf or t > jl) and gaps[t] < sph:
+                            sph = gaps[t]
+            v = _pair_search(gp, mp, ga, gb, ta_s, tb_s, margin, epsilon, max_depth, max_tests,
+                             MODE_CERTIFY_ONLY, rel_pad, abs_pad, stack, row, sw)
+            if v == CERTIFIED and sph < row[R_CLEAR]:
+                row[R_CLEAR] = sph        # the sub-ranges the spheres cleared: their gap bounds the clearance
+            info[WI_TESTS] += row[R_TESTS]
+            call_tests += row[R_TESTS]
+            row[R_TESTS] += 1.0            # the start-pose test, counted as the pair's (as pair_window does)
+            if row[R_DEPTH] > info[WI_DEPTH]:
+                info[WI_DEPTH] = row[R_DEPTH]
+            if v == CERTIFIED:
+                code[k] = WK_CERT
+            elif v == VIOLATION:
+                code[k] = WK_VIOL
+                fu = row[R_FIRST_UNRES]
+                if not (fu <= row[R_WTIME]):
+                    row[R_FIRST_UNRES] = row[R_WTIME]
+            else:
+                code[k] = WK_UNRES
+            if call_tests >= CALL_TESTS and s + 1 < k1:
+                done = s + 1               # the budget clock is the caller's: it continues from here
+                break
+    info[WI_DONE] = done
     if stage == 0:
         return S
-    return k1 - k0
+    return done - k0
 
 
 def new_result() -> np.ndarray:

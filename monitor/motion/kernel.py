@@ -449,16 +449,22 @@ def _fk(body_parent: np.ndarray, body_mocap: np.ndarray, body_pos: np.ndarray, b
          xmat[b, 2, 0], xmat[b, 2, 1], xmat[b, 2, 2]) = _quat_mat9(w, x, y, z)
 
 
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True, **NO_NRT)
+def mark_ancestors(body_parent: np.ndarray, body: int, need: np.ndarray, value: int) -> None:
+    """need[c] = value for body and every ancestor (world included); 2: a frozen base (_bounds_core)."""
+    c = body
+    while True:
+        need[c] = value
+        if c == 0:
+            break
+        c = body_parent[c]
+
+
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ancestors(body_parent: np.ndarray, body: int, need: np.ndarray) -> None:
     """need[c] = 1 for body and every ancestor (world included), 0 elsewhere."""
     need[:] = 0
-    c = body
-    while True:
-        need[c] = 1
-        if c == 0:
-            break
-        c = body_parent[c]
+    mark_ancestors(body_parent, body, need, 1)
 
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
@@ -467,7 +473,8 @@ def body_pose(mp, body: int, t: float, p_W_out: np.ndarray, R_WB_out: np.ndarray
 
     The float scratch is one array carved into C-contiguous views (two allocations instead of
     ten; the views have the types of the former arrays, so ``_fk`` keeps one specialisation;
-    issue 12, kernel cost: ``window_kernel`` calls this twice per surviving pair).
+    issue 12, kernel cost: ``window_kernel`` calls this once per body of its surviving pairs
+    per call, for their start poses).
     """
     nbody = mp.body_parent.shape[0]
     njnt = mp.jnt_type.shape[0]
@@ -684,6 +691,16 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
 
     ``need`` must be closed under ancestors. Fills xpos (nbody, 3), xmat (nbody, 3, 3),
     trans (nbody,) m and angle (nbody,) rad for those bodies (0 for static ones).
+    ``need[b] == 2`` marks a *frozen base* (issue 12, hand30): a body and all its ancestors
+    (closed under ancestors) held at their poses at m. Their bounds are 0 and the chains of
+    the other bodies stop at them, so a body below the base gets the bound of its motion
+    *relative to the base*: of the motion X_WC(m) X_WC(t)^-1 X_Wb(t) (C the deepest frozen
+    body; C itself gets the pads of a zero bound, ``abs_pad + scale_pad scale`` and ``abs_pad``
+    rad when it rotates), a chain rooted at a fixed frame, to which the chain, parent and velocity bounds
+    apply as to a chain rooted at the world (the same joints' coordinates, anchors and axes
+    at m; the rigid map X_WC(m) X_WC(t)^-1 is the identity at m). Poses (xpos, xmat) are
+    the world poses at m in every case. With no 2 in ``need`` the numbers are the absolute
+    bounds, bit for bit as before.
     ``ws``: the scratch arrays of :func:`bounds_workspace` (contents on entry do not matter:
     the arrays that must start at zero are zeroed here), so a caller that evaluates many
     sub-intervals allocates them once (issue 12, long windows: the ~20 allocations were
@@ -730,7 +747,7 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
     vang[:] = 0.0
     vrate[:] = 0.0
     for b in range(1, nbody):
-        if need[b] == 0 or mp.body_moving[b] == 0:
+        if need[b] != 1 or mp.body_moving[b] == 0:   # (need 2: a frozen base, see the docstring)
             continue
         for j in range(mp.body_jntadr[b], mp.body_jntadr[b] + mp.body_jntnum[b]):
             typ = mp.jnt_type[j]
@@ -796,10 +813,16 @@ def _bounds_core(mp, ta: float, tb: float, need: np.ndarray, xpos: np.ndarray, x
             trans[b] = 0.0
             angle[b] = 0.0
             continue
-        # Ancestors (moving) root-first.
+        if need[b] == 2:
+            # a frozen base: no motion relative to itself; the pads of a zero bound (below)
+            # still cover the rounding of its computed pose at m, as for any moving body
+            angle[b] = abs_pad if mp.body_rotating[b] != 0 else 0.0
+            trans[b] = abs_pad + scale_pad * scale
+            continue
+        # Ancestors (moving, below a frozen base) root-first.
         ns = 0
         c = b
-        while c != 0 and mp.body_moving[c] != 0:
+        while c != 0 and mp.body_moving[c] != 0 and need[c] != 2:
             stack[ns] = c
             ns += 1
             c = mp.body_parent[c]
@@ -897,7 +920,8 @@ def pair_workspace(mp):
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True, **NO_NRT)
 def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, RA_out: np.ndarray,
-               pB_out: np.ndarray, RB_out: np.ndarray, pws) -> tuple[float, float, float, float]:
+               pB_out: np.ndarray, RB_out: np.ndarray, pws,
+               relative: int) -> tuple[float, float, float, float]:
     """:func:`body_bound` of two bodies in ONE pass over the union of their chains.
 
     Returns (trans_a m, angle_a rad, trans_b, angle_b) and writes each body's pose at
@@ -909,6 +933,17 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
     bound depend only on its own ancestors (FK root first, the chain terms, the parent's
     bound), never on which other bodies are in ``need``; the union is closed under ancestors.
 
+    ``relative != 0`` (issue 12, hand30): when both bodies are given and their deepest common
+    ancestor C is not the world and moves, C and its ancestors are frozen at their poses at m
+    (:func:`_bounds_core`, ``need == 2``: C's own bound is then just the rounding pads of a zero
+    bound) and the bounds are those of the motion relative to C,
+    ``X_WC(m) X_WC(t)^-1 X_Wb(t)`` (C = ba or bb itself when one is the other's ancestor). That
+    map applies ONE rigid transform per time to both bodies, so the distance of any two points
+    of theirs at t is the one of the mapped points: a lower bound on the distance of the pair
+    from these bounds holds for the real motion (only distances of the pair may be derived from
+    them, not world positions). The poses written are the world poses at m, as before.
+    ``relative == 0``, or no such C: the absolute bounds (two ``body_bound`` calls' numbers).
+
     Compiled without reference counting (module docstring) and NOT inlined into its callers:
     numba's IR inlining binds the inlined parameters to new variables, and in a caller with
     reference counting each binding of ``mp`` and ``pws`` (25 arrays each) costs an
@@ -916,14 +951,20 @@ def pair_bound(mp, ba: int, bb: int, ta: float, tb: float, pA_out: np.ndarray, R
     """
     need, xpos, xmat, trans, angle, ws = pws
     need[:] = 0
+    base = 0                  # the deepest common ancestor: the first body of bb's path already marked
     for body in (ba, bb):
         if body >= 0:
             c = body
             while True:
+                if need[c] != 0:
+                    base = c
+                    break
                 need[c] = 1
                 if c == 0:
                     break
                 c = mp.body_parent[c]
+    if relative != 0 and ba >= 0 and bb >= 0 and base != 0 and mp.body_moving[base] != 0:
+        mark_ancestors(mp.body_parent, base, need, 2)
     _bounds_core(mp, ta, tb, need, xpos, xmat, trans, angle, ws)
     TA, angA, TB, angB = 0.0, 0.0, 0.0, 0.0
     if ba >= 0:
