@@ -32,6 +32,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
+
 _ULP = 2.0**-52
 
 

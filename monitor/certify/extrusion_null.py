@@ -74,10 +74,13 @@ import numpy as np
 from numba import njit
 from scipy.optimize import linprog, nnls
 
+from monitor._jit_cache import purge_if_changed
 from monitor.certify.common import Outcome
 from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
 from monitor.certify.extrusion_kernels import warm as _warm_kernels
 from monitor.tolerances import Tolerances
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
 _HIGHS_OPTIONS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10,
                   "presolve": True}

@@ -51,10 +51,13 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
 from monitor.certify.common import Outcome, PairOutcome
 from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
 from monitor.motion._kinematics import finite_velocities
 from monitor.tolerances import Tolerances
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
 SWEPT_MAX_POINTS = 1 << 15
 """At most this many swept difference points (``2 n_a n_b``) per span; larger pairs go to Python."""

@@ -31,7 +31,10 @@ import math
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
 from monitor.motion.kernel import _search_left, _search_right
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
 T_VF = 0
 T_EE = 1

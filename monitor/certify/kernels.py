@@ -90,6 +90,7 @@ import weakref
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
 from monitor.errors import MonitorError as _MonitorError
 from monitor.geometry._gjk import (
     OUT_SIZE,
@@ -111,6 +112,8 @@ from monitor.motion.kernel import (
     pair_bound,
     pair_workspace,
 )
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
 # ---------------------------------------------------------------------------- codes
 

@@ -40,6 +40,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
+
 _U = 2.0**-53
 """Unit roundoff of float64."""
 

@@ -73,6 +73,10 @@ import math
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
+
 
 def _no_nrt_option() -> dict[str, bool]:
     """``{"_nrt": False}`` when this numba has its private ``_nrt`` jit option, else ``{}``.

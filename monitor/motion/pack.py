@@ -25,12 +25,15 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from monitor._jit_cache import purge_if_changed
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.motion import _kinematics as K_
 from monitor.motion import kernel as KN
 from monitor.motion.base import MotionBounds
 from monitor.motion.bodymotion import BodyMotion
 from monitor.tolerances import DEFAULT, Tolerances
+
+purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
 _FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3
 
