@@ -14,9 +14,10 @@ distance), and the general tail of the engine for the kernel-decided shortcut.
 
 Attacks: C = one of the two bodies (parent-child), siblings and cousins under C, C with a hinge
 (3 rad yaw in one window), slide, ball or free joint, C welded under a moving root, offsets of
-1e4 m with tiny relative motion, non-unit joint axes, long windows (many waypoints), a plane on
-the moving base, the sweep (``engine.SWEEP_MIN_GEOMS = 0``), and windows with more than
-``CALL_TESTS`` whole-shape tests. The random fuzz (``_fuzz_case``) is behind ``slow``.
+1e4 m with tiny relative motion, non-unit joint axes, long windows (many waypoints), a world geom
+(its common ancestor with any body is the world; MuJoCo allows no plane on a moving body), the
+sweep (``engine.SWEEP_MIN_GEOMS = 0``), and windows with more than ``CALL_TESTS`` whole-shape tests.
+The random fuzz (``_fuzz_case``) is behind ``slow``.
 """
 
 from __future__ import annotations
@@ -490,3 +491,53 @@ def _geom_dist_at(m, times, q, witness) -> float:
     mujoco.mj_kinematics(m, d)
     a, b = (mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, g) for g in witness.geoms)
     return _geom_dist(m, d, a, b)
+
+
+
+_SWING_XML = """<mujoco><worldbody>
+  <body name="C" pos="{off} -1 0.4"><joint name="yaw" type="hinge" axis="0 0 1"/>
+    <body name="a"><joint name="ja" type="hinge" axis="0 0 2"/>
+      <geom name="sa" type="sphere" size="0.02" pos="0.3 0 0"/>
+      <geom name="sa2" type="sphere" size="0.02" pos="-0.3 0 0"/></body>
+    <body name="b"><geom name="sb" type="sphere" size="0.02" pos="{bx} {by} 0"/></body>
+  </body>
+</worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("off", [0.0, 1e4])
+@pytest.mark.parametrize("angle_b", [0.5, 0.8])
+def test_stage0_relative_sphere_of_a_geom_swinging_about_its_reference_point(off, angle_b):
+    """Stage 0's relative sphere must grow by chord(angle) * lever: body a's reference point is its
+    hinge (two spheres at +-0.3 m), so its relative translation bound is ~0 and all of sa's motion
+    (0.6 rad of swing on a 0.3 m arm while C yaws 3 rad) is rotation. sb sits on the arm's circle at
+    ``angle_b``: 0.5 rad (inside the swing: sa passes through it, closed-form minimum -0.04 m, while
+    at the window's middle the two are 0.0199 m apart) or 0.8 rad (outside: minimum 2 * 0.3 sin(0.1)
+    - 0.04 m at the window's end). A relative sphere without the rotation term culls the colliding
+    pair at the middle pose (a false certificate); the correct one keeps it."""
+    m = mujoco.MjModel.from_xml_string(_SWING_XML.format(off=off, bx=0.3 * math.cos(angle_b),
+                                                         by=0.3 * math.sin(angle_b)))
+    times = np.linspace(0.0, 0.2, 5)
+    s = times / times[-1]
+    q = np.stack([3.0 * s, 0.6 * s], axis=1)
+    truth = 2 * 0.3 * math.sin(0.5 * max(angle_b - 0.6, 0.0)) - 0.04
+    d = mujoco.MjData(m)
+    sa, sb = (mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in ("sa", "sb"))
+    sampled = []
+    for t in np.linspace(0.0, 0.2, 201):
+        d.qpos[:] = _oracle_qpos(m, times, q, t)
+        mujoco.mj_kinematics(m, d)
+        sampled.append(float(np.linalg.norm(d.geom_xpos[sa] - d.geom_xpos[sb])) - 0.04)
+    if angle_b < 0.6:
+        assert min(sampled) < 0.0, min(sampled)       # a real collision (and the closed form's -0.04)
+    else:
+        assert abs(min(sampled) - truth) < 1e-9, (min(sampled), truth)   # at the window's end
+    scene = monitor.Scene.from_model(m, pairs=[("sa", "sb")])
+    plan = monitor.Plan(times, q, m)
+    for margin in (max(truth - 1e-4, 0.0), max(truth + 1e-4, 0.0)):
+        cert = monitor.certify(scene, plan, margin=margin, epsilon=1e-5, method="toleranced",
+                               budget={"seconds": 60})
+        (p,) = cert.pairs
+        if truth < margin:
+            assert cert.verdict != "certified" and p.method != "culled", p
+        if cert.verdict == "certified":
+            assert p.clearance <= truth + 1e-12, (p, truth)
