@@ -27,6 +27,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
+from redteam_oracle import interp_qpos  # independent of monitor.Plan's interpolation
 
 import monitor
 from monitor.certify import engine
@@ -214,27 +215,8 @@ def _geom_dist(m, d, ga: int, gb: int) -> float:
 
 
 def _oracle_qpos(m, times, qpos, t) -> np.ndarray:
-    """Joint interpolation re-implemented (lerp; shortest-arc slerp for ball / free quaternions)."""
-    k = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
-    s = min(max((t - times[k]) / (times[k + 1] - times[k]), 0.0), 1.0)
-    a, b = qpos[k], qpos[k + 1]
-    q = a + s * (b - a)
-    for j in range(m.njnt):
-        adr, typ = int(m.jnt_qposadr[j]), int(m.jnt_type[j])
-        if typ > 1:
-            continue
-        sl = slice(adr + 3, adr + 7) if typ == 0 else slice(adr, adr + 4)
-        q0, q1 = a[sl] / np.linalg.norm(a[sl]), b[sl] / np.linalg.norm(b[sl])
-        c = float(q0 @ q1)
-        if c < 0:
-            q1, c = -q1, -c
-        th = math.acos(min(c, 1.0))
-        if th < 1e-12:
-            x = q0 + s * (q1 - q0)
-        else:
-            x = (math.sin((1 - s) * th) * q0 + math.sin(s * th) * q1) / math.sin(th)
-        q[sl] = x / np.linalg.norm(x)
-    return q
+    """The red-team oracle's own joint interpolation (lerp; shortest-arc slerp for ball / free)."""
+    return interp_qpos(m, np.asarray(times, float), qpos, float(t))
 
 
 def _sampled(m, times, qpos, pairs_ids, t0, t1, n) -> np.ndarray:
