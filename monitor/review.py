@@ -1280,7 +1280,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     valid but different from the ones used, a note); ``model.xml`` and ``model.mjb`` the
     same model; and the recomputed verdict equal to the logged one (certified <->
     not-certified flips are critical, except logged "uncertain" windows whose
-    ``stats["budget_exhausted"]`` is true).
+    ``stats["budget_exhausted"]`` is true or that re-derive as certified: those claimed less than
+    the checker proves now, a non-critical mismatch).
 
     Also critical: a ``request_id`` naming no logged request, a request id defined twice
     with different contents, a malformed request, an allowed pair whose Adjacent reason the
@@ -1571,6 +1572,12 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             budget = bool((c.get("stats") or {}).get("budget_exhausted")) and verdict == Verdict.UNCERTAIN
             if budget:  # the logged run ran out of its work budget: "uncertain" was the honest answer then
                 critical = False
+            # logged "uncertain", now certified: the log claimed less than the checker proves today
+            # (e.g. a newer monitor: red team 12 counted 2 151 such windows of 25 340 after the relative
+            # motion bounds). Not a safety flip: the gate acted on the weaker claim. Still a mismatch.
+            proves_more = verdict == Verdict.UNCERTAIN and new.verdict == Verdict.CERTIFIED
+            if proves_more:
+                critical = False
             out["critical"] += int(critical)
             logged = as_verdict(verdict) if verdict in VERDICTS else verdict  # unknown: already critical
             out["mismatches"].append({"index": k, "sim_time": c.get("sim_time"), "logged": logged,
@@ -1578,7 +1585,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                                       "logged_clearance": c.get("clearance"),
                                       "clearance": new.clearance if math.isfinite(new.clearance) else None,
                                       "witness": new.witness.to_dict() if new.witness else None,
-                                      "reason": "budget exhausted when logged" if budget else None})
+                                      "reason": "budget exhausted when logged" if budget else
+                                      "logged uncertain, certified now (the log claimed less)" if proves_more
+                                      else None})
     if unverifiable_after_edit:
         find(UNVERIFIABLE, f"{len(unverifiable_after_edit)} window(s) from index "
                            f"{unverifiable_after_edit[0]} were certified on a model edit the log does not "

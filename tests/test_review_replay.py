@@ -356,3 +356,25 @@ def test_writer_validates_rollouts(tmp_path):
         log.write_window(0.1, plan, c, rollout=(state, ((np.zeros(1), 5),), 0))
     plans = read_log(tmp_path / "w.mcap").topic(topics.PLAN)
     assert [p.get("source") for p in plans] == ["user", "rollout"]
+
+
+def test_a_window_logged_uncertain_that_certifies_now_is_a_non_critical_mismatch(bounce, tmp_path):
+    """A log may claim less than the checker proves now (a newer monitor: red team 12 counted 2 151 such
+    windows in 25 340 after the relative motion bounds). "uncertain" is always a sound answer and the
+    gate acted on it, so the flip is listed with its reason, not critical."""
+    path, _, _ = bounce
+    dst = tmp_path / "weaker.mcap"
+
+    def weaker(topic, o):
+        if topic == topics.CERTIFICATE and o.get("index") == 4:
+            assert o["verdict"] == "certified"
+            o = {**o, "verdict": "uncertain"}
+        return o
+
+    _forge(path, dst, msg=weaker)
+    code, ver = _verify(dst)
+    (m,) = ver["mismatches"]
+    assert (m["index"], m["logged"], m["recomputed"], m["critical"]) == (4, "uncertain", "certified", False)
+    assert "claimed less" in m["reason"]
+    assert ver["critical"] == 0 and not _findings(ver, "critical")
+    assert code == 0
