@@ -1,15 +1,17 @@
 """Cost of the per-step model checks, each alone (hot loop, plain timers), and their calls per step."""
 
-import timeit
 import collections
 import functools
+import timeit
+
 import gymnasium as gym
+
+import monitor.certify.kernels as KK
 import monitor.gate as G
 import monitor.gym_gate as GG
-import monitor.motion.plan as P
 import monitor.motion.pack as PK
+import monitor.motion.plan as P
 import monitor.scene as S
-import monitor.certify.kernels as KK
 from monitor.warmup import ensure_warm
 
 ensure_warm()

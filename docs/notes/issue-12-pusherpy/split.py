@@ -3,18 +3,20 @@
 Usage: PYTHONPATH=$PWD python docs/notes/issue-12-pusherpy/split.py wrap BLOCKS  (`nowrap`: loop only)
 """
 
+import functools
+import gc
+import statistics
 import sys
 import time
-import gc
-import functools
-import statistics
+
 import gymnasium as gym
-import monitor.motion.plan as P
-import monitor.motion.pack as PK
+
+import monitor.certify.engine as E
 import monitor.certify.kernels as KK
 import monitor.gate as G
 import monitor.gym_gate as GG
-import monitor.certify.engine as E
+import monitor.motion.pack as PK
+import monitor.motion.plan as P
 from monitor.gym_gate import SafetyGate
 from monitor.warmup import ensure_warm
 
@@ -22,8 +24,8 @@ ensure_warm()
 acc = {}
 
 
-def wrap(owner, name, label):
-    f = getattr(owner, name)
+def timed(f, label):
+    """``f`` with its thread time added to ``acc[label]``."""
 
     @functools.wraps(f)
     def w(*a, **k):
@@ -33,19 +35,14 @@ def wrap(owner, name, label):
         finally:
             acc[label] = acc.get(label, 0) + time.thread_time_ns() - t
 
+    return w
+
+
+def wrap(owner, name, label):
     if owner is P.Plan:  # a classmethod: keep it one
-        f0 = owner.__dict__[name].__func__
-
-        def wc(cls, *a, **k):
-            t = time.thread_time_ns()
-            try:
-                return f0(cls, *a, **k)
-            finally:
-                acc[label] = acc.get(label, 0) + time.thread_time_ns() - t
-
-        setattr(owner, name, classmethod(wc))
-        return
-    setattr(owner, name, w)
+        setattr(owner, name, classmethod(timed(owner.__dict__[name].__func__, label)))
+    else:
+        setattr(owner, name, timed(getattr(owner, name), label))
 
 
 targets = [
