@@ -154,7 +154,9 @@ def bind_caches(namespace: dict, stamp: str | None = None) -> int:
     and writes the caller's cache under the caller's unchanged file stamp; every later process
     then loads that stale code (red team 13). With the stamp of *all* kernel files, as this
     process saw them at its first kernel import, inside each index's source stamp, numba itself
-    ignores an index written by a process that saw other sources (its stamp check).
+    ignores an index written by a process that saw other sources (its stamp check), and the
+    data files carry the stamp in their names (no index of one source set pointing at a data file
+    another process overwrote with code of other sources).
 
     Args:
         namespace: a kernel module's ``globals()`` (call at the end of the module, before any
@@ -179,5 +181,10 @@ def bind_caches(namespace: dict, stamp: str | None = None) -> int:
             continue
         if not (isinstance(source, tuple) and len(source) == 3 and source[0] == STAMP_SUFFIX):
             cache_file._source_stamp = (STAMP_SUFFIX, source, stamp)
+            # data files named per stamp too: two processes that saw different sources and compile the
+            # same function at once cannot write the same data file under the other's index
+            pattern = getattr(cache_file, "_data_name_pattern", None)
+            if isinstance(pattern, str) and pattern.endswith(".{number:d}.nbc"):
+                cache_file._data_name_pattern = pattern[:-len("nbc")] + stamp[:16] + ".nbc"
         bound += 1
     return bound

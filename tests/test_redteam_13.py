@@ -106,3 +106,31 @@ def test_no_numba_function_escapes_the_kernel_file_list():
             first_kernel = re.search(r"^@njit", text, re.M).start()
             assert re.search(r"^purge_if_changed\(\)", text, re.M).start() < first_kernel, rel
             assert re.search(r"^bind_caches\(globals\(\)\)", text, re.M), rel
+
+
+def test_two_processes_compiling_under_different_sources_cannot_pair_index_and_data(tmp_path):
+    """numba's save writes the index then the data file. A process holding old kernels (stamp A) and
+    one holding new kernels (stamp B) compile the same function at once: B's index names data file 1,
+    then A overwrites data file 1 after B wrote it. A reader with stamp B must not get A's code
+    (fails on 8f3998d: both name their data ``<base>.1.nbc``)."""
+    import types
+
+    from numba.core.caching import IndexDataCacheFile
+
+    def kernel():
+        return None
+
+    def bound(stamp: str) -> IndexDataCacheFile:
+        cache_file = IndexDataCacheFile(str(tmp_path), "kernel.kernel-1.py3", ("src", 1.0, 10))
+        fake = types.SimpleNamespace(_cache=types.SimpleNamespace(_cache_file=cache_file), py_func=kernel)
+        if hasattr(J, "bind_caches"):
+            assert J.bind_caches({"__name__": kernel.__module__, "kernel": fake}, stamp) == 1
+        return cache_file
+
+    old, new = bound("a" * 64), bound("b" * 64)
+    key = ("sig", "target")
+    old._save_index({key: old._data_name(1)})  # A: index (its load saw nothing fresh)
+    new._save_index({key: new._data_name(1)})  # B: index, replaces A's
+    new._save_data(new._data_name(1), "code of the new kernels")
+    old._save_data(old._data_name(1), "code of the old kernels")  # A's data, last
+    assert new.load(key) in ("code of the new kernels", None)  # never the old code under the new index
