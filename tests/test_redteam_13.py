@@ -134,3 +134,24 @@ def test_two_processes_compiling_under_different_sources_cannot_pair_index_and_d
     new._save_data(new._data_name(1), "code of the new kernels")
     old._save_data(old._data_name(1), "code of the old kernels")  # A's data, last
     assert new.load(key) in ("code of the new kernels", None)  # never the old code under the new index
+
+
+def test_gate_predict_checks_nstep_like_the_gated_step():
+    """``Gate.predict`` is public and took ``int(nstep)``: 10**9 allocated (or ran) a 10**9-row rollout,
+    2.5 silently became 2 substeps, -3 a numpy ValueError (fails on 8f3998d). Now the typed error of
+    ``step`` / ``certify`` (MAX_WINDOW_STEPS)."""
+    import mujoco
+
+    from monitor.errors import InvalidInputError
+    from monitor.gate import MAX_WINDOW_STEPS, Gate
+
+    model = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body><joint name='j' type='hinge'/><geom size='.1'/></body></worldbody>"
+        "<actuator><motor joint='j'/></actuator></mujoco>")
+    data = mujoco.MjData(model)
+    gate = Gate(model)
+    for bad in (MAX_WINDOW_STEPS + 1, 10**9, 2.5, -3, 0, True, "3"):
+        with pytest.raises(InvalidInputError):
+            gate.predict(data, None, bad)
+    plan = gate.predict(data, None, 3)
+    assert len(plan.times) == 4 and data.time == 0.0  # 3 substeps, the live data untouched
