@@ -146,7 +146,8 @@ def test_gate_predict_checks_nstep_like_the_gated_step():
     from monitor.gate import MAX_WINDOW_STEPS, Gate
 
     model = mujoco.MjModel.from_xml_string(
-        "<mujoco><worldbody><body><joint name='j' type='hinge'/><geom size='.1'/></body></worldbody>"
+        "<mujoco><worldbody><body><joint name='j' type='hinge'/><geom size='.1'/></body>"
+        "<geom type='plane' size='1 1 .1' pos='0 0 -1'/></worldbody>"
         "<actuator><motor joint='j'/></actuator></mujoco>")
     data = mujoco.MjData(model)
     gate = Gate(model)
