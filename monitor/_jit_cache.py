@@ -47,6 +47,8 @@ STAMP_SUFFIX = ".monitor-kernels.stamp"
 """Name of the stamp file beside a kernel file's numba cache: ``<file stem>`` + this."""
 
 _done = False
+_stamp: str | None = None
+"""This process's stamp of the kernel files (taken by :func:`purge_if_changed`), or None before it."""
 
 
 def sources_stamp(root: Path, files: tuple[str, ...] = KERNEL_FILES) -> str:
@@ -131,12 +133,58 @@ def purge_stale(root: Path, files: tuple[str, ...] = KERNEL_FILES,
 
 def purge_if_changed() -> list[str]:
     """:func:`purge_stale` for this package, once per process (later calls return [])."""
-    global _done
+    global _done, _stamp
     if _done:
         return []
     _done = True
     try:
-        return purge_stale(Path(__file__).resolve().parent)
+        root = Path(__file__).resolve().parent
+        _stamp = sources_stamp(root)
+        return purge_stale(root)
     except Exception as exc:  # noqa: BLE001 - never break the import over the cache
         warnings.warn(f"monitor could not check its numba cache for stale kernels: {exc}", stacklevel=2)
         return []
+
+
+def bind_caches(namespace: dict, stamp: str | None = None) -> int:
+    """Fold the kernel files' stamp into numba's source stamp of each cached function of a module.
+
+    The purge alone misses one race: a process that imported the old sources (its callees' old
+    code in memory) compiles a caller after another process purged and stamped the new sources,
+    and writes the caller's cache under the caller's unchanged file stamp; every later process
+    then loads that stale code (red team 13). With the stamp of *all* kernel files, as this
+    process saw them at its first kernel import, inside each index's source stamp, numba itself
+    ignores an index written by a process that saw other sources (its stamp check), and the
+    data files carry the stamp in their names (no index of one source set pointing at a data file
+    another process overwrote with code of other sources).
+
+    Args:
+        namespace: a kernel module's ``globals()`` (call at the end of the module, before any
+            kernel runs); functions imported from other modules are left to their own module.
+        stamp: the stamp to bind (default: this process's, from :func:`purge_if_changed`).
+
+    Returns:
+        how many functions were bound.
+    """
+    stamp = _stamp if stamp is None else stamp
+    if stamp is None:
+        return 0
+    name = namespace.get("__name__")
+    bound = 0
+    for obj in list(namespace.values()):
+        cache_file = getattr(getattr(obj, "_cache", None), "_cache_file", None)
+        py_func = getattr(obj, "py_func", None)
+        if cache_file is None or py_func is None or getattr(py_func, "__module__", None) != name:
+            continue
+        source = getattr(cache_file, "_source_stamp", None)
+        if source is None:
+            continue
+        if not (isinstance(source, tuple) and len(source) == 3 and source[0] == STAMP_SUFFIX):
+            cache_file._source_stamp = (STAMP_SUFFIX, source, stamp)
+            # data files named per stamp too: two processes that saw different sources and compile the
+            # same function at once cannot write the same data file under the other's index
+            pattern = getattr(cache_file, "_data_name_pattern", None)
+            if isinstance(pattern, str) and pattern.endswith(".{number:d}.nbc"):
+                cache_file._data_name_pattern = pattern[:-len("nbc")] + stamp[:16] + ".nbc"
+        bound += 1
+    return bound

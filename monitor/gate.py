@@ -1533,8 +1533,12 @@ class Gate:
         return len(self.scene.pair_ids)
 
     def predict(self, data: mujoco.MjData, ctrl: np.ndarray | None, nstep: int | None = None) -> Any:
-        """The plan of the next window under ``ctrl`` (the configured predictor)."""
-        n = self.frame_skip if nstep is None else int(nstep)
+        """The plan of the next window under ``ctrl`` (the configured predictor).
+
+        Raises:
+            InvalidInputError: ``nstep`` is not an integer in [1, :data:`MAX_WINDOW_STEPS`].
+        """
+        n = self.frame_skip if nstep is None else _check_nstep(nstep, "nstep")
         if callable(self.predictor):
             return self.predictor(data, ctrl, n)
         return self._rollout.plan(data, ctrl, n)

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 
 purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
@@ -519,3 +519,6 @@ def warm() -> None:
 
 
 __all__ = ["min_norm_kernel", "first_time_kernel", "warm"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

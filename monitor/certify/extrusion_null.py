@@ -74,7 +74,7 @@ import numpy as np
 from numba import njit
 from scipy.optimize import linprog, nnls
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 from monitor.certify.common import Outcome
 from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
 from monitor.certify.extrusion_kernels import warm as _warm_kernels
@@ -701,3 +701,6 @@ __all__ = ["Leaf", "NullResult", "slack_lower", "small_slack_lp", "warm_small_lp
            "dual_certificate", "lp_earliest", "min_norm", "min_norm_reference", "static_distance",
            "quadratic_null_test", "quadratic_first_time", "quadratic_first_time_bisection",
            "halfspace_null_test"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

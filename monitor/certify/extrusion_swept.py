@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 from monitor.certify.common import Outcome, PairOutcome
 from monitor.certify.extrusion_kernels import first_time_kernel, min_norm_kernel
 from monitor.motion._kinematics import finite_velocities
@@ -500,3 +500,6 @@ def warm() -> None:
 
 
 __all__ = ["swept_pair_kernel", "halfspace_pair_kernel", "decide_pair", "warm", "SWEPT_MAX_POINTS"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 from monitor.motion.kernel import _search_left, _search_right
 
 purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
@@ -733,3 +733,6 @@ def _norm(x, y, z):
 
 
 __all__ = ["fat_level", "traj_balls", "screw_poses_bounds", "T_VF", "T_EE", "T_FE", "T_EF", "T_VH"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

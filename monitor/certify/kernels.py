@@ -90,7 +90,7 @@ import weakref
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 from monitor.errors import MonitorError as _MonitorError
 from monitor.geometry._gjk import (
     OUT_SIZE,
@@ -2270,3 +2270,6 @@ __all__ = ["CERTIFIED", "VIOLATION", "UNRESOLVED", "PAUSED", "UNSUPPORTED", "MOD
            "posed_distance", "interval_bound", "pair_window", "pairs_window", "new_result", "R_SIZE",
            "check_pair_window", "whole_shape_stage", "window_kernel", "sphere_gap", "scene_pack",
            "trajectory_pack", "trajectory_pack_memo"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 
 purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
@@ -1047,3 +1047,6 @@ def halfspace_distance(nH, bH, RH, tH, PC, RC, tC, rel_pad, abs_pad, out):
         out[4 + r] = pb[r] - max(dist, 0.0) * n[r] / nn
     out[10] = pad
     out[11] = 0
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

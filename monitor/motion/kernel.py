@@ -73,7 +73,7 @@ import math
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 
 purge_if_changed()  # before any cached kernel of this package loads (see monitor._jit_cache)
 
@@ -1143,3 +1143,6 @@ def derive(qpos: np.ndarray, body_parent: np.ndarray, body_mocap: np.ndarray, bo
                         rt = 1
         moving[b] = mv
         rotating[b] = rt
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)

@@ -25,7 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from monitor._jit_cache import purge_if_changed
+from monitor._jit_cache import bind_caches, purge_if_changed
 from monitor.errors import InvalidInputError, UnsupportedGeometryError
 from monitor.motion import _kinematics as K_
 from monitor.motion import kernel as KN
@@ -625,3 +625,6 @@ def body_poses(mp: MotionPack, times: object) -> tuple[np.ndarray, np.ndarray]:
 
 __all__ = ["MotionPack", "body_poses", "pack_trajectory", "plan_data_agrees", "poses_and_bounds",
            "probe_plan", "static_key"]
+
+
+bind_caches(globals())  # numba ignores caches written under other kernel sources (see monitor._jit_cache)
