@@ -700,7 +700,12 @@ def _search_workspace(gp, mp):
             np.empty((5, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((4, n)))
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+# Not inlined (issue 12, cold compile; docs/notes/issue-12-coldtrim.md): compiled once and called
+# by window_kernel and pair_window. Inlined, its whole body (with the ~20-array workspace tuple)
+# was re-typed and re-lowered inside window_kernel. Reference counting stays on: numba hands a
+# caller's "no reference counting" down to callees compiled first from it, and several callees
+# here allocate (body_pose, core_distance, _path_profile).
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _pair_search(gp, mp, ga, gb, t0, t1, margin, epsilon, max_depth, max_tests, mode, rel_pad, abs_pad,
                  stack, res, sw):
     """Decide geom pair (ga, gb) of ``gp`` over [t0, t1] of motion ``mp`` (see module docstring).
