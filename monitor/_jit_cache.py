@@ -11,7 +11,7 @@ whole-shape stage instead; ``docs/notes/session-2026-11-28-night.md``). Nothing 
 stale kernel errs on the safe side, so the package does not rely on it.
 
 :func:`purge_if_changed` (called once per process, by the first kernel module imported) computes one stamp
-over every kernel file (:data:`KERNEL_FILES`: path, modification time in ns, size) and
+over every kernel file (:data:`KERNEL_FILES`: path, modification time in ns, size, content hash) and
 compares it with the stamp stored beside each file's numba cache; where they differ, that
 file's ``.nbi`` / ``.nbc`` files are deleted and the stamp is written. Editing any kernel file
 thus recompiles every kernel once (~50 s of CPU on this project's machine): the price of never
@@ -52,12 +52,20 @@ _stamp: str | None = None
 
 
 def sources_stamp(root: Path, files: tuple[str, ...] = KERNEL_FILES) -> str:
-    """One hex digest over (relative path, mtime ns, size) of ``files`` under ``root`` (missing ones too)."""
+    """One hex digest over (relative path, mtime ns, size, content) of ``files`` under ``root``.
+
+    The content's SHA-256 is in it because numba's own check (modification time and size) misses
+    an edit that keeps both: a one-digit constant changed in a file copied with its old time
+    (``cp -p``, ``rsync -t``, an archive or a wheel with fixed timestamps). Reading and hashing the
+    ~350 kB of kernel sources costs well under a millisecond, once per process.
+    """
     h = hashlib.sha256()
     for rel in files:
         try:
-            st = os.stat(root / rel)
-            h.update(f"{rel}\0{st.st_mtime_ns}\0{st.st_size}\n".encode())
+            with open(root / rel, "rb") as f:
+                st = os.fstat(f.fileno())
+                content = hashlib.sha256(f.read()).hexdigest()
+            h.update(f"{rel}\0{st.st_mtime_ns}\0{st.st_size}\0{content}\n".encode())
         except OSError:
             h.update(f"{rel}\0missing\n".encode())
     return h.hexdigest()

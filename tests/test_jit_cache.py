@@ -65,6 +65,22 @@ def test_a_changed_kernel_file_drops_every_kernel_files_cache_once(tmp_path):
     assert not (cache / "k1.f-10.py311.1.nbc").exists() and not (cache / "k2.g-3.py311.nbi").exists()
 
 
+def test_an_edit_that_keeps_mtime_and_size_still_drops_the_caches(tmp_path):
+    """numba's own check (mtime, size) misses this edit; the stamp's content hash does not."""
+    root, cache, files = _tree(tmp_path)
+    find = lambda py_file: cache  # noqa: E731
+    J.purge_stale(root, files, find)
+    made = _fill(cache)
+    assert J.purge_stale(root, files, find) == []
+    f = root / files[0]
+    st = os.stat(f)
+    f.write_text("x = 2\n")                       # one digit: same size
+    os.utime(f, ns=(st.st_atime_ns, st.st_mtime_ns))  # the old time, as ``cp -p`` would leave it
+    assert os.stat(f).st_size == st.st_size and os.stat(f).st_mtime_ns == st.st_mtime_ns
+    assert J.purge_stale(root, files, find) == list(files)
+    assert not any(p.exists() for p in made[:3])
+
+
 def test_no_cache_directory_is_not_an_error(tmp_path):
     root, _, files = _tree(tmp_path)
     assert J.purge_stale(root, files, lambda py_file: None) == []
