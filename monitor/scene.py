@@ -92,6 +92,7 @@ from monitor.geometry.polytope import (
     sphere_shape,
 )
 from monitor.geometry.shapes import ConvexShape
+from monitor.motion.base import sealed
 from monitor.pairsel import object_names
 from monitor.tolerances import DEFAULT, Tolerances
 
@@ -483,6 +484,14 @@ def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape
     raise UnsupportedGeometryError(f"geom {g} has unknown type {name!r}")
 
 
+def _sealed_once(arr: np.ndarray) -> np.ndarray:
+    """``arr`` if it already lies over immutable ``bytes``, else a sealed copy."""
+    base = arr
+    while isinstance(base, np.ndarray):
+        base = base.base
+    return arr if isinstance(base, bytes) and not arr.flags.writeable else sealed(np.ascontiguousarray(arr))
+
+
 class Scene:
     """Convex shapes of every geom of an ``MjModel`` plus the pairs to certify.
 
@@ -511,8 +520,11 @@ class Scene:
     def __init__(self, model: Any, geoms: tuple[GeomInfo, ...], pair_ids: np.ndarray,
                  body_names: tuple[str, ...], body_static: np.ndarray, facets: int,
                  tolerances: Tolerances, *, pairs_sorted: bool = False):
-        pair_ids.setflags(write=False)
-        body_static.setflags(write=False)
+        # sealed over immutable bytes (a copy, once per build): the engine caches the scene's packs by
+        # the identity of these arrays, and a read-only array that owns its memory can be made
+        # writable again and edited under the cache (red team 10's open item)
+        pair_ids = _sealed_once(pair_ids)
+        body_static = _sealed_once(body_static)
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
@@ -545,6 +557,16 @@ class Scene:
         state = self.__dict__.copy()
         state["_hot"] = {}
         return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Unpickle, sealing ``pair_ids`` and ``body_static`` again (unpickled arrays are writable)."""
+        state = dict(state)
+        for name in ("pair_ids", "body_static"):
+            if isinstance(state.get(name), np.ndarray):
+                state[name] = _sealed_once(state[name])
+        if state.get("_sorted_pairs") is not None:
+            state["_sorted_pairs"] = state["pair_ids"]
+        self.__dict__.update(state)
 
     # ------------------------------------------------------------------ model edits
 

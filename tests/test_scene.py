@@ -824,3 +824,40 @@ def test_from_model_pairs_are_in_strict_order(seed):
     for scene in scenes:
         assert _strictly_increasing(scene.pair_ids) and scene._sorted_pairs is scene.pair_ids
     assert len(scenes[2].pair_ids) == 30 and len(scenes[3].pair_ids) < len(every)
+
+
+_SEALED_XML = """<mujoco><worldbody>
+<geom name="wall" type="box" size="0.02 0.5 0.5" pos="0.3 0 0"/>
+<geom name="far" type="box" size="0.02 0.5 0.5" pos="-3 0 0"/>
+<body name="ball"><joint name="x" type="slide" axis="1 0 0"/><geom name="b" type="sphere" size="0.1"/></body>
+</worldbody></mujoco>"""
+
+
+def test_pair_ids_and_body_static_cannot_be_edited_under_the_engines_caches():
+    """Red team 10's open item: the engine caches a scene's packs by the identity of ``pair_ids``; a
+    read-only array that owns its memory could be made writable again and edited in place, and the
+    next certify answered from the pack of the old pairs. The oracle: the same motion through the
+    wall, certified on a fresh scene holding the edited pair, is a violation."""
+    from monitor import Plan, certify
+
+    model = mujoco.MjModel.from_xml_string(_SEALED_XML)
+    scene = Scene.from_model(model, pairs=[("b", "far")])
+    through = Plan([0.0, 1.0], [[0.0], [0.5]], model)          # the ball ends inside the wall
+    assert str(certify(scene, through).verdict) == "certified"  # only ball-vs-far is asked
+    fresh = Scene.from_model(model, pairs=[("b", "wall")])
+    assert str(certify(fresh, through).verdict) == "violation"
+    for arr in (scene.pair_ids, scene.body_static):
+        for owner in (arr, arr.base):
+            if isinstance(owner, np.ndarray):
+                try:
+                    owner.setflags(write=True)
+                except ValueError:
+                    continue
+                if arr is scene.pair_ids and arr.flags.writeable:  # the edit went through: it must count
+                    arr[0] = fresh.pair_ids[0]
+                    assert str(certify(scene, through).verdict) != "certified"
+    assert not scene.pair_ids.flags.writeable and not scene.body_static.flags.writeable
+    again = __import__("pickle").loads(__import__("pickle").dumps(scene))
+    assert not again.pair_ids.flags.writeable and not again.body_static.flags.writeable
+    with pytest.raises(ValueError):
+        again.pair_ids.setflags(write=True)
