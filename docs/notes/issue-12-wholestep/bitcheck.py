@@ -5,7 +5,8 @@ Usage: PYTHONPATH=$PWD python docs/notes/issue-12-wholestep/bitcheck.py [tunnel_
 Drives the real gate (tunnel: the bench's controller, ``Gate.step``; Pusher: ``SafetyGate`` with
 seeded ``action_space.sample()``), and before every step computes the step's rows twice from the
 live data: with an independent ``Rollout`` (``_window``, then ``brake_rows(..., window_fresh=True)``
-with ``hold_ctrl``, the gate's own sequence) and with ``cmj.Physics.run`` (one compiled call). The
+with ``hold_ctrl``, the gate's own sequence), with ``cmj.Physics.run`` (one compiled call) and with
+``cmj.Physics.run_bindings`` (the same C calls through the bindings, a lean Python loop). The
 window rows, the tail rows (same length) and the brake control must be equal as bytes.
 """
 from __future__ import annotations
@@ -24,10 +25,12 @@ def compare(m, d, ctrl, nstep, gate, ref: Rollout, proto: Physics, h):
     w_ref = ref._window(d, ctrl, nstep)
     t_ref, brake = ref.brake_rows(d, ctrl, nstep, lambda s: hold_ctrl(m, s), gate.brake_steps,
                                   gate.brake_vel_tol, window_fresh=True)
-    w, t, status = proto.run(d, np.asarray(ctrl, dtype=np.float64))
-    assert status == 0, status
-    ok = (w.tobytes() == w_ref.tobytes() and t.shape == t_ref.shape and t.tobytes() == t_ref.tobytes()
-          and proto.t.ctrl.tobytes() == brake.tobytes())
+    ok = True
+    for run in (proto.run, proto.run_bindings):  # compiled ctypes calls, then the same calls via the bindings
+        w, t, status = run(d, np.asarray(ctrl, dtype=np.float64))
+        assert status == 0, status
+        ok &= (w.tobytes() == w_ref.tobytes() and t.shape == t_ref.shape and t.tobytes() == t_ref.tobytes()
+               and proto.t.ctrl.tobytes() == brake.tobytes())
     h.update(w.tobytes())
     h.update(t.tobytes())
     return ok, len(t) - 1

@@ -148,6 +148,46 @@ class Physics:
         self.views = (self.s.ctrl, self.t.ctrl, self.s.warning.number[UNSTABLE],
                       self.t.warning.number[UNSTABLE])
 
+    def run_bindings(self, data, ctrl):
+        """The same C calls as :func:`physics`, each through the Python bindings (errors -> FatalError).
+
+        A lean Python loop (no rollout object, no bytes keys): what the physics costs when it stays on
+        the bindings' error-safe path. The hold control and the stop test run in numpy / Python floats.
+        """
+        m, s, t = self.m, self.s, self.t
+        key, end, win, tail = self.key, self.end, self.win, self.tail
+        nq = m.nq
+        mujoco.mj_getState(m, data, key, INTEGRATION)
+        mujoco.mj_copyData(s, m, data)
+        s_ctrl, t_ctrl, s_warn, t_warn = self.views
+        s_ctrl[:] = ctrl
+        win[0] = key[:1 + nq]
+        w0 = s_warn.tobytes()
+        for k in range(1, self.nstep + 1):
+            mujoco.mj_step(m, s)
+            mujoco.mj_getState(m, s, win[k], WINDOW_ROW)
+        if s_warn.tobytes() != w0:
+            return win, tail[:0], 1
+        mujoco.mj_normalizeQuat(m, win[0, 1:])
+        mujoco.mj_getState(m, s, end, INTEGRATION)
+        mujoco.mj_setState(m, t, end, INTEGRATION)
+        a, adr, gain0, bias0, bias1, gear0, lo, hi, lim, max_steps, vel_tol = self.args_tail
+        t_ctrl[:] = 0.0
+        for j in range(a.shape[0]):
+            i = a[j]
+            if gain0[i] != 0.0 and bias1[i] != 0.0:
+                t_ctrl[i] = -(bias0[i] + bias1[i] * (gear0[i] * end[1 + adr[j]])) / gain0[i]
+        np.clip(t_ctrl, lo, hi, out=t_ctrl, where=lim)
+        tail[0] = end[:tail.shape[1]]
+        t_warn[:] = 0
+        k = 0
+        for k in range(1, max_steps + 1):
+            mujoco.mj_step(m, t)
+            mujoco.mj_getState(m, t, tail[k], TAIL_ROW)
+            if np.abs(tail[k, 1 + nq:]).max() <= vel_tol:
+                break
+        return win, tail[:k + 1], 2 if t_warn.any() else 0
+
     def run(self, data, ctrl):
         k, status = physics(self.m._address, data._address, self.s._address, self.t._address, ctrl,
                             *self.views, self.m.nq, self.nstep, *self.args_tail, self.key, self.end,

@@ -33,7 +33,7 @@ def main():
     PT.install()
     _, _, _, recs = (PT.record_tunnel if which == "tunnel" else PT.record_pusher)(steps)
     by = defaultdict(list)
-    for _, _, calls, _ in recs:
+    for _, _, calls, *_ in recs:
         for disp, a in calls:
             by[disp.py_func.__name__].append((disp, a))
     print(f"{which}: {len(recs)} steps")

@@ -15,6 +15,8 @@ Usage: PYTHONPATH=$PWD:$PWD/docs/notes/issue-12-wholestep python docs/notes/issu
    * ``ungated_c``: the same ``nstep`` ``mj_step`` calls from one compiled call (``cmj.step_n``);
    * ``gate_physics``: the gate's own ``Rollout._window`` + ``Rollout.brake_rows`` (hold_ctrl);
    * ``a``: ``cmj.Physics.run`` (window + tail in one compiled call);
+   * ``a_bind``: the same C calls as ``a`` through the bindings, in a lean Python loop
+     (``cmj.Physics.run_bindings``: MuJoCo errors stay ``FatalError``);
    * ``b_pack`` / ``b_cert``: the step's recorded kernel calls replayed from Python, the pack's
      ``_derive_and_scale`` / every other kernel (stage 0 ``window_kernel``, extrusion
      ``swept_pair_kernel``, witness ``core_distance``, ...), each on fresh copies of its arguments
@@ -167,7 +169,7 @@ def main():
     print(f"{which}: {len(recs)} steps; kernel calls per step: "
           + ", ".join(f"{k} {v / len(recs):.2f}" for k, v in sorted(names.items(), key=lambda kv: -kv[1])))
     maddr, daddr = m._address, d._address
-    variants = ["ungated", "ungated_c", "gate_physics", "a", "b_pack", "b_cert", "ab", "shell"]
+    variants = ["ungated", "ungated_c", "gate_physics", "a", "a_bind", "b_pack", "b_cert", "ab", "shell"]
     if which == "pusher":
         variants.append("env_step")
     per_round = defaultdict(list)
@@ -199,6 +201,10 @@ def main():
         if v == "a":
             t0 = ns()
             proto.run(d, ctrl)
+            return ns() - t0, 0
+        if v == "a_bind":
+            t0 = ns()
+            proto.run_bindings(d, ctrl)
             return ns() - t0, 0
         if v == "b":
             tp = tc = 0
@@ -236,7 +242,7 @@ def main():
         return ns() - t0, 0
 
     env_plain = None
-    passes = ("ungated", "ungated_c", "gate_physics", "a", "b", "ab", "shell")
+    passes = ("ungated", "ungated_c", "gate_physics", "a", "a_bind", "b", "ab", "shell")
     if which == "pusher":
         import gymnasium as gym
         env_plain = gym.make("Pusher-v5")
