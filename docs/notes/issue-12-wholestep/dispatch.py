@@ -3,8 +3,11 @@
 Usage: PYTHONPATH=$PWD python docs/notes/issue-12-wholestep/dispatch.py CALLS ROUNDS
 
 Interleaved blocks (order rotated per round): a compiled no-op called with k float64 arrays of shape (3,)
-(k = 1, 4, 8, 16, 26), a no-op with one int64 scalar, and one ``mujoco.mj_step`` on the tunnel scene
-through the bindings (the ungated step there). Medians over ROUNDS of the per-call mean (µs).
+(k = 1, 4, 8, 16, 26), a no-op with one int64 scalar, one ``mujoco.mj_step`` on the tunnel scene
+through the bindings (the ungated step there), and ``shell``: the Python a whole-step ``Gate.step``
+keeps around one compiled call (cast a list ctrl, shape check, a no-op call with the ctrl and 4
+workspace arrays, status test, a ``__slots__`` report, two stats increments).
+Medians over ROUNDS of the per-call mean (µs).
 """
 from __future__ import annotations
 
@@ -57,7 +60,32 @@ def main():
             mujoco.mj_step(m, d)
         return (ns() - t) / calls / 1e3
 
-    blocks = {"mj_step (tunnel)": step, "noop(int)": scalar,
+    class Report:
+        __slots__ = ("verdict", "applied", "rows")
+
+        def __init__(self, verdict, applied, rows):
+            self.verdict, self.applied, self.rows = verdict, applied, rows
+
+    stats = {"windows": 0, "certified": 0}
+    ws = arrays[:4]
+
+    def shell():
+        """The Python a whole-step Gate.step keeps: cast, shape, one 4-array call, status, report, stats."""
+        ctrl = [0.5]
+        t = ns()
+        for _ in range(calls):
+            c = np.asarray(ctrl, dtype=np.float64)
+            if c.shape != (1,):
+                raise ValueError("shape")
+            status = noop(c, *ws)
+            if status:
+                raise RuntimeError("not handled")
+            Report("certified", c, ws[0])
+            stats["windows"] += 1
+            stats["certified"] += 1
+        return (ns() - t) / calls / 1e3
+
+    blocks = {"mj_step (tunnel)": step, "noop(int)": scalar, "shell (5 arrays)": shell,
               **{f"noop({k} arrays)": noop_k(k) for k in (1, 4, 8, 16, 26)}}
     names = list(blocks)
     res = {n: [] for n in names}
