@@ -1848,7 +1848,8 @@ def _render_signature(sig: dict[str, Any] | None, lines: list[str], findings: bo
     if not sig or (sig.get("status") == "unsigned" and not sig.get("key_id")):
         return
     unsigned = sig.get("unsigned_windows") or []
-    head = f"   signature: {sig['status']} (log key id {sig.get('log_key_id') or '-'}, key given {sig.get('key_id') or '-'})"
+    head = (f"   signature: {sig['status']} (log key id {sig.get('log_key_id') or '-'}, key given "
+            f"{sig.get('key_id') or '-'})")
     if sig.get("key_id") is None:
         lines.append(f"{head}: {sig.get('checkpoints', 0)} checkpoint(s), not checked")
     else:

@@ -11,6 +11,7 @@ split after a made-up state; a predictor relabel) are rebuilt as in
 
 from __future__ import annotations
 
+import hmac
 import json
 import shutil
 import types
@@ -23,7 +24,6 @@ from test_log_digest import XML, seal_copy
 from test_review_applied import _arm_run
 from test_review_replay import BOUNCE, INTEGRATION, _recertified
 
-from monitor import review
 from monitor.certify.certificate import Certificate, PairResult
 from monitor.cli import main
 from monitor.errors import LogKeyError
@@ -57,7 +57,8 @@ def _review(*args, capsys):
 
 def _window(log, model, k):
     t0 = 0.01 * k
-    plan = types.SimpleNamespace(times=np.array([t0, t0 + 0.01]), qpos=np.tile(model.qpos0, (2, 1)), model=model)
+    plan = types.SimpleNamespace(times=np.array([t0, t0 + 0.01]), qpos=np.tile(model.qpos0, (2, 1)),
+                                 model=model)
     pr = PairResult(("floor", "g"), ("world", "b"), "certified", "toleranced", 1, 0, (), 0.9, None)
     log.write_window(t0, plan, Certificate("certified", (t0, t0 + 0.01), 0.0, 1e-3, "auto", None, None, 0.9,
                                            (pr,), {}))
@@ -83,10 +84,17 @@ def test_a_signed_log_verifies_with_its_key_only(tmp_path, index):
     c = read_log(path)
     assert c.run["signature"]["key_id"] == key_id(KEY)
     ok = check_signatures(c, KEY)
-    assert (ok.status, ok.valid, ok.checkpoints, ok.signed_windows, ok.signed_close) == ("verified", 7, 7, 5, True)
+    assert (ok.status, ok.valid, ok.checkpoints, ok.signed_windows) == ("verified", 7, 7, 5)  # open, 5, close
+    assert ok.signed_close
     assert not ok.critical and not ok.unverifiable
     bad = check_signatures(c, OTHER_KEY)
     assert bad.status == "wrong_key" and bad.critical and bad.unsigned_windows == [0, 1, 2, 3, 4]
+    final = c.signatures[-1]  # its HMAC by the standard library's one-shot, over the documented input
+    f = final.payload
+    text = "|".join(str(f[k]) for k in ("algorithm", "key_id", "checkpoint", "windows", "messages", "attachments",
+                                           "metadata")) + "|1"
+    assert f["final"] is True and f["mac"] == hmac.digest(KEY, b"monitor-log-signature/1\0" + text.encode() + b"\0"
+                                                          + final.chain, "sha256").hex()
     none = check_signatures(c, None)
     assert none.status == "not_checked" and not none.critical
     assert any(n.startswith("signature not checked: no key") for n in none.notes)
@@ -120,8 +128,8 @@ def test_review_cli_codes_for_a_killed_and_a_forged_scripted_log(tmp_path, key_f
     forged = tmp_path / "forged.mcap"
     seal_copy(tmp_path / "full.mcap", forged, edit=None)
     tmp = tmp_path / "edited.mcap"
-    rewrite(forged, tmp, msg=lambda t, o: {**o, "clearance": 0.5} if t == topics.CERTIFICATE and o["index"] == 1
-            else o)
+    rewrite(forged, tmp, msg=lambda t, o: {**o, "clearance": 0.5}
+            if t == topics.CERTIFICATE and o["index"] == 1 else o)
     seal_copy(tmp, forged)
     code, entry = _review("--key-file", key_file, forged, capsys=capsys)
     sig = entry["signature"]
@@ -131,7 +139,7 @@ def test_review_cli_codes_for_a_killed_and_a_forged_scripted_log(tmp_path, key_f
 def test_a_sealed_log_without_its_signed_close_or_with_records_after_it_is_critical(tmp_path):
     src = tmp_path / "a.mcap"
     _scripted(src)
-    cut = tmp_path / "cut.mcap"  # the final checkpoint dropped, the log re-sealed: a claimed close, not signed
+    cut = tmp_path / "cut.mcap"  # final checkpoint dropped, log re-sealed: a close claimed, not signed
     n = [0]
 
     def drop_final(topic, o):
@@ -223,7 +231,8 @@ def test_the_environment_key_file_signs_and_an_unsigned_log_fails_with_a_key(tmp
     code, entry = _review(unsigned, capsys=capsys)  # no key anywhere: as before signing existed
     assert code == 0 and entry["signature"]["status"] == "unsigned" and not entry["signature"]["notes"]
     code, entry = _review("--key-file", key_file, unsigned, capsys=capsys)
-    assert code == 1 and any("authenticity cannot be established" in t for t in entry["signature"]["critical"])
+    assert code == 1
+    assert any("authenticity cannot be established" in t for t in entry["signature"]["critical"])
     monkeypatch.setenv(KEY_FILE_ENV, str(key_file))
     signed = tmp_path / "s.mcap"
     log = _scripted(signed, key=None)
@@ -237,11 +246,17 @@ def test_the_environment_key_file_signs_and_an_unsigned_log_fails_with_a_key(tmp
 # --------------------------------------------------------------------------- real gate runs
 
 
-def test_a_signed_safety_gate_run_passes_review_verify_with_the_key(tmp_path, key_file, monkeypatch, capsys):
-    monkeypatch.setenv(KEY_FILE_ENV, str(key_file))  # SafetyGate(log=path) takes the key from the environment
+@pytest.mark.parametrize("how", ["environment", "user_log"])
+def test_a_signed_safety_gate_run_passes_review_verify_with_the_key(tmp_path, key_file, monkeypatch, capsys,
+                                                                    how):
     path = tmp_path / "arm.mcap"
-    _arm_run(path, steps=4)
-    monkeypatch.delenv(KEY_FILE_ENV)
+    if how == "environment":  # SafetyGate(log=path) takes the key from the environment
+        monkeypatch.setenv(KEY_FILE_ENV, str(key_file))
+        _arm_run(path, steps=4)
+        monkeypatch.delenv(KEY_FILE_ENV)
+    else:  # the user's own signed MonitorLog (the gate does not close it)
+        with MonitorLog(path, key=KEY) as log:
+            _arm_run(log, steps=4)
     code, entry = _review("--verify", "--key-file", key_file, path, capsys=capsys)
     sig = entry["verify"]["signature"]
     assert code == 0, entry["verify"]["findings"]
@@ -257,7 +272,8 @@ def signed_bounce(tmp_path_factory):
     model = mujoco.MjModel.from_xml_string(BOUNCE)
     d = mujoco.MjData(model)
     d.qpos[0], d.qvel[0] = -0.25, 1.0  # as test_review_replay._bounce_log
-    with Gate(model, log=path, frame_skip=50, allowed=None, on_violation="warn", log_options={"key": KEY}) as g:
+    with Gate(model, log=path, frame_skip=50, allowed=None, on_violation="warn",
+              log_options={"key": KEY}) as g:
         for _ in range(6):
             g.step(d, np.zeros(1))
     return path, model
@@ -331,7 +347,8 @@ def _predictor_relabel(src, model, dst):
 
 @pytest.mark.parametrize("forgery, first_bad", [(_episode_split, 3), (_predictor_relabel, 0)],
                          ids=["episode_split", "predictor_relabel"])
-def test_red_team_11_forgeries_fail_with_the_key(signed_bounce, tmp_path, key_file, capsys, forgery, first_bad):
+def test_red_team_11_forgeries_fail_with_the_key(signed_bounce, tmp_path, key_file, capsys, forgery,
+                                                 first_bad):
     src, model = signed_bounce
     code, entry = _review("--verify", "--key-file", key_file, src, capsys=capsys)
     assert code == 0 and entry["verify"]["signature"]["status"] == "verified"

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import hashlib
 import hmac
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,6 +51,9 @@ RUN_KEY = "signature"
 """``monitor.run`` key of the signature claim (algorithm, key id, topic)."""
 _DOMAIN = b"monitor-log-signature/1\0"
 _FIELDS = ("algorithm", "key_id", "checkpoint", "windows", "messages", "attachments", "metadata", "final")
+_PAYLOAD = ('{"algorithm":"%s","key_id":"%s","checkpoint":%d,"windows":%d,"messages":%d,"attachments":%d,'
+            '"metadata":%d,"final":%s,"mac":"%s"}')
+"""The checkpoint payload (compact JSON; the fields are a fixed ASCII string, a hex id and ints)."""
 
 
 def key_id(key: bytes) -> str:
@@ -109,9 +111,23 @@ def key_from_env() -> bytes | None:
         raise LogKeyError(f"${KEY_FILE_ENV}: {exc}") from exc
 
 
-def _mac(key: bytes, fields: dict[str, Any], chain: bytes) -> str:
-    text = json.dumps({k: fields[k] for k in _FIELDS}, sort_keys=True, separators=(",", ":"))
-    return hmac.digest(key, _DOMAIN + text.encode() + b"\0" + chain, "sha256").hex()
+def _keyed(key: bytes) -> Any:
+    """The key's HMAC-SHA256 object before any data (copied per checkpoint: ~1 µs instead of ~5)."""
+    return hmac.new(key, digestmod=hashlib.sha256)
+
+
+def _mac(keyed: Any, fields: dict[str, Any], chain: bytes) -> str:
+    """HMAC-SHA256 (hex) of the domain, the fields (fixed order, ``|``-separated) and the chain digest.
+
+    The encoding is unambiguous for what a verifier accepts: ``algorithm`` and ``key_id`` are
+    compared with the expected constants before the HMAC is checked, the counts are ints.
+    """
+    text = "%s|%s|%d|%d|%d|%d|%d|%s" % (fields["algorithm"], fields["key_id"], fields["checkpoint"],  # noqa: UP031
+                                        fields["windows"], fields["messages"], fields["attachments"],
+                                        fields["metadata"], "1" if fields["final"] is True else "0")
+    h = keyed.copy()
+    h.update(_DOMAIN + text.encode() + b"\0" + chain)
+    return h.hexdigest()
 
 
 class Signer:
@@ -123,8 +139,9 @@ class Signer:
     """
 
     def __init__(self, key: bytes) -> None:
-        self._key = as_key(key)
-        self.key_id = key_id(self._key)
+        key = as_key(key)
+        self._keyed = _keyed(key)
+        self.key_id = key_id(key)
         self.n = 0
 
     def claim(self) -> dict[str, str]:
@@ -136,9 +153,11 @@ class Signer:
         fields = {"algorithm": SIGN_ALGORITHM, "key_id": self.key_id, "checkpoint": self.n,
                   "windows": int(windows), "messages": digest.n_messages,
                   "attachments": digest.n_attachments, "metadata": digest.n_metadata, "final": bool(final)}
-        fields["mac"] = _mac(self._key, fields, digest.checkpoint())
+        mac = _mac(self._keyed, fields, digest.checkpoint())
         self.n += 1
-        return json.dumps(fields, separators=(",", ":")).encode()
+        return (_PAYLOAD % (SIGN_ALGORITHM, self.key_id, fields["checkpoint"], fields["windows"],  # noqa: UP031
+                            fields["messages"], fields["attachments"], fields["metadata"],
+                            "true" if final else "false", mac)).encode()
 
     def __repr__(self) -> str:  # never the key
         return f"Signer(key_id={self.key_id!r}, checkpoints={self.n})"
@@ -179,9 +198,11 @@ def read_point(data: bytes, digest: Digest, certificates_before: int) -> SignPoi
         payload = None
     if not isinstance(payload, dict):
         return SignPoint(None, None, "undecodable checkpoint payload", n, certificates_before)
-    bad = [k for k in _FIELDS if k not in payload] + (["mac"] if not isinstance(payload.get("mac"), str) else [])
+    bad = [k for k in _FIELDS if k not in payload]
+    bad += [] if isinstance(payload.get("mac"), str) else ["mac"]
     bad += [k for k in ("checkpoint", "windows", "messages", "attachments", "metadata")
             if k in payload and not _is_count(payload[k])]
+    bad += [] if isinstance(payload.get("final", False), bool) else ["final"]
     if bad:
         return SignPoint(payload, None, f"malformed checkpoint (fields {sorted(set(bad))})", n,
                          certificates_before)
@@ -232,7 +253,7 @@ class SignatureCheck:
         return asdict(self)
 
 
-def _point_problem(sp: SignPoint, j: int, key: bytes, kid: str) -> str | None:
+def _point_problem(sp: SignPoint, j: int, keyed: Any, kid: str) -> str | None:
     if sp.problem is not None:
         return sp.problem
     p = sp.payload
@@ -245,7 +266,7 @@ def _point_problem(sp: SignPoint, j: int, key: bytes, kid: str) -> str | None:
     if p["messages"] != sp.messages_before:
         return (f"it covers {p['messages']} message(s), {sp.messages_before} precede it (messages added or "
                 f"dropped)")
-    if not hmac.compare_digest(_mac(key, p, sp.chain), p["mac"]):
+    if not hmac.compare_digest(_mac(keyed, p, sp.chain), p["mac"]):
         return "its HMAC does not match: a record it covers was changed after signing"
     return None
 
@@ -286,16 +307,18 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
     if not points:
         out.critical.append("authenticity cannot be established: the log holds no signed checkpoint"
                             + (f" although its run metadata says it is signed by key id {log_kid} (stripped)"
-                               if claim is not None else " (an unsigned log)") + f"; the key given has id {kid}")
+                               if claim is not None else " (an unsigned log)")
+                            + f"; the key given has id {kid}")
         return out
     if claim is not None and claim.get("key_id") != kid or first.get("key_id") not in (None, kid):
         out.status = "wrong_key"
-        out.critical.append(f"authenticity cannot be established: the log is signed by key id {log_kid}, the key "
-                            f"given has id {kid}")
+        out.critical.append(f"authenticity cannot be established: the log is signed by key id {log_kid}, "
+                            f"the key given has id {kid}")
         return out
     last: SignPoint | None = None
+    keyed = _keyed(key)
     for j, sp in enumerate(points):
-        why = _point_problem(sp, j, key, kid)
+        why = _point_problem(sp, j, keyed, kid)
         if why is not None:
             w = last.payload["windows"] if last is not None else 0
             out.first_bad = {"checkpoint": j, "windows": w, "reason": why}
@@ -315,15 +338,16 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
         final = False
     else:
         p = last.payload
-        extra = [counts[0] - last.messages_before - 1, counts[1] - p["attachments"], counts[2] - p["metadata"]]
+        extra = [counts[0] - last.messages_before - 1, counts[1] - p["attachments"],
+                 counts[2] - p["metadata"]]
         final = bool(p["final"])
-    tail = ", ".join(f"{n} {what}" for n, what in zip(extra, ("message(s)", "attachment(s)", "metadata record(s)"))
-                     if n > 0)
+    kinds = ("message(s)", "attachment(s)", "metadata record(s)")
+    tail = ", ".join(f"{n} {what}" for n, what in zip(extra, kinds) if n > 0)
     where = (f"checkpoint {out.valid - 1}, after window {last.payload['windows'] - 1}" if last is not None
              and last.payload["windows"] else f"checkpoint {out.valid - 1}" if last is not None else "none")
     if out.first_bad is None and tail:
-        text = (f"{_windows_text(out.unsigned_windows) if out.unsigned_windows else 'no window'} and {tail} after "
-                f"the last valid signature ({where})")
+        wins = _windows_text(out.unsigned_windows) if out.unsigned_windows else "no window"
+        text = f"{wins} and {tail} after the last valid signature ({where})"
         if final:
             out.critical.append(f"records after the signed close: {text}")
         else:
@@ -332,8 +356,8 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
     out.signed_close = final and not tail and out.first_bad is None
     if not out.signed_close and out.first_bad is None and not (final and tail):
         if getattr(contents, "seal", None) is not None:
-            out.critical.append(f"the log claims a close (its digest seal) that is not signed: the signed part "
-                                f"ends at {where}")
+            out.critical.append(f"the log claims a close (its digest seal) that is not signed: the signed "
+                                f"part ends at {where}")
         else:
             out.notes.append(f"no signed close: the signed part ends at {where} (a killed writer, or a copy "
                              f"cut there: whether the run went on cannot be known)")

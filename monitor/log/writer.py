@@ -627,7 +627,8 @@ class MonitorLog:
     def _sign(self, log_ns: int, sim_ns: int, final: bool = False) -> None:
         """A signed checkpoint over everything written so far (a signing log only)."""
         if self._signer is not None:
-            self._put(topics.SIGNATURE, log_ns, sim_ns, self._signer.checkpoint(self._digest, self._index, final))
+            payload = self._signer.checkpoint(self._digest, self._index, final)
+            self._put(topics.SIGNATURE, log_ns, sim_ns, payload)
 
     @property
     def key_id(self) -> str | None:
