@@ -91,10 +91,10 @@ def test_a_signed_log_verifies_with_its_key_only(tmp_path, index):
     assert bad.status == "wrong_key" and bad.critical and bad.unsigned_windows == [0, 1, 2, 3, 4]
     final = c.signatures[-1]  # its HMAC by the standard library's one-shot, over the documented input
     f = final.payload
-    text = "|".join(str(f[k]) for k in ("algorithm", "key_id", "checkpoint", "windows", "messages", "attachments",
-                                           "metadata")) + "|1"
-    assert f["final"] is True and f["mac"] == hmac.digest(KEY, b"monitor-log-signature/1\0" + text.encode() + b"\0"
-                                                          + final.chain, "sha256").hex()
+    names = ("algorithm", "key_id", "checkpoint", "windows", "messages", "attachments", "metadata")
+    text = "|".join(str(f[k]) for k in names) + "|1"
+    data = b"monitor-log-signature/1\0" + text.encode() + b"\0" + final.chain
+    assert f["final"] is True and f["mac"] == hmac.digest(KEY, data, "sha256").hex()
     none = check_signatures(c, None)
     assert none.status == "not_checked" and not none.critical
     assert any(n.startswith("signature not checked: no key") for n in none.notes)
