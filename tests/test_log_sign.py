@@ -164,38 +164,12 @@ def test_a_sealed_log_without_its_signed_close_or_with_records_after_it_is_criti
     c = check_signatures(read_log(inserted), KEY)
     assert c.status == "mismatch" and c.first_bad["checkpoint"] == 5 and c.signed_windows == 4
     appended = tmp_path / "appended.mcap"  # a window appended after the signed close
-    _append_certificate(src, tmp_path / "t3.mcap")
+    last = {k: v for k, v in read_log(src).certificates()[-1].items() if k != "_log_time"}
+    rewrite(src, tmp_path / "t3.mcap", append=[(topics.CERTIFICATE, {**last, "index": 5})])
     seal_copy(tmp_path / "t3.mcap", appended)
     c = check_signatures(read_log(appended), KEY)
     assert c.status == "mismatch" and c.first_bad is None and c.unsigned_windows == [5]
     assert any(t.startswith("records after the signed close: 1 window(s) (5)") for t in c.critical)
-
-
-def _append_certificate(src, dst):
-    """Copy ``src`` (file order) and append a copy of its last certificate as window 5."""
-    from mcap.reader import make_reader
-    from mcap.writer import Writer
-
-    with open(src, "rb") as fi, open(dst, "wb") as fo:
-        r = make_reader(fi)
-        w = Writer(fo)
-        w.start(library=r.get_header().library)
-        s = r.get_summary()
-        smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
-        cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
-                for cid, c in s.channels.items()}
-        for m in r.iter_metadata():
-            w.add_metadata(m.name, dict(m.metadata))
-        for a in r.iter_attachments():
-            w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
-        last = None
-        for _, ch, m in r.iter_messages(log_time_order=False):
-            w.add_message(cmap[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
-            last = (ch, m) if ch.topic == topics.CERTIFICATE else last
-        ch, m = last
-        data = json.dumps({**json.loads(m.data), "index": 5}, separators=(",", ":")).encode()
-        w.add_message(cmap[ch.id], m.log_time + 1, data, m.publish_time, m.sequence + 100)
-        w.finish()
 
 
 # --------------------------------------------------------------------------- bad keys
