@@ -13,10 +13,10 @@ added or reordered since, whether by bit rot or by a tool that rewrites records.
 What it does **not** prove: who wrote the log, or that the run happened. The seal
 is not signed; anyone with this module can regenerate a consistent log (or strip the
 seal, which makes the log look like one from a killed writer: review then says the
-log is unsealed). Authenticity needs a key that the forger does not have (an HMAC
-or signature over :meth:`Digest.hexdigest`, kept outside the log), which this
-module does not provide. Whatever the seal says, ``review --verify`` still
-recomputes every window from the model and the plan.
+log is unsealed). Authenticity needs a key that the forger does not have: a log
+written with a key holds HMAC-SHA256 checkpoints over this digest chain
+(:mod:`monitor.log.sign`, ``review --key-file``). Whatever the seal says, ``review
+--verify`` still recomputes every window from the model and the plan.
 
 Independent of the file layout: messages are chained in order (chunked and
 unchunked files keep the order of ``add_message``), attachments are chained in

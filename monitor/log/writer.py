@@ -32,6 +32,12 @@ Two phases (crash tolerance *and* an indexed file):
    (:func:`finalise_log`; ``index=False`` keeps the journal). A journal left by a
    killed writer is finalised by ``python -m monitor review --reindex FILE``.
 
+Integrity and authenticity: every record is fed to a SHA-256 chain (:mod:`monitor.log.digest`),
+sealed at close (unkeyed: tamper evidence against accidents, not against a forger). With a key
+(``key=`` or ``$MONITOR_LOG_KEY_FILE``) the log also holds HMAC-SHA256 checkpoints of that chain
+(:mod:`monitor.log.sign`): one at open, one after every window (inside the per-window flush, so a
+killed writer leaves every finished window signed) and a final one at close.
+
 Model export: the exact compiled model is always attached as MJB
 (``mj_saveModel``; loadable by the same MuJoCo version). The MJCF XML comes from an
 ``MjSpec`` (pass ``model_source=`` a path or spec) or, failing that, from
@@ -69,7 +75,8 @@ from monitor.log.digest import METADATA_DIGEST, Digest
 MAX_MESSAGES_PER_WINDOW = 8
 """Upper bound on records one window writes (plan, certificate, violation, action,
 log, tf, and up to two scene updates on the first window): the most a killed writer can
-lose under the per-window flush policy."""
+lose under the per-window flush policy. A signing log writes one more, its checkpoint
+(:mod:`monitor.log.sign`), as the window's last record."""
 
 FINAL_CHUNK_BYTES = 1 << 20
 """Chunk size (bytes, before compression) of a finalised log."""
@@ -427,7 +434,7 @@ class MonitorLog:
                "format_version": topics.FORMAT_VERSION,
                "flush_policy": "journal: unchunked; flush per window" + ("; fsync" if fsync else "")
                + ("; finalised into a chunked, indexed file on close" if index else ""),
-               "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW}
+               "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW + (self._signer is not None)}
         versions = package_versions()
         run.update({f"version.{k}": v for k, v in versions.items()})
         run["mujoco_version"] = versions.get("mujoco")
