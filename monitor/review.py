@@ -1995,6 +1995,15 @@ def _verify_html(ver: dict[str, Any]) -> str:
                     [[ver.get("model_source"), ver.get("checked"), ver.get("applied_checked", 0),
                       len(ver.get("mismatches", [])), ver.get("critical"), ver.get("missing_plans"),
                       len(ver.get("errors", [])), ver.get("pairs_differ", 0)]], "summary")]
+    sig = ver.get("signature") or {}
+    if sig.get("key_id") or sig.get("status", "unsigned") != "unsigned":
+        parts.append("<h4>Signature</h4>" + _table(
+            ["status", "log key id", "key given", "checkpoints valid", "windows signed", "windows not signed",
+             "signed close"],
+            [[sig.get("status"), sig.get("log_key_id") or "-", sig.get("key_id") or "-",
+              f"{sig.get('valid', 0)} of {sig.get('checkpoints', 0)}", sig.get("signed_windows", 0),
+              len(sig.get("unsigned_windows") or []), "yes" if sig.get("signed_close") else "no"]],
+            "bad" if sig.get("critical") or sig.get("unverifiable") else ""))
     if ver.get("mismatches"):
         parts.append("<h4>Windows whose verdict changed</h4>" + _table(
             ["window", "sim time", "logged", "recomputed", "critical", "logged clearance", "clearance",

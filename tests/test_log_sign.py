@@ -360,3 +360,19 @@ def test_stripping_the_signatures_fails_with_the_key(signed_bounce, tmp_path, ke
     code, entry = _review("--verify", claimless, capsys=capsys)  # no key: the old behaviour, no note
     assert not any("signature" in n for n in entry["verify"]["notes"])
     shutil.rmtree(tmp_path, ignore_errors=True)
+
+
+def test_a_verification_made_without_the_key_takes_the_signature_check_afterwards(signed_bounce, tmp_path):
+    """``review --ray`` verifies in workers without the key; the check is added in the main process."""
+    from monitor import review
+
+    src, model = signed_bounce
+    dst = tmp_path / "forged.mcap"
+    _episode_split(src, model, dst)
+    contents = read_log(dst)
+    ver = review.verify(contents)
+    assert ver["signature"]["status"] == "not_checked" and ver["critical"] == 0
+    ver = review.add_signature(ver, contents, KEY)
+    assert ver["signature"]["first_bad"]["checkpoint"] == 3 and ver["critical"] == 1
+    assert review.verify_exit_code(ver) == 1
+    assert not any(n.startswith("signature not checked") for n in ver["notes"])
