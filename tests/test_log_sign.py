@@ -134,6 +134,11 @@ def test_review_cli_codes_for_a_killed_and_a_forged_scripted_log(tmp_path, key_f
     code, entry = _review("--key-file", key_file, forged, capsys=capsys)
     sig = entry["signature"]
     assert code == 1 and sig["first_bad"]["checkpoint"] == 2 and sig["signed_windows"] == 1
+    nomodel = tmp_path / "nomodel.mcap"  # attachments dropped: --verify cannot run, the signature still fails
+    rewrite(tmp_path / "full.mcap", tmp, attachments=lambda name, data: None)
+    seal_copy(tmp, nomodel)
+    code, entry = _review("--verify", "--key-file", key_file, nomodel, capsys=capsys)
+    assert "error" in entry["verify"] and code == 1 and entry["signature"]["first_bad"]["checkpoint"] == 0
 
 
 def test_a_sealed_log_without_its_signed_close_or_with_records_after_it_is_critical(tmp_path):

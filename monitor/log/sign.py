@@ -322,9 +322,9 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
         if why is not None:
             w = last.payload["windows"] if last is not None else 0
             out.first_bad = {"checkpoint": j, "windows": w, "reason": why}
-            out.critical.append(f"signature mismatch at checkpoint {j} (the first after window "
-                                f"{w - 1 if w else 'none'}): {why}; the log is not what the key holder "
-                                f"wrote from there on")
+            at = "written at open" if j == 0 else f"written after window {j - 1}"
+            out.critical.append(f"signature mismatch at checkpoint {j} ({at}): {why}; {w} window(s) before "
+                                f"it stay signed, the log from there on is not what the key holder wrote")
             break
         last = sp
         out.valid += 1
