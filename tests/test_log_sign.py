@@ -16,6 +16,7 @@ import json
 import shutil
 import types
 
+import jsonschema
 import mujoco
 import numpy as np
 import pytest
@@ -95,6 +96,9 @@ def test_a_signed_log_verifies_with_its_key_only(tmp_path, index):
     text = "|".join(str(f[k]) for k in names) + "|1"
     data = b"monitor-log-signature/1\0" + text.encode() + b"\0" + final.chain
     assert f["final"] is True and f["mac"] == hmac.digest(KEY, data, "sha256").hex()
+    for payload in c.topic(topics.SIGNATURE):  # each checkpoint matches its registered schema
+        fields = {k: v for k, v in payload.items() if k != "_log_time"}
+        jsonschema.validate(fields, topics.schema(topics.SIGNATURE))
     none = check_signatures(c, None)
     assert none.status == "not_checked" and not none.critical
     assert any(n.startswith("signature not checked: no key") for n in none.notes)
