@@ -28,6 +28,10 @@ class LogFormatError(MonitorError):
     """An MCAP log is truncated, corrupt, not MCAP, or lacks the monitor schema."""
 
 
+class LogKeyError(InvalidInputError):
+    """A log signing key (or key file) is unusable: missing or unreadable file, empty, too short."""
+
+
 class DependencyNotInstalled(MonitorError, ImportError):
     """An optional dependency is missing; the message names the extra to install."""
 
@@ -38,5 +42,6 @@ __all__ = [
     "ModelMismatchError",
     "UnsupportedGeometryError",
     "LogFormatError",
+    "LogKeyError",
     "DependencyNotInstalled",
 ]

@@ -53,6 +53,7 @@ and the braking-tail check work in the env's control space, as without wrappers.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
 
@@ -156,7 +157,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             exclusively (``fcntl.flock``); when another live gate writes it (e.g. the sub-envs
             of ``gym.make_vec(..., wrappers=[partial(SafetyGate, log="x.mcap")])``) this gate
             writes the first free ``x.1.mcap``, ``x.2.mcap``, ... (``gate.log_path``), never
-            the same file.
+            the same file. A path log is signed when ``$MONITOR_LOG_KEY_FILE`` names a key file
+            (:mod:`monitor.log.sign`); a MonitorLog (e.g. ``MonitorLog(path, key=...)``) is not
+            recorded in ``env.spec`` (it cannot be copied).
         unsafe: ``"uncertain"`` (default: anything not certified is unsafe) or ``"violation"``.
         timing: add ``info["safety"]["certify_us"]`` (wall time, µs). Off by default
             because a wall time differs between identical runs, which fails
@@ -189,7 +192,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
                  penetration_tol: float = DEFAULT_PENETRATION_TOL, brake_horizon: float = 0.25) -> None:
         gymnasium.utils.RecordConstructorArgs.__init__(
             self, predictor=predictor, pairs=pairs, margin=margin, epsilon=epsilon,
-            on_violation=on_violation, fallback=fallback, budget=budget, log=log, unsafe=unsafe,
+            on_violation=on_violation, fallback=fallback, budget=budget, unsafe=unsafe,
+            log=log if log is None or isinstance(log, str | os.PathLike) else None,  # a MonitorLog: no copy
             timing=timing, brake=brake, allowed=allowed, hazards=hazards, allow=allow, ongoing=ongoing,
             penetration_tol=penetration_tol, brake_horizon=brake_horizon)
         gymnasium.Wrapper.__init__(self, env)

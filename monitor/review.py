@@ -1258,7 +1258,7 @@ def _apply_model_edit(model: Any, edit: _Edit) -> None:
 def verify(contents: LogContents, *, model_source: str = "auto", progress: bool | None = None,
            limit: int | None = None, tolerances: dict[str, Any] | None = None,
            expect_pairs: str | None = None, max_penetration: float | None = None,
-           trust_model_edits: bool = False) -> dict[str, Any]:
+           trust_model_edits: bool = False, key: bytes | None = None) -> dict[str, Any]:
     """Recompute every logged certificate from the attached model and the logged plan.
 
     Inputs of the recomputation: the model (attachments), the plan (same window index),
@@ -1321,6 +1321,8 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
             (a log that consistently claims a loose rule is otherwise only reported in a note).
             0 requires the plain rule.
         trust_model_edits: accept the logged model edits as the run's model (see above).
+        key: the log signing key: the log's signed checkpoints are checked
+            (:func:`signature_findings`); None: a signed log gets the note "signature not checked".
 
     Returns:
         dict with ``windows`` (certificates in the log), ``checked`` (recomputed),
@@ -1334,7 +1336,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         ``applied_checked`` (records re-derived, counted in ``checked`` too), ``applied_records``,
         ``applied_steps`` (replaced steps whose record covers them), ``applied_missing``, and
         ``replayed``, ``replay_user``, ``replay_failed``, ``continuity_checked``
-        (:func:`_replay_findings`).
+        (:func:`_replay_findings`), ``signature`` (:class:`monitor.log.sign.SignatureCheck` as a dict).
 
     Raises:
         LogFormatError: the model cannot be rebuilt from the attachments.
@@ -1361,6 +1363,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
         find(CRITICAL, f"digest seal: {contents.seal_detail}")
     elif contents.seal_status == "unsealed":
         notes.append("log is not sealed (no digest): edits after writing cannot be detected by digest")
+    signature = signature_findings(contents, key, find, notes)
     consistency = model_consistency(contents)
     if consistency["status"] == "inconsistent":
         find(CRITICAL, consistency["detail"])
@@ -1460,7 +1463,7 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
                            (None if policy is None else [list(p) for p in policy]),
                            "mismatches": [], "findings": findings, "notes": notes, "critical": 0,
                            "unverifiable": 0, "missing_plans": 0, "errors": [], "pairs_differ": 0,
-                           "applied_checked": 0}
+                           "applied_checked": 0, "signature": signature}
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     edits, edits_bad_from = _model_edits(contents, model, find, notes)
     replay_edits = list(edits)  # the loop below consumes edits; the re-simulation applies them again
@@ -1614,6 +1617,47 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     return out
 
 
+def signature_findings(contents: LogContents, key: bytes | None, find: Callable[..., None],
+                       notes: list[str]) -> dict[str, Any]:
+    """Check the log's signed checkpoints with ``key`` (:func:`monitor.log.sign.check_signatures`).
+
+    Critical: a checkpoint that does not verify (the first is named), a key given and the log
+    unsigned or signed by another key id, records after the signed close, a seal (a claimed
+    close) without a signed close. Unverifiable: records after the last valid checkpoint.
+    Notes: no key for a signed log ("signature not checked: no key"), no signed close, what
+    verified. An unsigned log without a key: nothing (as before signing existed).
+
+    Returns:
+        the check as a dict (``status``, ``key_id``, ``signed_windows``, ``unsigned_windows``, ...).
+    """
+    from monitor.log.sign import check_signatures
+
+    sig = check_signatures(contents, key)
+    for text in sig.critical:
+        find(CRITICAL, f"signature: {text}")
+    for text in sig.unverifiable:
+        find(UNVERIFIABLE, f"signature: {text}")
+    notes.extend(sig.notes)
+    return sig.to_json()
+
+
+def add_signature(ver: dict[str, Any], contents: LogContents, key: bytes | None) -> dict[str, Any]:
+    """Add the signature check to a :func:`verify` result made without it (``review --ray``)."""
+    if ver.get("error") or "findings" not in ver:
+        return ver
+    before = len(ver["findings"])
+
+    def find(severity: str, reason: str, index: int | None = None) -> None:
+        ver["findings"].append({"index": index, "severity": severity, "reason": reason})
+
+    ver["notes"] = [n for n in ver.get("notes", []) if not n.startswith("signature not checked")]
+    ver["signature"] = signature_findings(contents, key, find, ver["notes"])
+    new = ver["findings"][before:]
+    ver["critical"] = ver.get("critical", 0) + sum(f["severity"] == CRITICAL for f in new)
+    ver["unverifiable"] = ver.get("unverifiable", 0) + sum(f["severity"] == UNVERIFIABLE for f in new)
+    return ver
+
+
 def verify_exit_code(ver: dict[str, Any]) -> int:
     """Exit code of one log's verification.
 
@@ -1758,6 +1802,8 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
                 f"{' / '.join(map(str, r['bodies'])) or '-':28} {' / '.join(map(str, r['geoms'])) or '-':32} "
                 f"{_fmt_point(r['point']):32} {fmt_bound(r['distance']):>10} "
                 f"{fmt_bound(r['clearance']):>10}")
+    if entry.get("signature"):  # checked without --verify
+        _render_signature(entry["signature"], lines, findings=True)
     ver = entry.get("verify")
     if ver:
         if ver.get("error"):
@@ -1776,6 +1822,7 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
             lines.append(f"     applied motions re-derived: {ver.get('applied_checked', 0)} record(s) of "
                          f"{ver.get('applied_records', 0)}, covering {ver.get('applied_steps', 0)} replaced "
                          f"step(s); {ver.get('applied_missing', 0)} replaced step(s) without a record")
+        _render_signature(ver.get("signature"), lines, findings=False)
         mc = ver.get("model_consistency")
         if mc:
             lines.append(f"     model: {mc['status']}: {mc['detail']}")
@@ -1794,6 +1841,30 @@ def _render_entry(entry: dict[str, Any], lines: list[str]) -> None:
                 lines.append(f"     ... and {len(rows_f) - 20} more {sev} finding(s)")
         for note in ver.get("notes", []):
             lines.append(f"     note: {note}")
+
+
+def _render_signature(sig: dict[str, Any] | None, lines: list[str], findings: bool) -> None:
+    """One status line for a signature check (and, ``findings``, its findings and notes)."""
+    if not sig or (sig.get("status") == "unsigned" and not sig.get("key_id")):
+        return
+    unsigned = sig.get("unsigned_windows") or []
+    head = (f"   signature: {sig['status']} (log key id {sig.get('log_key_id') or '-'}, key given "
+            f"{sig.get('key_id') or '-'})")
+    if sig.get("key_id") is None:
+        lines.append(f"{head}: {sig.get('checkpoints', 0)} checkpoint(s), not checked")
+    else:
+        lines.append(f"{head}: {sig.get('valid', 0)} of {sig.get('checkpoints', 0)} checkpoint(s) valid, "
+                     f"{sig.get('signed_windows', 0)} window(s) signed, {len(unsigned)} not"
+                     + ("; signed close" if sig.get("signed_close") else ""))
+    if findings:
+        for sev, texts in ((CRITICAL, sig.get("critical", [])), (UNVERIFIABLE, sig.get("unverifiable", []))):
+            lines += [f"     [{sev.upper()}] log: signature: {t}" for t in texts]
+        lines += [f"     note: {t}" for t in sig.get("notes", [])]
+
+
+def signature_exit_code(sig: dict[str, Any]) -> int:
+    """Exit code of a signature check alone (review without --verify): 1 critical, 2 unverifiable, else 0."""
+    return 1 if sig.get("critical") else (2 if sig.get("unverifiable") else 0)
 
 
 def _pyplot() -> Any:
@@ -1924,6 +1995,15 @@ def _verify_html(ver: dict[str, Any]) -> str:
                     [[ver.get("model_source"), ver.get("checked"), ver.get("applied_checked", 0),
                       len(ver.get("mismatches", [])), ver.get("critical"), ver.get("missing_plans"),
                       len(ver.get("errors", [])), ver.get("pairs_differ", 0)]], "summary")]
+    sig = ver.get("signature") or {}
+    if sig.get("key_id") or sig.get("status", "unsigned") != "unsigned":
+        parts.append("<h4>Signature</h4>" + _table(
+            ["status", "log key id", "key given", "checkpoints valid", "windows signed", "windows not signed",
+             "signed close"],
+            [[sig.get("status"), sig.get("log_key_id") or "-", sig.get("key_id") or "-",
+              f"{sig.get('valid', 0)} of {sig.get('checkpoints', 0)}", sig.get("signed_windows", 0),
+              len(sig.get("unsigned_windows") or []), "yes" if sig.get("signed_close") else "no"]],
+            "bad" if sig.get("critical") or sig.get("unverifiable") else ""))
     if ver.get("mismatches"):
         parts.append("<h4>Windows whose verdict changed</h4>" + _table(
             ["window", "sim time", "logged", "recomputed", "critical", "logged clearance", "clearance",

@@ -26,13 +26,14 @@ def _compact(obj: Any) -> bytes:
 def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = None,
             metadata: Callable[[str, dict], dict] | None = None,
             attachments: Callable[[str, bytes], bytes | None] | None = None,
-            chunked: bool = False) -> None:
+            chunked: bool = False, append: list[tuple[str, dict]] | None = None) -> None:
     """Copy ``src`` to ``dst`` record by record; the digest seal is stripped (as a forger would).
 
     ``msg(topic, payload)`` (JSON channels) returns the payload (edited in place or new; raw bytes
     are written as they are), None to drop it, or a list of payloads to write several;
     ``metadata(name, values)`` edits decoded metadata values (without it the stored strings are
-    copied unchanged); ``attachments(name, data)`` returns new bytes or None to drop.
+    copied unchanged); ``attachments(name, data)`` returns new bytes or None to drop;
+    ``append``: ``(topic, payload)`` messages written after every other message (1 ns later each).
     """
     with open(src, "rb") as fi, open(dst, "wb") as fo:
         r = make_reader(fi)
@@ -62,4 +63,8 @@ def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = No
                 outs = [o if isinstance(o, bytes) else _compact(o) for o in res]
             for data in outs:
                 w.add_message(cmap[ch.id], m.log_time, data, m.publish_time, m.sequence)
+            last = (m.log_time, m.publish_time, m.sequence)
+        by_topic = {c.topic: cid for cid, c in s.channels.items()}
+        for k, (topic, payload) in enumerate(append or []):
+            w.add_message(cmap[by_topic[topic]], last[0] + 1 + k, _compact(payload), last[1], last[2] + 1 + k)
         w.finish()

@@ -18,6 +18,13 @@ Exit codes (1 takes precedence over 2, 2 over 0):
 Truncated logs (a killed writer: the file ends inside a record and has no closing
 magic) are reviewed from their recovered part with a warning and do not change the code.
 
+Signed logs (``MonitorLog(key=...)``, see monitor.log.sign): ``--key-file PATH`` (else the file
+named by $MONITOR_LOG_KEY_FILE) checks every signed checkpoint, with or without --verify: a
+checkpoint that does not verify, an unsigned log or one signed by another key, records after the
+signed close, or a seal without a signed close are critical (1); windows after the last valid
+checkpoint are unverifiable (2). Without a key a signed log gets the note "signature not checked:
+no key". An unusable key file: exit 2 with a one-line message.
+
 A LOG argument may be a directory: its ``*.mcap`` files are reviewed (sorted).
 ``--ray`` re-verifies the logs in parallel, one Ray task per log
 (:func:`monitor.distributed.verify_logs`); it implies ``--verify`` and gives the
@@ -72,6 +79,9 @@ def add_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reindex", action="store_true",
                    help="first rewrite each LOG in place as a chunked, indexed MCAP (finalises the "
                         "journal a killed writer left; a record cut by the kill is dropped), then review it")
+    p.add_argument("--key-file", metavar="PATH", default=None,
+                   help="check the logs' signatures with the key in PATH (default: the file named by "
+                        "$MONITOR_LOG_KEY_FILE, if set); an unsigned log or another key is critical")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON instead of text")
     p.add_argument("--report", metavar="OUT.html", default=None, help="write a self-contained HTML report")
     p.add_argument("--progress", dest="progress", action="store_true", default=None,
@@ -106,7 +116,7 @@ def _review_one(path: str, args: argparse.Namespace,
                 verified: dict[str, Any] | None = None) -> tuple[dict[str, Any], int]:
     from monitor.errors import LogFormatError, MonitorError
     from monitor.log.reader import read_log
-    from monitor.review import analyze, verify, verify_exit_code
+    from monitor.review import add_signature, analyze, signature_exit_code, verify, verify_exit_code
 
     try:
         contents = read_log(path, progress=args.progress)
@@ -119,19 +129,26 @@ def _review_one(path: str, args: argparse.Namespace,
         entry["error"] = (f"{path}: no certificate could be recovered ({contents.n_messages} message(s) "
                           f"read, {contents.unreadable_bytes} unreadable byte(s); {why})")
         return entry, 2
+    key = getattr(args, "key", None)
     if verified is not None:  # computed in parallel (--ray): same dict as verify(), or {"error": ...}
-        entry["verify"] = verified
+        entry["verify"] = add_signature(verified, contents, key)
     elif args.verify:
         try:
             entry["verify"] = verify(contents, model_source=args.model_source, progress=args.progress,
                                      limit=args.limit, tolerances=getattr(args, "tolerance_values", None),
                                      expect_pairs=getattr(args, "expect_pairs", None),
                                      max_penetration=getattr(args, "max_penetration", None),
-                                     trust_model_edits=bool(getattr(args, "trust_model_edits", False)))
+                                     trust_model_edits=bool(getattr(args, "trust_model_edits", False)),
+                                     key=key)
         except ImportError as exc:
             entry["verify"] = {"error": f"verification needs the certification engine: {exc}"}
         except (MonitorError, ValueError) as exc:
             entry["verify"] = {"error": str(exc)}
+    if "signature" not in entry.get("verify", {}):  # no --verify, or it failed: still checked (cheap)
+        from monitor.log.sign import check_signatures
+
+        entry["signature"] = check_signatures(contents, key).to_json()
+        code = _worst(code, signature_exit_code(entry["signature"]))
     if "verify" in entry:
         code = _worst(code, verify_exit_code(entry["verify"]))
     return entry, code
@@ -181,6 +198,14 @@ def run(args: argparse.Namespace) -> int:
     mp = getattr(args, "max_penetration", None)
     if mp is not None and not (math.isfinite(mp) and mp >= 0):
         print(f"error: --max-penetration must be a finite number >= 0 (m), got {mp}", file=sys.stderr)
+        return 2
+    from monitor.errors import LogKeyError
+    from monitor.log.sign import key_from_env, load_key
+
+    try:
+        args.key = load_key(args.key_file) if getattr(args, "key_file", None) else key_from_env()
+    except LogKeyError as exc:
+        print(f"error: {'--key-file: ' if getattr(args, 'key_file', None) else ''}{exc}", file=sys.stderr)
         return 2
     paths = expand_logs(args.logs)
     if not paths:

@@ -2,6 +2,8 @@
 
 Topic names and JSON schemas: :mod:`monitor.log.topics`. Foxglove 3-D review
 messages: :mod:`monitor.log.foxglove_scene` (optional, needs foxglove-sdk).
+Tamper evidence: :mod:`monitor.log.digest` (unkeyed seal); authenticity: :mod:`monitor.log.sign`
+(HMAC-SHA256 checkpoints, ``MonitorLog(key=...)`` or ``$MONITOR_LOG_KEY_FILE``).
 """
 
 from __future__ import annotations

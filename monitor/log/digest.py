@@ -13,15 +13,21 @@ added or reordered since, whether by bit rot or by a tool that rewrites records.
 What it does **not** prove: who wrote the log, or that the run happened. The seal
 is not signed; anyone with this module can regenerate a consistent log (or strip the
 seal, which makes the log look like one from a killed writer: review then says the
-log is unsealed). Authenticity needs a key that the forger does not have (an HMAC
-or signature over :meth:`Digest.hexdigest`, kept outside the log), which this
-module does not provide. Whatever the seal says, ``review --verify`` still
-recomputes every window from the model and the plan.
+log is unsealed). Authenticity needs a key that the forger does not have: a log
+written with a key holds HMAC-SHA256 checkpoints over this digest chain
+(:mod:`monitor.log.sign`, ``review --key-file``). Whatever the seal says, ``review
+--verify`` still recomputes every window from the model and the plan.
 
 Independent of the file layout: messages are chained in order (chunked and
 unchunked files keep the order of ``add_message``), attachments are chained in
 order (they are never chunked), metadata records are hashed as a sorted set
 (their position relative to chunked messages depends on chunk flushing).
+
+Signed checkpoints (:mod:`monitor.log.sign`) use :meth:`Digest.checkpoint`: the message chain
+at the checkpoint message and the attachment and metadata chains (metadata chained in their
+own order, which chunking keeps) after the first ``a`` attachments and ``m`` metadata records.
+A reader (``keep_prefixes=True``) keeps the chains' state after every attachment and metadata
+record, because a chunked file may hold metadata written after a checkpoint before it.
 """
 
 from __future__ import annotations
@@ -35,6 +41,8 @@ from monitor.log.topics import METADATA_FINALISE  # added after sealing by final
 METADATA_DIGEST = "monitor.digest"
 """Metadata record holding the seal (written last, excluded from the digest itself)."""
 ALGORITHM = "monitor-sha256-chain/1"
+CHECKPOINT_ALGORITHM = "monitor-sha256-checkpoint/1"
+"""Domain of :meth:`Digest.checkpoint` (the digest a signed checkpoint's HMAC covers)."""
 
 
 def _field(h: Any, data: bytes) -> None:
@@ -51,12 +59,19 @@ class Digest:
         >>> seal = d.seal()  # add_metadata(METADATA_DIGEST, seal) before finish()
     """
 
-    def __init__(self) -> None:
+    def __init__(self, keep_prefixes: bool = False) -> None:
         self._messages = hashlib.sha256(ALGORITHM.encode())
         self._attachments = hashlib.sha256(ALGORITHM.encode())
         self._metadata: list[bytes] = []
+        self._metadata_chain = hashlib.sha256(ALGORITHM.encode())  # in record order (checkpoints)
         self.n_messages = 0
         self.n_attachments = 0
+        self._keep = bool(keep_prefixes)
+        # state (32 bytes) of the attachment / metadata chain after the first i records (readers only)
+        self._att_states = [self._attachments.digest()] if self._keep else []
+        self._meta_states = [self._metadata_chain.digest()] if self._keep else []
+        self._att_now: tuple[int, bytes] | None = None  # (count, state): the writer's cache
+        self._meta_now: tuple[int, bytes] | None = None
 
     def message(self, topic: str, log_time: int, publish_time: int, sequence: int, data: bytes) -> None:
         """One message record: channel topic, log/publish time (ns), sequence, payload bytes."""
@@ -75,12 +90,57 @@ class Digest:
         _field(h, media_type.encode("utf-8", "surrogatepass"))
         _field(h, hashlib.sha256(bytes(data)).digest())
         self.n_attachments += 1
+        if self._keep:
+            self._att_states.append(h.digest())
 
     def metadata(self, name: str, values: dict[str, str]) -> None:
         """One metadata record with its raw (stored) string values; the seal record is ignored."""
         if name in (METADATA_DIGEST, METADATA_FINALISE):
             return
-        self._metadata.append(json.dumps([name, sorted(values.items())], ensure_ascii=True).encode())
+        rec = json.dumps([name, sorted(values.items())], ensure_ascii=True).encode()
+        self._metadata.append(rec)
+        _field(self._metadata_chain, rec)
+        if self._keep:
+            self._meta_states.append(self._metadata_chain.digest())
+
+    @property
+    def n_metadata(self) -> int:
+        """Metadata records fed (the seal and the finalise record excluded)."""
+        return len(self._metadata)
+
+    def checkpoint(self, n_attachments: int | None = None, n_metadata: int | None = None) -> bytes:
+        """32-byte digest of every message so far and of the first attachments / metadata records.
+
+        Args:
+            n_attachments, n_metadata: how many attachment / metadata records (in their own
+                order) the checkpoint covers; None: all fed so far. Fewer than fed needs
+                ``keep_prefixes=True``.
+
+        Raises:
+            IndexError: a count above the records fed, or a prefix without ``keep_prefixes``.
+        """
+        na = self.n_attachments if n_attachments is None else int(n_attachments)
+        nm = self.n_metadata if n_metadata is None else int(n_metadata)
+        att = self._state(na, self.n_attachments, self._attachments, self._att_states, "_att_now")
+        meta = self._state(nm, self.n_metadata, self._metadata_chain, self._meta_states, "_meta_now")
+        h = hashlib.sha256(CHECKPOINT_ALGORITHM.encode())
+        h.update(self._messages.digest())
+        h.update(att)
+        h.update(meta)
+        h.update(f"{self.n_messages}/{na}/{nm}".encode())
+        return h.digest()
+
+    def _state(self, n: int, fed: int, chain: Any, states: list[bytes], cache: str) -> bytes:
+        """State of a chain after its first ``n`` records (``fed`` so far)."""
+        if n < 0 or n > fed:
+            raise IndexError(f"{n} records asked, {fed} fed")
+        if n == fed:
+            now = getattr(self, cache)
+            if now is None or now[0] != n:
+                now = (n, chain.digest())
+                setattr(self, cache, now)
+            return now[1]
+        return states[n]  # IndexError without keep_prefixes
 
     def hexdigest(self) -> str:
         """Digest of everything fed so far (hex)."""
@@ -121,4 +181,4 @@ def check_seal(seal: dict[str, str] | None, digest: Digest) -> tuple[str, str]:
                         + (f" ({counts})" if counts else " (same record counts: edited or reordered)"))
 
 
-__all__ = ["Digest", "check_seal", "METADATA_DIGEST", "ALGORITHM"]
+__all__ = ["Digest", "check_seal", "METADATA_DIGEST", "ALGORITHM", "CHECKPOINT_ALGORITHM"]

@@ -70,6 +70,7 @@ from mcap.records import (
 from monitor.errors import InvalidInputError, LogFormatError
 from monitor.log import topics
 from monitor.log.digest import METADATA_DIGEST, Digest, check_seal
+from monitor.log.sign import read_point
 
 MAGIC = b"\x89MCAP0\r\n"
 _RECORD_HEAD = 9  # opcode (1) + length (8)
@@ -146,6 +147,10 @@ class LogContents:
         seal: the ``monitor.digest`` seal record (None when the log is unsealed).
         seal_status: ``"sealed" | "mismatch" | "unsealed"`` and ``seal_detail`` (see
             :mod:`monitor.log.digest`: what a seal proves and what it does not).
+        signatures: the signed checkpoints (:data:`topics.SIGNATURE` messages) in file order,
+            each with the digest it must sign (:func:`monitor.log.sign.read_point`); checked
+            with a key by :func:`monitor.log.sign.check_signatures`.
+        digest_counts: (messages, attachments, metadata records) fed to the digest (all read).
     """
 
     path: str
@@ -172,6 +177,8 @@ class LogContents:
     seal: dict[str, str] | None = None
     seal_status: str = "unsealed"
     seal_detail: str = ""
+    signatures: list[Any] = field(default_factory=list)
+    digest_counts: tuple[int, int, int] = (0, 0, 0)
 
     @property
     def run(self) -> dict[str, Any]:
@@ -515,7 +522,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
 
         bar = tqdm(total=size, unit="B", unit_scale=True, desc=f"reading {p.name}", leave=False)
     channels: dict[int, Channel] = {}
-    digest = Digest()
+    digest = Digest(keep_prefixes=True)
     try:
         with open(p, "rb") as f:
             w = _Walker(f, size, bar, out)
@@ -534,6 +541,9 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                     channels[rec.id] = rec
                 elif isinstance(rec, Message):
                     ch = channels.get(rec.channel_id)
+                    if ch is not None and ch.topic == topics.SIGNATURE:  # before the digest takes it
+                        out.signatures.append(read_point(rec.data, digest,
+                                                         len(out.messages.get(topics.CERTIFICATE, ()))))
                     digest.message(ch.topic if ch else "", rec.log_time, rec.publish_time, rec.sequence,
                                    rec.data)
                     _take_message(out, channels, rec)
@@ -562,6 +572,7 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
                            f"writer finished it: the file is damaged, not cut")
     out.unreadable_bytes = 0 if out.complete else size - out.readable_bytes
     out.seal_status, out.seal_detail = check_seal(out.seal, digest)
+    out.digest_counts = (digest.n_messages, digest.n_attachments, digest.n_metadata)
     return out
 
 

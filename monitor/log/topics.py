@@ -53,6 +53,12 @@ LOG = "/monitor/log"
 """foxglove.Log (JSON encoding, no foxglove-sdk needed): one line per violation, uncertain
 window or blocked (replaced) action; level error for violations, warning otherwise."""
 
+SIGNATURE = "/monitor/signature"
+"""Signed checkpoints (:mod:`monitor.log.sign`; only in a log written with a key): one when the log
+opens, one after every window and a final one at close, each an HMAC-SHA256 over every record
+before it. Not a :data:`JSON_TOPICS` entry: registered (schema ``monitor.Signature``) only when signing."""
+SIGNATURE_SCHEMA = ("monitor.Signature", "signature.json")
+
 FORMAT_VERSION = 3
 """Stored as ``format_version`` in the ``monitor.run`` metadata (absent = version 1)."""
 
@@ -125,7 +131,7 @@ PROFILE = ""
 @cache
 def schema_text(topic: str) -> str:
     """The JSON schema (text) registered for a JSON ``topic``."""
-    _, fname = JSON_TOPICS[topic]
+    _, fname = SIGNATURE_SCHEMA if topic == SIGNATURE else JSON_TOPICS[topic]
     return resources.files("monitor.log").joinpath("schemas", fname).read_text(encoding="utf-8")
 
 
@@ -136,7 +142,7 @@ def schema(topic: str) -> dict[str, Any]:
 
 __all__ = [
     "CERTIFICATE", "VIOLATION", "PLAN", "ACTION", "SCENE", "MARKERS", "TRANSFORMS", "LOG", "JSON_TOPICS",
-    "FORMAT_VERSION", "APPLIED_MOTIONS_KEY", "ROLLOUTS_KEY",
+    "SIGNATURE", "FORMAT_VERSION", "APPLIED_MOTIONS_KEY", "ROLLOUTS_KEY",
     "METADATA_MODEL_EDIT", "MODEL_EDITS_KEY", "METADATA_FINALISE", "METADATA_JSON_KEYS", "METADATA_REQUEST",
     "FOXGLOVE_TOPICS", "METADATA_RUN", "METADATA_MODEL", "ATTACHMENT_XML", "ATTACHMENT_MJB",
     "ASSET_PREFIX", "schema", "schema_text",

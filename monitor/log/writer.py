@@ -32,6 +32,12 @@ Two phases (crash tolerance *and* an indexed file):
    (:func:`finalise_log`; ``index=False`` keeps the journal). A journal left by a
    killed writer is finalised by ``python -m monitor review --reindex FILE``.
 
+Integrity and authenticity: every record is fed to a SHA-256 chain (:mod:`monitor.log.digest`),
+sealed at close (unkeyed: tamper evidence against accidents, not against a forger). With a key
+(``key=`` or ``$MONITOR_LOG_KEY_FILE``) the log also holds HMAC-SHA256 checkpoints of that chain
+(:mod:`monitor.log.sign`): one at open, one after every window (inside the per-window flush, so a
+killed writer leaves every finished window signed) and a final one at close.
+
 Model export: the exact compiled model is always attached as MJB
 (``mj_saveModel``; loadable by the same MuJoCo version). The MJCF XML comes from an
 ``MjSpec`` (pass ``model_source=`` a path or spec) or, failing that, from
@@ -63,13 +69,14 @@ from mcap.writer import CompressionType, Writer
 from monitor._json import jsonable
 from monitor.certify.types import Verdict
 from monitor.errors import InvalidInputError, LogFormatError
-from monitor.log import replay, topics
+from monitor.log import replay, sign, topics
 from monitor.log.digest import METADATA_DIGEST, Digest
 
 MAX_MESSAGES_PER_WINDOW = 8
 """Upper bound on records one window writes (plan, certificate, violation, action,
 log, tf, and up to two scene updates on the first window): the most a killed writer can
-lose under the per-window flush policy."""
+lose under the per-window flush policy. A signing log writes one more, its checkpoint
+(:mod:`monitor.log.sign`), as the window's last record."""
 
 FINAL_CHUNK_BYTES = 1 << 20
 """Chunk size (bytes, before compression) of a finalised log."""
@@ -362,6 +369,13 @@ class MonitorLog:
         fsync: ``os.fsync`` after every window (power-loss durability; slower).
         index: on :meth:`close`, rewrite the journal into a chunked, indexed file
             (:func:`finalise_log`); False leaves the unchunked journal.
+        key: sign the log (:mod:`monitor.log.sign`): bytes (at least 16; random), an HMAC-SHA256
+            checkpoint after opening, after every window and at close. None: the key in the file
+            named by ``$MONITOR_LOG_KEY_FILE`` when that is set, else an unsigned log. False:
+            unsigned whatever the environment says.
+
+    Raises:
+        LogKeyError: an unusable ``key`` or key file (before the file is created).
 
     Example:
         >>> with MonitorLog("run.mcap", model=model, metadata={"margin": 0.01}) as log:
@@ -378,7 +392,9 @@ class MonitorLog:
 
     def __init__(self, path: str | os.PathLike[str] | None = None, *, model: Any = None,
                  metadata: dict[str, Any] | None = None, env_id: str | None = None, foxglove: bool = True,
-                 model_source: Any = None, fsync: bool = False, index: bool = True) -> None:
+                 model_source: Any = None, fsync: bool = False, index: bool = True,
+                 key: bytes | bool | None = None) -> None:
+        self._signer = _signer(key)  # before the file is created: a bad key leaves nothing behind
         self.path = Path(path) if path is not None else default_path(env_id)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._fsync = bool(fsync)
@@ -395,6 +411,11 @@ class MonitorLog:
                                           data=topics.schema_text(topic).encode("utf-8"))
             self._channels[topic] = self._w.register_channel(topic=topic, message_encoding="json",
                                                              schema_id=sid)
+        if self._signer is not None:
+            sid = self._w.register_schema(name=topics.SIGNATURE_SCHEMA[0], encoding="jsonschema",
+                                          data=topics.schema_text(topics.SIGNATURE).encode("utf-8"))
+            self._channels[topics.SIGNATURE] = self._w.register_channel(
+                topic=topics.SIGNATURE, message_encoding="json", schema_id=sid)
         self._index = 0
         self._seq = 0
         self._episode = 0
@@ -413,11 +434,13 @@ class MonitorLog:
                "format_version": topics.FORMAT_VERSION,
                "flush_policy": "journal: unchunked; flush per window" + ("; fsync" if fsync else "")
                + ("; finalised into a chunked, indexed file on close" if index else ""),
-               "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW}
+               "max_messages_lost_on_kill": MAX_MESSAGES_PER_WINDOW + (self._signer is not None)}
         versions = package_versions()
         run.update({f"version.{k}": v for k, v in versions.items()})
         run["mujoco_version"] = versions.get("mujoco")
         run.update(metadata or {})
+        if self._signer is not None:
+            run[sign.RUN_KEY] = self._signer.claim()
         # requests the certificates answer: key text -> id (monitor.request records, see topics);
         # a "request" in the run metadata (a gate's, at open) is id 0 and gets no record of its own
         self._requests: dict[str, int] = {}
@@ -431,6 +454,7 @@ class MonitorLog:
         if model is not None:
             self._attach_model(model)
             self._model_base = _model_fields(model)
+        self._sign(self._open_ns, 0)
         self._flush()
 
     # ----------------------------------------------------------------- context manager
@@ -607,6 +631,17 @@ class MonitorLog:
         self._digest.message(topic, log_ns, sim_ns, self._seq, data)
         self._seq += 1
 
+    def _sign(self, log_ns: int, sim_ns: int, final: bool = False) -> None:
+        """A signed checkpoint over everything written so far (a signing log only)."""
+        if self._signer is not None:
+            payload = self._signer.checkpoint(self._digest, self._index, final)
+            self._put(topics.SIGNATURE, log_ns, sim_ns, payload)
+
+    @property
+    def key_id(self) -> str | None:
+        """Id of the signing key (:func:`monitor.log.sign.key_id`); None for an unsigned log."""
+        return None if self._signer is None else self._signer.key_id
+
     def _flush(self) -> None:
         self._f.flush()
         if self._fsync:
@@ -739,6 +774,7 @@ class MonitorLog:
         self._index += 1
         self._last_sim_time = t
         self._last_log_ns = log_ns
+        self._sign(log_ns, sim_ns)
         self._flush()
         return k
 
@@ -769,6 +805,7 @@ class MonitorLog:
             return
         self._closed = True
         try:
+            self._sign(max(self._last_log_ns, self._open_ns), 0, final=True)
             self._w.add_metadata(METADATA_DIGEST, self._digest.seal())
             self._w.finish()
         finally:
@@ -781,6 +818,17 @@ class MonitorLog:
 
 
 # --------------------------------------------------------------------------- helpers
+
+
+def _signer(key: Any) -> sign.Signer | None:
+    """The log's signer: ``key`` bytes, None (``$MONITOR_LOG_KEY_FILE`` if set) or False (none)."""
+    if key is False:
+        return None
+    if key is None:
+        key = sign.key_from_env()
+        if key is None:
+            return None
+    return sign.Signer(key)
 
 
 APPLIED_KINDS = ("fallback", "brake_tail")
