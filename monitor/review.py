@@ -1623,9 +1623,9 @@ def signature_findings(contents: LogContents, key: bytes | None, find: Callable[
 
     Critical: a checkpoint that does not verify (the first is named), a key given and the log
     unsigned or signed by another key id, records after the signed close, a seal (a claimed
-    close) without a signed close. Unverifiable: records after the last valid checkpoint.
-    Notes: no key for a signed log ("signature not checked: no key"), no signed close, what
-    verified. An unsigned log without a key: nothing (as before signing existed).
+    close) without a signed close. Unverifiable: records after the last valid checkpoint, or no
+    signed close (a copy cut after a checkpoint). Notes: no key for a signed log ("signature not
+    checked: no key"), what verified. An unsigned log without a key: nothing (as before signing existed).
 
     Returns:
         the check as a dict (``status``, ``key_id``, ``signed_windows``, ``unsigned_windows``, ...).

@@ -283,8 +283,8 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
     (the first one is named), a key given and the log unsigned or signed with another key id,
     records after the signed close, a log whose seal claims a close that is not signed;
     *unverifiable*: records after the last valid checkpoint (a writer killed inside a window, or
-    records appended); *notes*: no key given for a signed log ("signature not checked"), no
-    signed close, the checkpoints verified.
+    records appended), no signed close (the log may have been cut after a checkpoint); *notes*:
+    no key given for a signed log ("signature not checked"), the checkpoints verified.
 
     Args:
         contents: a :class:`~monitor.log.reader.LogContents`.
@@ -359,8 +359,12 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
             out.critical.append(f"the log claims a close (its digest seal) that is not signed: the signed "
                                 f"part ends at {where}")
         else:
-            out.notes.append(f"no signed close: the signed part ends at {where} (a killed writer, or a copy "
-                             f"cut there: whether the run went on cannot be known)")
+            # unverifiable, not a note: a copy cut right after a checkpoint hides every later window
+            # (a violation among them) and reads exactly like a killed writer's log
+            if not out.unverifiable:  # else the tail's finding already says the log ends unsigned
+                out.unverifiable.append(f"no signed close: the signed part ends at {where} (a killed "
+                                        f"writer, or a copy cut there: whether windows followed cannot be "
+                                        f"known)")
     if out.critical:
         out.status = "mismatch"
     elif out.signed_close:
