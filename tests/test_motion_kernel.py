@@ -474,9 +474,12 @@ def test_pair_bound_relative_to_the_common_ancestor_holds_on_dense_samples():
 
 def test_rounding_scale_equals_its_definition_with_static_bodies():
     """The pack's rounding scale (``tol[TOL_SCALE]``, ``batch(BATCH_SCALE)``) is exactly its
-    definition: max over waypoints and bodies of |origin| (every body's FK at every waypoint,
-    ``tree_poses``) + reference points + the whole-window bound at scale 0. The kernel
-    recomputes only the moving bodies after the first waypoint; here random trees get some
+    definition, ``max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` (poses at
+    the window's midpoint m by ``tree_poses``, W the whole-window bound at scale 0), equals
+    ``Plan._scale`` (MuJoCo FK + the plan's own numpy bounds, 1e-9), and is at least (i) the
+    former definition (max over waypoints and bodies of |origin| by MuJoCo FK, + max W +
+    3 max |ref|: pads only grow) and (ii) every body's |origin| and |reference point| at 64
+    dense times of the window (MuJoCo FK: the magnitude it stands for). Random trees get some
     coordinates frozen (static bodies between moving ones), some frozen at +-0 alternately
     (equal, so not moving, but not the same bits)."""
     rng = np.random.default_rng(20261128)
@@ -495,22 +498,34 @@ def test_rounding_scale_equals_its_definition_with_static_bodies():
                     qpos[:, a] = np.where(np.arange(K) % 2 == 0, 0.0, -0.0)
         mocap_pos = rng.uniform(-1, 1, (m.nmocap, 3)) if m.nmocap else None
         mocap_quat = np.array([_rand_quat(rng) for _ in range(m.nmocap)]) if m.nmocap else None
-        mp = pack_trajectory(Plan(times, qpos, model=m, mocap_pos=mocap_pos, mocap_quat=mocap_quat))
+        plan = Plan(times, qpos, model=m, mocap_pos=mocap_pos, mocap_quat=mocap_quat)
+        mp = pack_trajectory(plan)
         nbody = m.nbody
         n_static += int(np.count_nonzero(mp.body_moving[1:] == 0))
         if not mp.body_moving.any():
             assert mp.tol[KN.TOL_SCALE] == 0.0
             continue
-        pos, _ = body_poses(mp, mp.times)                  # tree_poses at every waypoint
-        big = float(np.linalg.norm(pos, axis=-1).max())
-        ref_norm = float(np.linalg.norm(mp.ref_points, axis=-1).max())
+        scale = mp.tol[KN.TOL_SCALE]
+        mid = 0.5 * (mp.times[:1] + mp.times[-1:])
+        pos_m, _ = body_poses(mp, mid)                     # tree_poses at the midpoint
+        rho = np.linalg.norm(mp.ref_points, axis=-1)
         mp0 = mp._replace(tol=mp.tol.copy())
         mp0.tol[KN.TOL_SCALE] = 0.0
         tr = np.empty((1, nbody))
         KN.batch(mp0, KN.BATCH_BOUNDS, mp.times[:1].copy(), mp.times[-1:].copy(), np.empty((1, nbody, 3)),
                  np.empty((1, nbody, 3, 3)), tr, np.empty((1, nbody)))
-        whole = max(float(tr.max()), 0.0)
-        assert mp.tol[KN.TOL_SCALE] == big + ref_norm + whole + 2.0 * ref_norm
+        whole = tr[0]
+        per_body = np.linalg.norm(pos_m[0], axis=-1) + 2.0 * rho + whole
+        assert scale == float(per_body.max()) + float(whole.max()) + 3.0 * float(rho.max())
+        assert scale == pytest.approx(plan._scale, rel=1e-9)
+        wp_pos, _ = plan.body_poses(plan.times)           # MuJoCo FK at every waypoint
+        former = float(np.linalg.norm(wp_pos, axis=-1).max()) + float(whole.max()) + 3.0 * float(rho.max())
+        assert scale >= former * (1.0 - 1e-12)
+        dense = np.linspace(plan.t0, plan.t1, 64)
+        pos_d, mat_d = plan.body_poses(dense)
+        ref_d = pos_d + np.einsum("tbij,bj->tbi", mat_d, plan.ref_points)
+        assert float(np.linalg.norm(pos_d, axis=-1).max()) <= scale * (1.0 + 1e-12)
+        assert float(np.linalg.norm(ref_d, axis=-1).max()) <= scale * (1.0 + 1e-12)
     assert n_static > 20
 
 

@@ -1037,9 +1037,12 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
     * ``BATCH_BOUNDS``: tree_bounds for N sub-intervals [t0[n], t1[n]]: pos (N, nbody, 3),
       rot (N, nbody, 3, 3), trans/angle (N, nbody). Returns 0.
     * ``BATCH_POSES``: tree_poses at the N times t0: pos, rot. Returns 0.
-    * ``BATCH_SCALE``: the rounding scale of the trajectory (m), as ``Plan._scale``: waypoint
-      origins + reference points + the whole-window bound computed with scale 0
-      (``mp.tol[3]`` must be 0 when this is called). pos/rot/trans/angle: (1, nbody, ...) scratch.
+    * ``BATCH_SCALE``: the rounding scale of the trajectory (m), as ``Plan._scale``: from the
+      whole-window bounds computed with scale 0 and the poses at the window's midpoint,
+      ``max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` (no FK at the
+      waypoints; ``inf`` if a term is NaN). ``mp.tol[3]`` must be 0 when this is called.
+      pos/rot/trans/angle: (1, nbody, ...) scratch; on return they hold the whole-window
+      poses at the midpoint and bounds.
     """
     if mode == BATCH_BOUNDS:
         for n in range(t0.shape[0]):
@@ -1049,50 +1052,33 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
         for n in range(t0.shape[0]):
             tree_poses(mp, t0[n], pos[n], rot[n])
         return 0.0
+    # The scale from ONE whole-window pass (issue 12, packscale): with m the window's midpoint,
+    # W_b / A_b body b's whole-window bounds (computed here with scale 0) and rho_b = |ref_b|,
+    # every origin satisfies |x_b(t)| <= |x_b(m)| + W_b + chord(A_b) rho_b <= |x_b(m)| + W_b + 2 rho_b
+    # (rule (1) of plan.py about the reference point), so
+    #     S = max_b (|x_b(m)| + 2 rho_b + W_b) + max_b W_b + 3 max_b rho_b
+    # is >= the former definition (max over waypoints and bodies of |x_b(t_k)|, + max W + 3 max rho)
+    # and every pad grows with S (plan.py, "Rounding"). No FK at the K waypoints.
     nbody = mp.body_parent.shape[0]
     K = mp.times.shape[0]
-    ref_norm = 0.0
-    for b in range(nbody):
-        r = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
-        if r > ref_norm:
-            ref_norm = r
-    # tree_poses at every waypoint, its scratch allocated once for the K calls (the same
-    # calls of _locate / _qpos_at / _fk). After the first waypoint only the moving bodies
-    # are recomputed (issue 12, Arm tail: ~130 us of FK for a 131-waypoint pack): a body
-    # with body_moving == 0 is the world, a mocap body or a body whose chain coordinates
-    # compare equal at every waypoint (``derive``), so its pose is the first waypoint's
-    # (equal inputs to the same arithmetic; +-0 inputs can only flip the sign of a zero
-    # coordinate), and _fk leaves the rows of bodies it skips as they are, so a moving
-    # body reads its static parent's pose from the first pass. Same norms, same maximum.
-    njnt = mp.jnt_type.shape[0]
-    need = np.ones(nbody, dtype=np.int64)
-    moving_need = np.empty(nbody, dtype=np.int64)
-    for b in range(nbody):
-        moving_need[b] = 1 if mp.body_moving[b] != 0 else 0
-    q = np.empty(mp.qpos.shape[1])
-    xquat = np.empty((nbody, 4))
-    ja = np.empty((njnt, 3))
-    jx = np.empty((njnt, 3))
-    jf = np.empty((njnt, 4))
-    tmp3 = np.empty(4)
-    qloc = np.empty(4)
-    big = 0.0
-    for k in range(K):
-        i, s, at_end = _locate(mp.times, mp.times[k])
-        _qpos_at(mp.qpos, mp.qt_adr, mp.qt_same, mp.qt_half, mp.qt_target, i, s, at_end, q)
-        _fk(mp.body_parent, mp.body_mocap, mp.body_pos, mp.body_quat, mp.body_jntadr, mp.body_jntnum,
-            mp.jnt_type, mp.jnt_qposadr, mp.jnt_pos, mp.jnt_axis, mp.jnt_axis_norm, mp.qpos0,
-            q, need if k == 0 else moving_need, pos[0], xquat, rot[0], ja, jx, jf, tmp3, qloc)
-        for b in range(nbody):
-            r = _norm3(pos[0, b, 0], pos[0, b, 1], pos[0, b, 2])
-            if r > big:
-                big = r
     tree_bounds(mp, mp.times[0], mp.times[K - 1], pos[0], rot[0], trans[0], angle[0])
+    ref_norm = 0.0
     whole = 0.0
+    body = 0.0
     for b in range(nbody):
-        if trans[0, b] > whole:
-            whole = trans[0, b]
-    return big + ref_norm + whole + 2.0 * ref_norm
+        rho = _norm3(mp.ref_points[b, 0], mp.ref_points[b, 1], mp.ref_points[b, 2])
+        if rho > ref_norm:
+            ref_norm = rho
+        w = trans[0, b]
+        if w > whole:
+            whole = w
+        v = _norm3(pos[0, b, 0], pos[0, b, 1], pos[0, b, 2]) + 2.0 * rho + w
+        if v > body:
+            body = v
+        elif v != v:               # NaN (overflowing coordinates): no finite scale
+            body = math.inf
+    scale = body + whole + 3.0 * ref_norm
+    return scale if scale == scale else math.inf
 
 
 @njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)

@@ -13,7 +13,9 @@ compiled specialisation serves every trajectory.
   interpolation. The world (body 0) holds its constant pose.
 
 The rounding scale (``tol[3]``) is computed once here, by the kernels, as
-``Plan._scale`` defines it (waypoint origins + reference points + whole-window bound).
+``Plan._scale`` defines it (the poses at the window's midpoint + reference points + the
+whole-window bound: one bound pass, no FK at the waypoints; ``monitor.motion.plan``, "The
+rounding scale").
 """
 
 from __future__ import annotations

@@ -102,6 +102,28 @@ rel_pad * (total path + 1). The results are then padded by
 plan, covering the FK rounding of MuJoCo's poses) and angles by
 rel_pad * Theta + abs_pad (radians).
 
+*The rounding scale* S (``Plan._scale``; the compiled pack's ``tol[3]``, the same
+formula). With m the window's midpoint, x_b(m) body b's FK origin there, W_b its
+whole-window translation bound computed with scale 0 and rho_b = ||ref_b||:
+
+    S = max_b (||x_b(m)|| + 2 rho_b + W_b) + max_b W_b + 3 max_b rho_b.
+
+(a) S bounds every origin and reference point over the window: by (1) about the
+reference point, ||x_b(t) - x_b(m)|| <= W_b + chord(Theta_b) rho_b <= W_b + 2 rho_b, so
+||x_b(t)|| <= max_b (||x_b(m)|| + 2 rho_b + W_b) for every t, and
+||x_b(t) + R_b(t) ref_b|| <= that + rho_b <= S. (b) S is at least the former
+definition (FK at all K waypoints), max_{k,b} ||x_b(t_k)|| + max_b W_b + 3 max_b rho_b,
+by (a) at t = t_k. (c) Every translation bound is a nondecreasing function of S and no angle depends on it: S
+enters only through nonnegative multiples, rel_pad * S * coef_k of each rotational
+chain term (coef_k >= 0), scale_pad * S in the chain and final pads (and in the zero
+bound of a frozen base, ``kernel._bounds_core``), and rel_pad * 4 h sum|omega| * S in the
+velocity bound (h >= 0); sums, minima and the parent's bound (by induction from the
+root) keep that order. By (b) and (c), every bound with this S is at least the bound
+with the former scale at the same sub-interval: pads only grow, never shrink. A NaN term
+(overflowing coordinates) makes S = inf, not a NaN that a maximum or a comparison would
+skip (the engine's compiled path refuses scales >= 1e9 m).
+It costs one FK at m and the one whole-window bound instead of FK at all K waypoints.
+
 *Reference points.* The bound grows with ||p - ref_b||, so ref_b is the centre of
 the box around the bounding spheres of the body's geoms (``geom_pos`` +-
 ``geom_rbound``, planes count as their origin), or ``body_ipos`` when the body
@@ -284,7 +306,9 @@ class _ModelStructure:
         self.flag_cache: dict[bytes, tuple] = {}
         self.ref = _ref_points(model)
         self.ref.setflags(write=False)
-        self.ref_norm = float(np.max(np.linalg.norm(self.ref, axis=-1), initial=0.0))
+        self.ref_norms = np.linalg.norm(self.ref, axis=-1)   # (nbody,) |ref_b| (m)
+        self.ref_norms.setflags(write=False)
+        self.ref_norm = float(np.max(self.ref_norms, initial=0.0))
         for arr in (self.mocap_pos0, self.mocap_quat0, self.mocap_rows, self.mocap_ids, self.quat_cols,
                     self.lin, self.body_pos, self.body_quat, self.body_mat, self.vkind, *self.jnt.values()):
             if isinstance(arr, np.ndarray):
@@ -623,6 +647,7 @@ class Plan(WindowTimes):
         # Waypoint poses (for translation segments and the rounding scale) and the
         # rounding scale are computed on first use (see ``_wp_pos`` / ``_scale``).
         self._wp_cache: tuple[np.ndarray, np.ndarray] | None = None
+        self._wp0_cache: tuple[np.ndarray, np.ndarray] | None = None
         self._scale_cache: float | None = None
         self._mb_cache: dict[bytes, MotionBounds] = {}
         self._pose_cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
@@ -647,14 +672,37 @@ class Plan(WindowTimes):
         return self._wp_cache[1]
 
     @property
+    def _wp0(self) -> tuple[np.ndarray, np.ndarray]:
+        """FK at the first waypoint: origins (nbody, 3) m and rotations (nbody, 3, 3).
+
+        Row 0 of ``_wp_pos`` / ``_wp_mat`` (the same ``mj_kinematics`` call on the same qpos
+        row and mocap poses: the same numbers), without the FK at the other waypoints.
+        """
+        if self._wp_cache is not None:
+            return self._wp_cache[0][0], self._wp_cache[1][0]
+        if self._wp0_cache is None:
+            pos, mat = self._fk(self._qpos[:1])
+            self._wp0_cache = (pos[0], mat[0])
+        return self._wp0_cache
+
+    @property
     def _scale(self) -> float:
-        """Coordinate magnitude of the plan (m), for the rounding pads of the bounds."""
+        """Coordinate magnitude of the plan (m), for the rounding pads of the bounds.
+
+        ``S = max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` with m the
+        window's midpoint, x_b(m) the FK origin there and W_b body b's whole-window bound
+        computed with scale 0 (module docstring, "Rounding"); ``inf`` if a term is NaN.
+        The compiled pack computes the same formula (``batch(BATCH_SCALE)``).
+        """
         if self._scale_cache is None:
-            ref_norm = self._st.ref_norm
-            scale = float(np.max(np.linalg.norm(self._wp_pos, axis=-1), initial=0.0)) + ref_norm
-            whole = self._bounds(self._times[:1].copy(), self._times[-1:].copy(), scale=0.0,
-                                 kinds=Plan._bound_kinds)
-            self._scale_cache = scale + float(np.max(whole[0], initial=0.0)) + 2.0 * ref_norm
+            ta, tb = self._times[:1].copy(), self._times[-1:].copy()
+            whole = self._bounds(ta, tb, scale=0.0, kinds=Plan._bound_kinds)[0][0]   # (nbody,)
+            x_m = self._fk(self._qpos_many(0.5 * (ta + tb)))[0][0]                  # (nbody, 3)
+            rho = self._st.ref_norms
+            per_body = np.linalg.norm(x_m, axis=-1) + 2.0 * rho + whole
+            scale = (float(np.max(per_body, initial=0.0)) + float(np.max(whole, initial=0.0))
+                     + 3.0 * self._st.ref_norm)
+            self._scale_cache = scale if scale == scale else math.inf
         return self._scale_cache
 
     # ------------------------------------------------------------------ basics
@@ -909,7 +957,8 @@ class Plan(WindowTimes):
         def frame(c: int) -> tuple[np.ndarray, np.ndarray]:
             if c in frames:
                 return frames[c]
-            return self._wp_mat[0, c][None], self._wp_pos[0, c][None]  # constant frame
+            wp_pos, wp_mat = self._wp0
+            return wp_mat[c][None], wp_pos[c][None]  # constant frame (its pose at every time)
 
         for b in range(1, nbody):
             if not self._moving[b]:
