@@ -437,3 +437,19 @@ def test_trusted_refuses_what_the_validating_constructor_refuses(bad):
     with pytest.raises(InvalidInputError) as got:
         Plan._trusted(t.copy(), q.copy(), m, mocap_pos=mp.copy(), mocap_quat=mq.copy())
     assert str(got.value) == str(want.value)
+
+
+def test_reference_points_stay_read_only_through_pickles_and_copies(model):
+    """``Plan.ref_points`` and the per-model structure's arrays lie over immutable bytes: they
+    cannot be made writable again (a read-only array that owns its memory can), also after a
+    pickle or deepcopy round trip (unpickled arrays are writable)."""
+    import copy
+    import pickle
+
+    q0 = model.qpos0.copy()
+    plan = Plan([0.0, 0.1], np.stack([q0, q0]), model)
+    for p in (plan, pickle.loads(pickle.dumps(plan)), copy.deepcopy(plan)):
+        for arr in (p.ref_points, p._st.ref, p._st.ref_norms):
+            for owner in (arr, arr.base):
+                with pytest.raises(ValueError):
+                    owner.setflags(write=True)

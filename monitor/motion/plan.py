@@ -142,7 +142,7 @@ import numpy as np
 from monitor.certify.common import check_active_budget
 from monitor.errors import InvalidInputError
 from monitor.motion import _kinematics as K
-from monitor.motion.base import MotionBounds, WindowTimes, chord, sealed
+from monitor.motion.base import MotionBounds, Sealed, WindowTimes, chord, sealed
 from monitor.tolerances import DEFAULT, Tolerances
 
 _FREE = int(mujoco.mjtJoint.mjJNT_FREE)
@@ -179,7 +179,7 @@ _STRUCT_CACHE: dict[bytes, _ModelStructure] = {}
 _STRUCT_CACHE_MAX = 16
 
 
-class _ModelStructure:
+class _ModelStructure(Sealed):
     """Everything :class:`Plan` derives from the model alone (read-only, shared)."""
 
     key: bytes = b""
@@ -304,10 +304,10 @@ class _ModelStructure:
         self.chains: dict[bytes, tuple[list[np.ndarray], list[int]]] = {}
         # (moving, rotating, chains) per pattern of changing qpos columns (_flags_and_chains).
         self.flag_cache: dict[bytes, tuple] = {}
-        self.ref = _ref_points(model)
-        self.ref.setflags(write=False)
-        self.ref_norms = np.linalg.norm(self.ref, axis=-1)   # (nbody,) |ref_b| (m)
-        self.ref_norms.setflags(write=False)
+        # over bytes, never writable again: Plan.ref_points hands ``ref`` out, and the motion packs
+        # and memos derived from it are cached per structure
+        self.ref = sealed(_ref_points(model))
+        self.ref_norms = sealed(np.linalg.norm(self.ref, axis=-1))   # (nbody,) |ref_b| (m)
         self.ref_norm = float(np.max(self.ref_norms, initial=0.0))
         for arr in (self.mocap_pos0, self.mocap_quat0, self.mocap_rows, self.mocap_ids, self.quat_cols,
                     self.lin, self.body_pos, self.body_quat, self.body_mat, self.vkind, *self.jnt.values()):
