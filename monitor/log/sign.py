@@ -266,6 +266,9 @@ def _point_problem(sp: SignPoint, j: int, keyed: Any, kid: str) -> str | None:
     if p["messages"] != sp.messages_before:
         return (f"it covers {p['messages']} message(s), {sp.messages_before} precede it (messages added or "
                 f"dropped)")
+    if p["windows"] != sp.certificates_before:
+        return (f"it covers {p['windows']} window(s), {sp.certificates_before} certificate(s) were read "
+                f"before it (certificates hidden from the reader, e.g. on a channel that is not json)")
     if not hmac.compare_digest(_mac(keyed, p, sp.chain), p["mac"]):
         return "its HMAC does not match: a record it covers was changed after signing"
     return None
