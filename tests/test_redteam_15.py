@@ -14,16 +14,22 @@ gate, and a bad key surfaced only at the first step.
 
 from __future__ import annotations
 
+import copy
 import json
+import pickle
 
+import mujoco
+import numpy as np
 import pytest
 from mcap.data_stream import RecordBuilder
 from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 from mcap_rewrite import rewrite
-from test_log_digest import seal_copy
+from test_log_digest import XML, seal_copy
 from test_log_sign import KEY, _review, _scripted, key_file, signed_bounce  # noqa: F401 - fixtures
 
+from monitor.errors import LogKeyError
+from monitor.gate import Gate
 from monitor.log import read_log, topics
 from monitor.log.reader import MAGIC
 from monitor.log.sign import KEY_FILE_ENV, check_signatures
@@ -94,3 +100,30 @@ def test_a_hidden_violation_window_fails_review_with_the_key(signed_bounce, tmp_
     sig = entry["verify"]["signature"]
     assert code == 1 and sig["status"] == "mismatch"
     assert sig["first_bad"]["checkpoint"] == first_violation + 1 and sig["signed_windows"] == first_violation
+
+
+def test_a_gate_does_not_copy_its_log_key_into_pickles_or_copies(tmp_path):
+    model = mujoco.MjModel.from_xml_string(XML)
+    g = Gate(model, log=tmp_path / "g.mcap", log_options={"key": KEY}, allowed=None)
+    for clone in (pickle.loads(pickle.dumps(g)), copy.deepcopy(g)):
+        assert KEY not in pickle.dumps(clone) and KEY.hex().encode() not in pickle.dumps(clone)
+        with pytest.raises(LogKeyError, match="not copied"):  # the copy cannot write an unsigned log
+            clone.step(mujoco.MjData(model), np.zeros(model.nu))
+    assert not (tmp_path / "g.mcap").exists()
+    assert KEY not in pickle.dumps(g)
+    g.step(mujoco.MjData(model), np.zeros(model.nu))  # the original still signs
+    g.close()
+    assert check_signatures(read_log(tmp_path / "g.mcap"), KEY).status == "verified"
+
+
+def test_a_gate_refuses_a_bad_log_key_when_it_is_made(tmp_path, monkeypatch):
+    model = mujoco.MjModel.from_xml_string(XML)
+    with pytest.raises(LogKeyError, match="at least 16"):
+        Gate(model, log=tmp_path / "a.mcap", log_options={"key": KEY[:15]})
+    with pytest.raises(LogKeyError, match="must be bytes"):
+        Gate(model, log=tmp_path / "a.mcap", log_options={"key": KEY.hex()})
+    monkeypatch.setenv(KEY_FILE_ENV, str(tmp_path / "missing.key"))
+    with pytest.raises(LogKeyError, match="MONITOR_LOG_KEY_FILE"):
+        Gate(model, log=tmp_path / "a.mcap")
+    assert not list(tmp_path.iterdir())
+    Gate(model, log=tmp_path / "a.mcap", log_options={"key": False})  # unsigned on purpose: no key read
