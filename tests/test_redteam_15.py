@@ -127,3 +127,18 @@ def test_a_gate_refuses_a_bad_log_key_when_it_is_made(tmp_path, monkeypatch):
         Gate(model, log=tmp_path / "a.mcap")
     assert not list(tmp_path.iterdir())
     Gate(model, log=tmp_path / "a.mcap", log_options={"key": False})  # unsigned on purpose: no key read
+
+
+@pytest.mark.parametrize("last", [b"\n", b" ", b"\t", b"\r"])
+def test_a_key_ending_in_whitespace_is_one_key_in_code_and_in_a_key_file(tmp_path, capsys, last):
+    """A random key whose last byte is ASCII whitespace (4 of 256 keys): the writer signed with the key as
+    given in code, review read the same bytes from a key file and stripped the whitespace: another key id,
+    "signed by another key" (exit 1) for a genuine log."""
+    key = bytes(range(40, 71)) + last  # 32 bytes
+    path = tmp_path / "a.mcap"
+    _scripted(path, n=2, key=key)
+    own_file = tmp_path / "log.key"
+    own_file.write_bytes(key)  # the user's key, byte for byte
+    code, entry = _review(path, "--key-file", own_file, capsys=capsys)
+    assert code == 0 and entry["signature"]["status"] == "verified"
+    assert check_signatures(read_log(path), key).status == "verified"  # the Python API, key as given
