@@ -1327,6 +1327,8 @@ class Gate:
         self._rollout = Rollout(model)
         self._log_spec = log
         self._log_options = dict(log_options or {})
+        if isinstance(log, (str, os.PathLike)):
+            self._log_options["key"] = _log_key(self._log_options.get("key"))  # a bad key: here, not mid-run
         self._log = None
         self._log_owned = False
         self._log_lock: Any = None
@@ -2285,6 +2287,12 @@ class Gate:
             return self._log
         spec = self._log_spec
         if isinstance(spec, (str, os.PathLike)):
+            if self._log_options.get("key") == _KEY_WITHHELD:
+                from monitor.errors import LogKeyError
+
+                raise LogKeyError("this Gate is a pickled or deep-copied one whose log is signed with "
+                                  "log_options['key']: the key is not copied with a Gate; make the gate "
+                                  "anew with the key (or sign with $MONITOR_LOG_KEY_FILE)")
             from monitor.log._lock import claim_log_path
             from monitor.log.writer import MonitorLog  # lazy: mcap only when logging
 
@@ -2432,9 +2440,15 @@ class Gate:
                 self._log_lock = None
 
     def __getstate__(self) -> dict[str, Any]:
-        """Pickle state: everything but the weak reference to the last checked ``MjData``."""
+        """Pickle state: all but the weak reference to the last checked ``MjData`` and the log's key.
+
+        The signing key (``log_options["key"]``) is never written into a pickle or a deep copy; a
+        copy that opens its log raises :class:`~monitor.errors.LogKeyError`.
+        """
         state = self.__dict__.copy()
         state["_data_checked"] = None
+        if isinstance(self._log_options.get("key"), bytes):
+            state["_log_options"] = {**self._log_options, "key": _KEY_WITHHELD}
         return state
 
     def __enter__(self) -> Gate:
@@ -2442,6 +2456,29 @@ class Gate:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+_KEY_WITHHELD = "<log signing key withheld from a pickled or copied Gate>"
+"""Stands for ``log_options["key"]`` in a pickled or deep-copied :class:`Gate` (see ``Gate.__getstate__``)."""
+
+
+def _log_key(key: Any) -> Any:
+    """``log_options["key"]`` checked when the gate is made (the log opens at the first window).
+
+    Bytes of a valid key (:func:`monitor.log.sign.as_key`); None: the key file named by
+    ``$MONITOR_LOG_KEY_FILE`` is checked now and read again when the log opens; False: unsigned.
+
+    Raises:
+        LogKeyError: an unusable key or key file.
+    """
+    from monitor.log import sign  # lazy: mcap only when logging
+
+    if key is None:
+        sign.key_from_env()
+        return None
+    if key is False:
+        return False
+    return sign.as_key(key, "log_options['key']")
 
 
 _GATE_CERTIFY = Gate._certify

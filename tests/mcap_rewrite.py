@@ -26,14 +26,17 @@ def _compact(obj: Any) -> bytes:
 def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = None,
             metadata: Callable[[str, dict], dict] | None = None,
             attachments: Callable[[str, bytes], bytes | None] | None = None,
-            chunked: bool = False, append: list[tuple[str, dict]] | None = None) -> None:
+            chunked: bool = False, append: list[tuple[str, dict]] | None = None,
+            encoding: Callable[[str, dict], str | None] | None = None) -> None:
     """Copy ``src`` to ``dst`` record by record; the digest seal is stripped (as a forger would).
 
     ``msg(topic, payload)`` (JSON channels) returns the payload (edited in place or new; raw bytes
     are written as they are), None to drop it, or a list of payloads to write several;
     ``metadata(name, values)`` edits decoded metadata values (without it the stored strings are
     copied unchanged); ``attachments(name, data)`` returns new bytes or None to drop;
-    ``append``: ``(topic, payload)`` messages written after every other message (1 ns later each).
+    ``append``: ``(topic, payload)`` messages written after every other message (1 ns later each);
+    ``encoding(topic, payload)`` (JSON channels): a message encoding other than json moves the message,
+    unchanged, to a twin channel (same topic and schema) with that encoding; None keeps it.
     """
     with open(src, "rb") as fi, open(dst, "wb") as fo:
         r = make_reader(fi)
@@ -44,6 +47,7 @@ def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = No
         smap = {sid: w.register_schema(x.name, x.encoding, x.data) for sid, x in s.schemas.items()}
         cmap = {cid: w.register_channel(c.topic, c.message_encoding, smap.get(c.schema_id, 0), c.metadata)
                 for cid, c in s.channels.items()}
+        twins: dict[tuple[int, str], int] = {}
         for m in r.iter_metadata():
             if m.name == METADATA_DIGEST:
                 continue
@@ -61,8 +65,17 @@ def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = No
                 res = msg(ch.topic, json.loads(m.data))
                 res = [] if res is None else (res if isinstance(res, list) else [res])
                 outs = [o if isinstance(o, bytes) else _compact(o) for o in res]
+            cid = cmap[ch.id]
+            enc = None
+            if encoding is not None and ch.message_encoding == "json":
+                enc = encoding(ch.topic, json.loads(m.data))
+            if enc is not None:
+                if (ch.id, enc) not in twins:
+                    twins[(ch.id, enc)] = w.register_channel(ch.topic, enc, smap.get(ch.schema_id, 0),
+                                                             ch.metadata)
+                cid = twins[(ch.id, enc)]
             for data in outs:
-                w.add_message(cmap[ch.id], m.log_time, data, m.publish_time, m.sequence)
+                w.add_message(cid, m.log_time, data, m.publish_time, m.sequence)
             last = (m.log_time, m.publish_time, m.sequence)
         by_topic = {c.topic: cid for cid, c in s.channels.items()}
         for k, (topic, payload) in enumerate(append or []):

@@ -576,6 +576,11 @@ def read_log(path: str | os.PathLike[str], *, progress: bool | None = None) -> L
     return out
 
 
+_JSON_ONLY = frozenset(topics.JSON_TOPICS) | {topics.SIGNATURE}
+"""Topics the writer writes only as JSON: a message of theirs on another encoding is a bad payload
+(the digest chain covers a message's topic, times, sequence and bytes, not its channel record)."""
+
+
 def _take_message(out: LogContents, channels: dict[int, Channel], rec: Message) -> None:
     ch = channels.get(rec.channel_id)
     if ch is None:  # a message before its channel: corrupt writer, skip it
@@ -584,6 +589,10 @@ def _take_message(out: LogContents, channels: dict[int, Channel], rec: Message) 
         return
     out.counts[ch.topic] = out.counts.get(ch.topic, 0) + 1
     if ch.message_encoding != "json":
+        if ch.topic in _JSON_ONLY:  # a forger's twin channel: the digest and signatures do not cover channels
+            out.bad_payloads += 1
+            out.problem(f"{ch.topic} message (sequence {rec.sequence}) on a channel with message encoding "
+                        f"{ch.message_encoding[:40]!r}, not json: not decoded (the writer writes json)")
         return
     try:
         if len(rec.data) > MAX_JSON_BYTES:

@@ -49,6 +49,8 @@ MIN_KEY_BYTES = 16
 """Shortest key accepted (bytes). Use random bytes, e.g. ``head -c 32 /dev/urandom > log.key``."""
 RUN_KEY = "signature"
 """``monitor.run`` key of the signature claim (algorithm, key id, topic)."""
+_TRAILING = b" \t\r\n"
+"""Trailing bytes removed from every key (a key file's final newline; see :func:`as_key`)."""
 _DOMAIN = b"monitor-log-signature/1\0"
 _FIELDS = ("algorithm", "key_id", "checkpoint", "windows", "messages", "attachments", "metadata", "final")
 _PAYLOAD = ('{"algorithm":"%s","key_id":"%s","checkpoint":%d,"windows":%d,"messages":%d,"attachments":%d,'
@@ -64,6 +66,10 @@ def key_id(key: bytes) -> str:
 def as_key(key: Any, what: str = "key") -> bytes:
     """Validate a key: bytes (or bytearray / memoryview) of at least :data:`MIN_KEY_BYTES`.
 
+    Trailing ASCII whitespace (space, tab, CR, LF) is removed, as :func:`load_key` removes it from a
+    key file: a key given in code and the same bytes written to a key file are one key (a random
+    key ending in such a byte signed with one id and reviewed with another).
+
     Raises:
         LogKeyError: another type (a ``str`` is refused: a path or a passphrase? use
             :func:`load_key` for a file) or a key that is too short.
@@ -71,7 +77,7 @@ def as_key(key: Any, what: str = "key") -> bytes:
     if not isinstance(key, (bytes, bytearray, memoryview)):
         raise LogKeyError(f"{what} must be bytes (for a key file use monitor.log.sign.load_key(path) or "
                           f"${KEY_FILE_ENV}), got {type(key).__name__}")
-    key = bytes(key)
+    key = bytes(key).rstrip(_TRAILING)
     if len(key) < MIN_KEY_BYTES:
         raise LogKeyError(f"{what} has {len(key)} byte(s); at least {MIN_KEY_BYTES} are needed")
     return key
@@ -90,7 +96,7 @@ def load_key(path: str | os.PathLike[str]) -> bytes:
         data = p.read_bytes()
     except OSError as exc:
         raise LogKeyError(f"key file {str(p)!r}: cannot read it ({exc.strerror or exc})") from exc
-    data = data.rstrip(b" \t\r\n")
+    data = data.rstrip(_TRAILING)
     if not data:
         raise LogKeyError(f"key file {str(p)!r} is empty")
     return as_key(data, f"key file {str(p)!r}")
@@ -266,6 +272,9 @@ def _point_problem(sp: SignPoint, j: int, keyed: Any, kid: str) -> str | None:
     if p["messages"] != sp.messages_before:
         return (f"it covers {p['messages']} message(s), {sp.messages_before} precede it (messages added or "
                 f"dropped)")
+    if p["windows"] != sp.certificates_before:
+        return (f"it covers {p['windows']} window(s), {sp.certificates_before} certificate(s) were read "
+                f"before it (certificates hidden from the reader, e.g. on a channel that is not json)")
     if not hmac.compare_digest(_mac(keyed, p, sp.chain), p["mac"]):
         return "its HMAC does not match: a record it covers was changed after signing"
     return None
@@ -288,7 +297,10 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
 
     Args:
         contents: a :class:`~monitor.log.reader.LogContents`.
-        key: the key (None: not checked).
+        key: the key (None: not checked); normalised as the writer does (:func:`as_key`).
+
+    Raises:
+        LogKeyError: a key that :func:`as_key` refuses.
     """
     points: list[SignPoint] = list(getattr(contents, "signatures", []))
     claim = contents.run.get(RUN_KEY)
@@ -302,6 +314,7 @@ def check_signatures(contents: Any, key: bytes | None) -> SignatureCheck:
             out.notes.append(f"signature not checked: no key (the log says it is signed by key id {log_kid}, "
                              f"{len(points)} checkpoint(s); give --key-file or ${KEY_FILE_ENV})")
         return out
+    key = as_key(key)  # the writer's normalisation (trailing whitespace), so both derive one key
     kid = out.key_id = key_id(key)
     out.unsigned_windows = [c.get("index") for c in contents.topic(topics.CERTIFICATE)]  # until verified
     if not points:
