@@ -998,7 +998,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     chunk = 1 if bud.tests is not None else P
     # every survivor on the extrusion route (the tunnel's windows; see _all_translate): stage 0
     # runs stage 1 too, which then only tests the start poses, as the second call below would
-    ext_only = not whole and chunk == P and (not narrow or _all_translate(plan, mp, memo))
+    ext_only = (_ONE_CALL and not whole and bud.tests is None
+                and (not narrow or _all_translate(plan, mp, memo)))
     first = chunk if (whole or ext_only) else 0
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
@@ -1176,6 +1177,11 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
              "budget_exhausted": bool(bud.exhausted), "nothing_checked": False, **ext_stats}
     return Certificate._trusted(_VERDICT_OF[verdict], (t0, t1), margin, epsilon, _METHOD_OF[method], witness,
                                 earliest, clearance, lazy, stats, allowed)
+
+
+_ONE_CALL = True
+"""Let :func:`_certify_fast` run stage 0 and the start-pose tests of an all-extrusion-route window in one
+``window_kernel`` call (:func:`_all_translate`); tests switch it off to compare with the two calls."""
 
 
 def _all_translate(plan: Any, mp: Any, memo: dict) -> bool:
@@ -1513,18 +1519,37 @@ def _plan_inputs(scene: Any, plan: Any, memo: dict, t0: float, t1: float, margin
     values and the :class:`Tolerances` object it was built from. The kernel only reads
     ``fixed``, ``mov`` and ``prm``; ``moving`` is read-only.
     """
+    static = scene.body_static
     hit = memo.get("moving")
     if hit is None:
+        # a Plan's flags array is read-only and shared by the plans of one moving pattern (Plan's
+        # flag cache): the gate's new Plan per window finds the last one's moving / kernel flags
+        # in the scene's cache (the same values: a copy of that very array, _body_flags of it)
+        src = plan._moving if type(plan) is _plan_class() else None
+        hot = _hot(scene) if src is not None else None
+        pm = None if hot is None else hot.get("plan_moving")
+        if pm is not None and pm[0] is src and pm[1] is static:
+            memo["moving"], memo["flags"] = pm[2], pm[3]
+            return pm[2], pm[3][1], pm[3][2], _window_prm(memo, t0, t1, margin, epsilon, tol, KS)
         hit = memo["moving"] = np.asarray(plan.moving_bodies(), bool).copy()
         hit.setflags(write=False)
+        if hot is not None and not src.flags.writeable:
+            fixed, mov = _body_flags(scene, hit)
+            memo["flags"] = fl = (static, fixed, mov)
+            hot["plan_moving"] = (src, static, hit, fl)
     moving = hit
-    static = scene.body_static
     fl = memo.get("flags")
     if fl is None or fl[0] is not static:
         fixed, mov = _body_flags(scene, moving)
         fl = (static, fixed, mov)
         if _hot(scene) is not None:   # a Scene (sync replaces body_static); duck-typed scenes: per call
             memo["flags"] = fl
+    return moving, fl[1], fl[2], _window_prm(memo, t0, t1, margin, epsilon, tol, KS)
+
+
+def _window_prm(memo: dict, t0: float, t1: float, margin: float, epsilon: float, tol: Tolerances,
+                KS: Any) -> np.ndarray:
+    """(WP_SIZE,) the window kernel's ``prm`` for these values, kept in ``memo`` (:func:`_plan_inputs`)."""
     pr = memo.get("prm")
     if (pr is None or pr[0] != t0 or pr[1] != t1 or pr[2] != margin or pr[3] != epsilon or pr[4] is not tol
             or (t0 == 0.0 and math.copysign(1.0, t0) != math.copysign(1.0, pr[0]))    # -0.0 == 0.0
@@ -1532,7 +1557,7 @@ def _plan_inputs(scene: Any, plan: Any, memo: dict, t0: float, t1: float, margin
         prm = np.array([t0, t1, margin, epsilon, tol.rel_pad, tol.abs_pad, tol.scale_pad,
                         float(tol.max_depth), float(KS.WHOLE_SHAPE_MAX_TESTS)])
         memo["prm"] = pr = (t0, t1, margin, epsilon, tol, prm)
-    return moving, fl[1], fl[2], pr[5]
+    return pr[5]
 
 
 def _body_flags(scene: Any, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
