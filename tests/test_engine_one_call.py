@@ -28,32 +28,12 @@ from monitor.tolerances import DEFAULT
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _switch_cases import cert_key, on_and_off, tunnel_gate_keys  # noqa: E402
+from _switch_cases import cert_key, on_and_off_counted, tunnel_gate_keys  # noqa: E402
 
 
 def _calls_and_keys(run):
     """(certificate keys of ``run()``, window_kernel calls it made) with ``_ONE_CALL`` on, then off."""
-    real = engine._window_kernel
-    n = [0]
-
-    def counted(*a, **k):
-        n[0] += 1
-        return real(*a, **k)
-
-    out = []
-
-    def timed():
-        n[0] = 0
-        keys = run()
-        out.append(n[0])
-        return keys
-
-    engine._window_kernel = counted
-    try:
-        on, off = on_and_off(engine, "_ONE_CALL", timed)
-    finally:
-        engine._window_kernel = real
-    return on, off, out[0], out[1]
+    return on_and_off_counted(engine, "_ONE_CALL", run, engine, "_window_kernel")
 
 
 def test_one_call_same_certificates_on_translating_cases():
