@@ -4,6 +4,6 @@
 base=$1; new=$2; pairs=$3; script=$(readlink -f $4); shift 4
 for i in $(seq 1 $pairs); do
   for t in $base $new; do
-    (cd $t && PYTHONPATH=$t /work/main/.venv/bin/python $script "$@" 2>&1 | grep -E "^(CPU|TUN|GYM)")
+    (cd $t && PYTHONPATH=$t /work/main/.venv/bin/python $script "$@" 2>&1 | grep -E "^(CPU|TUN|GYM|REPLAY)")
   done
 done
