@@ -30,6 +30,35 @@ def on_and_off(module, flag: str, run):
     return a, b
 
 
+def on_and_off_counted(module, flag: str, run, spied, name: str, counts=lambda result: True):
+    """:func:`on_and_off`, counting the calls of ``spied.name`` in each run (those whose result ``counts``).
+
+    Returns (result on, result off, calls on, calls off); ``spied.name`` is restored afterwards.
+    """
+    real = getattr(spied, name)
+    n = [0]
+
+    def counted(*a, **k):
+        r = real(*a, **k)
+        n[0] += bool(counts(r))
+        return r
+
+    per_run = []
+
+    def run_counted():
+        n[0] = 0
+        out = run()
+        per_run.append(n[0])
+        return out
+
+    setattr(spied, name, counted)
+    try:
+        a, b = on_and_off(module, flag, run_counted)
+    finally:
+        setattr(spied, name, real)
+    return a, b, per_run[0], per_run[1]
+
+
 def tunnel_gate_keys(steps: int = 60) -> list[str]:
     """:func:`cert_key` of every certificate of ``steps`` plain ``Gate.step`` windows on models/tunnel.
 

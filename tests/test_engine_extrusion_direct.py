@@ -24,26 +24,15 @@ from monitor.certify.engine import certify
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _switch_cases import agv_scene_plan, on_and_off, tunnel_gate_keys  # noqa: E402
+from _switch_cases import agv_scene_plan, on_and_off_counted, tunnel_gate_keys  # noqa: E402
 from _switch_cases import cert_key as _key  # noqa: E402
 
 
 def _both(run):
     """(direct path on, off) results of ``run()``, and how often the direct builder returned a certificate."""
-    real = engine._extrusion_decided
-    used = [0]
-
-    def counted(*a, **k):
-        c = real(*a, **k)
-        used[0] += c is not None
-        return c
-
-    engine._extrusion_decided = counted
-    try:
-        a, b = on_and_off(engine, "_EXTRUSION_DIRECT", run)
-    finally:
-        engine._extrusion_decided = real
-    return a, b, used[0]
+    a, b, n_on, n_off = on_and_off_counted(engine, "_EXTRUSION_DIRECT", run, engine, "_extrusion_decided",
+                                           lambda c: c is not None)
+    return a, b, n_on + n_off
 
 
 def test_same_certificates_on_translating_cases():

@@ -996,10 +996,15 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     # without a test budget, each call stops by itself after kernels.CALL_TESTS whole-shape tests
     # (the budget is polled between calls); with "whole", stage 0 runs stage 1 too
     chunk = 1 if bud.tests is not None else P
-    first = chunk if whole else 0
+    # every survivor on the extrusion route (the tunnel's windows; see _all_translate): stage 0
+    # runs stage 1 too, which then only tests the start poses, as the second call below would
+    ext_only = (_ONE_CALL and not whole and bud.tests is None
+                and (not narrow or _all_translate(plan, mp, memo)))
+    first = chunk if (whole or ext_only) else 0
     if not rows.size:
         rows = None  # window_kernel's specialisation without the sweep (see its "rows")
-    S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, none, 0, 0, first, prm, code, gap, surv, res,
+    route0 = np.zeros(P, np.int64) if ext_only else none
+    S = int(_window_kernel(KS, sp.geoms, mp, pid, fixed, mov, route0, 0, 0, first, prm, code, gap, surv, res,
                            sc, sr, rows, info))
     done_to = int(info[KS.WI_DONE])
     charged = info.item(KS.WI_TESTS)
@@ -1010,7 +1015,11 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                            bud, wall0, allowed, sc, sr, KS)
     route = none if whole else np.zeros(S, np.int64)   # empty: every slot takes the whole-shape stage
     stopped = False
-    if narrow and not whole and S:   # "auto": both bodies translating -> extrusion route
+    if ext_only:
+        # the budget poll the routing below makes (a clock only: no test budget here); the start
+        # tests it would run after it ran in the call above (done_to == S)
+        stopped = bud.exhausted
+    elif narrow and not whole and S:   # "auto": both bodies translating -> extrusion route
         route = np.ones(S, np.int64)
         trans: dict[int, bool] = {}
         # a budget checkpoint where the plan's waypoint FK (first translation_segments) used to
@@ -1063,7 +1072,8 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
     if _EXTRUSION_DIRECT and method != "toleranced" and done_to == S and not stopped:
         # every survivor on the extrusion route (the tunnel's window): its certificate without the
         # general stages and tail (see _extrusion_decided); None leaves it to them
-        cert = _extrusion_decided(scene, plan, sel, pid, code, gap, surv, res, info, S, mp=mp, t0=t0, t1=t1,
+        cert = _extrusion_decided(scene, plan, sel, pid, code, gap, surv, res, info, S, mp=mp,
+                                  all_translate=ext_only and narrow, t0=t0, t1=t1,
                                   margin=margin, epsilon=epsilon, method=method, bud=bud, tol=tol,
                                   wall0=wall0, allowed=allowed, sc=sc, sr=sr, KS=KS)
         if cert is not None:
@@ -1169,6 +1179,37 @@ def _certify_fast(scene: Any, plan: Any, margin: float, epsilon: float, method: 
                                 earliest, clearance, lazy, stats, allowed)
 
 
+_ONE_CALL = True
+"""Let :func:`_certify_fast` run stage 0 and the start-pose tests of an all-extrusion-route window in one
+``window_kernel`` call (:func:`_all_translate`); tests switch it off to compare with the two calls."""
+
+
+def _all_translate(plan: Any, mp: Any, memo: dict) -> bool:
+    """Whether :func:`_translates` holds for every body of a Plan / BodyMotion (False for other trajectories).
+
+    Then ``"auto"`` routes every survivor of the window kernel that it leaves ``WK_OPEN`` to the
+    extrusion route (``route`` 0 per slot), so the route is known before stage 0 and one
+    ``window_kernel`` call does stage 0 and the start-pose tests (issue 12, tunnel gate: the
+    second call cost ~20 us per window). Kept in ``memo`` (the dict cached with the trajectory's
+    motion pack; the trajectory is immutable). The same flags as :func:`_translates`: a body
+    translates unless it moves and rotates (the pack's ``body_rotating`` or the trajectory's own
+    ``_rotating``).
+    """
+    hit = memo.get("all_translate")
+    if hit is None:
+        if type(plan) not in _known_trajectories():
+            return False       # translation_segments may be asked (and poll the budget): the routing loop
+        bm, br, pr = mp.body_moving, mp.body_rotating, plan._rotating
+        if not (type(pr) is np.ndarray and bm.shape == br.shape == pr.shape and bm.ndim == 1):
+            hit = False
+        elif bm.shape[0] > 64:
+            hit = not ((bm != 0) & ((br != 0) | np.asarray(pr, bool))).any()
+        else:   # (Python ints of a few bodies: the numpy calls above cost ~5 us)
+            hit = not any(m and (r or q) for m, r, q in zip(bm.tolist(), br.tolist(), pr.tolist()))
+        memo["all_translate"] = hit
+    return hit
+
+
 def _no_extrusion_route(mp: Any, mov: np.ndarray) -> bool:
     """Whether ``"auto"`` routes every survivor of this motion to the whole-shape stage.
 
@@ -1211,6 +1252,11 @@ def _python_decided(results: dict[int, PairResult]) -> tuple[list[PairResult], b
     """
     if not results:
         return [], False, False, []
+    if len(results) == 1:    # (the tunnel's window: one pair, without the list passes below)
+        (i, r), = results.items()
+        v = r.verdict
+        cand1 = [(r.witness.time, i, r.witness)] if v == Verdict.VIOLATION and r.witness is not None else []
+        return [r], v == Verdict.VIOLATION, v == Verdict.UNCERTAIN, cand1
     ids = sorted(results)
     checked = [results[i] for i in ids]
     cand = [(r.witness.time, i, r.witness) for i, r in zip(ids, checked)
@@ -1369,7 +1415,7 @@ _EXTRUSION_DIRECT = True
 
 def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, code: np.ndarray,
                        gap: np.ndarray, surv: np.ndarray, res: np.ndarray, info: np.ndarray, S: int, *,
-                       mp: Any, t0: float,
+                       mp: Any, all_translate: bool, t0: float,
                        t1: float, margin: float, epsilon: float, method: str, bud: Budget, tol: Tolerances,
                        wall0: float, allowed: tuple, sc: np.ndarray, sr: np.ndarray,
                        KS: Any) -> Certificate | None:
@@ -1393,6 +1439,7 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         sel, pid, code, gap, surv, res, info, sc, sr: the window kernel's arrays
             (:func:`_certify_fast`); S: survivors, all run by the kernel.
         mp: the motion pack (its body flags route the pairs).
+        all_translate: :func:`_all_translate` holds (every body translates: no per-body check).
         others: as in :func:`_certify_fast`.
     """
     sv = surv[:S]
@@ -1408,11 +1455,12 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
     try:
         for k, a, b in zip(sv.tolist(), pid[sv, 0].tolist(), pid[sv, 1].tolist()):
             ga, gb = geoms[a], geoms[b]
-            for body in (ga.body_id, gb.body_id):
-                if body not in trans:
-                    trans[body] = _translates(plan, mp, body)
-                if not trans[body]:
-                    return None
+            if not all_translate:
+                for body in (ga.body_id, gb.body_id):
+                    if body not in trans:
+                        trans[body] = _translates(plan, mp, body)
+                    if not trans[body]:
+                        return None
             sa, sb = plan.translation_segments(ga.body_id), plan.translation_segments(gb.body_id)
             if sa is None or sb is None:
                 return None
@@ -1438,7 +1486,7 @@ def _extrusion_decided(scene: Any, plan: Any, sel: np.ndarray, pid: np.ndarray, 
         mix[r.method] = mix.get(r.method, 0) + 1
     checked_r, has_viol, has_unc, cand = _python_decided(results)
     verdict = Verdict.VIOLATION if has_viol else Verdict.UNCERTAIN if has_unc else Verdict.CERTIFIED
-    lazy = _WindowPairs(sel, pid, code, gap, sv, res[:S], np.zeros(P, bool), results, geoms, (t0, t1),
+    lazy = _WindowPairs(sel, pid, code, gap, sv, res[:S], _none_unfinished(P), results, geoms, (t0, t1),
                         sc, sr, info.item(KS.WI_PAD))
     witness = None
     if cand:
@@ -1471,18 +1519,37 @@ def _plan_inputs(scene: Any, plan: Any, memo: dict, t0: float, t1: float, margin
     values and the :class:`Tolerances` object it was built from. The kernel only reads
     ``fixed``, ``mov`` and ``prm``; ``moving`` is read-only.
     """
+    static = scene.body_static
     hit = memo.get("moving")
     if hit is None:
+        # a Plan's flags array is read-only and shared by the plans of one moving pattern (Plan's
+        # flag cache): the gate's new Plan per window finds the last one's moving / kernel flags
+        # in the scene's cache (the same values: a copy of that very array, _body_flags of it)
+        src = plan._moving if type(plan) is _plan_class() else None
+        hot = _hot(scene) if src is not None else None
+        pm = None if hot is None else hot.get("plan_moving")
+        if pm is not None and pm[0] is src and pm[1] is static:
+            memo["moving"], memo["flags"] = pm[2], pm[3]
+            return pm[2], pm[3][1], pm[3][2], _window_prm(memo, t0, t1, margin, epsilon, tol, KS)
         hit = memo["moving"] = np.asarray(plan.moving_bodies(), bool).copy()
         hit.setflags(write=False)
+        if hot is not None and not src.flags.writeable:
+            fixed, mov = _body_flags(scene, hit)
+            memo["flags"] = fl = (static, fixed, mov)
+            hot["plan_moving"] = (src, static, hit, fl)
     moving = hit
-    static = scene.body_static
     fl = memo.get("flags")
     if fl is None or fl[0] is not static:
         fixed, mov = _body_flags(scene, moving)
         fl = (static, fixed, mov)
         if _hot(scene) is not None:   # a Scene (sync replaces body_static); duck-typed scenes: per call
             memo["flags"] = fl
+    return moving, fl[1], fl[2], _window_prm(memo, t0, t1, margin, epsilon, tol, KS)
+
+
+def _window_prm(memo: dict, t0: float, t1: float, margin: float, epsilon: float, tol: Tolerances,
+                KS: Any) -> np.ndarray:
+    """(WP_SIZE,) the window kernel's ``prm`` for these values, kept in ``memo`` (:func:`_plan_inputs`)."""
     pr = memo.get("prm")
     if (pr is None or pr[0] != t0 or pr[1] != t1 or pr[2] != margin or pr[3] != epsilon or pr[4] is not tol
             or (t0 == 0.0 and math.copysign(1.0, t0) != math.copysign(1.0, pr[0]))    # -0.0 == 0.0
@@ -1490,7 +1557,7 @@ def _plan_inputs(scene: Any, plan: Any, memo: dict, t0: float, t1: float, margin
         prm = np.array([t0, t1, margin, epsilon, tol.rel_pad, tol.abs_pad, tol.scale_pad,
                         float(tol.max_depth), float(KS.WHOLE_SHAPE_MAX_TESTS)])
         memo["prm"] = pr = (t0, t1, margin, epsilon, tol, prm)
-    return moving, fl[1], fl[2], pr[5]
+    return pr[5]
 
 
 def _body_flags(scene: Any, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1804,7 +1871,8 @@ def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unpr
         clear = o.clearance if np.isfinite(o.clearance) else margin
         if meth == "toleranced":
             clear = max(clear, margin)
-        return PairResult(names, bodies, Verdict.CERTIFIED, meth, o.tests, o.max_depth, (), float(clear))
+        return _pair_result(names, bodies, Verdict.CERTIFIED, meth, o.tests, o.max_depth, (), float(clear),
+                            None)
     intervals = list(o.intervals)
     if o.verdict == Outcome.CERTIFIED:  # start pose not proven clear
         intervals = [(t0, t0)]
@@ -1813,20 +1881,32 @@ def _checked_result(plan: Any, meth: str, o: PairOutcome, ga: Any, gb: Any, unpr
         cands.append(float(o.witness_time))
         if not intervals:
             intervals = [(float(o.witness_time), float(o.witness_time))]
-    for a, b in intervals[:_MAX_WITNESS_INTERVALS]:
-        k = 1 if b <= a else max(2, tol.witness_candidates)
-        cands += np.linspace(a, b, k).tolist()   # Python floats: the same values, cheaper set/sort
+    spans = intervals[:_MAX_WITNESS_INTERVALS]
     w = None
-    if cands:
+    if cands or spans:
         try:  # a budget that runs out here leaves the pair "uncertain" (no witness)
-            w = _find_witness(plan, ga, gb, np.array(sorted(set(cands))), margin, tol, bud)
+            w = _find_witness_of(plan, ga, gb, cands, spans, margin, tol, bud)
         except BudgetExhausted:
             w = None
     if w is not None:
-        return PairResult(names, bodies, Verdict.VIOLATION, meth, o.tests, o.max_depth, tuple(intervals),
-                          float("-inf"), w)
-    return PairResult(names, bodies, Verdict.UNCERTAIN, meth, o.tests, o.max_depth,
-                      tuple(intervals) if intervals else ((t0, t1),), float("-inf"))
+        return _pair_result(names, bodies, Verdict.VIOLATION, meth, o.tests, o.max_depth, tuple(intervals),
+                            float("-inf"), w)
+    return _pair_result(names, bodies, Verdict.UNCERTAIN, meth, o.tests, o.max_depth,
+                        tuple(intervals) if intervals else ((t0, t1),), float("-inf"), None)
+
+
+def _pair_result(geoms: tuple[str, str], bodies: tuple[str, str], verdict: Verdict, method: str, tests: int,
+                 max_depth: int, intervals: tuple, clearance: float, witness: Witness | None) -> PairResult:
+    """``PairResult(geoms, bodies, verdict, method, tests, max_depth, intervals, clearance, witness)``.
+
+    For a ``verdict`` that is already a :class:`Verdict` (what ``__post_init__`` would make of
+    it): the frozen dataclass built field for field, without its per-field
+    ``object.__setattr__`` (as :meth:`_WindowPairs.kernel_witness` builds a Witness).
+    """
+    r = _new(PairResult)
+    r.__dict__.update(geoms=geoms, bodies=bodies, verdict=verdict, method=method, tests=tests,
+                      max_depth=max_depth, intervals=intervals, clearance=clearance, witness=witness, note="")
+    return r
 
 
 def _broad_phase(scene: Any, plan: Any, margin: float, tol: Tolerances, t0: float, t1: float,
@@ -1876,14 +1956,14 @@ def _run_extrusion(plan: Any, ext_items: list, margin: float, tol: Tolerances, b
     test. ``PairOutcome.info["stage"]`` names the deciding stage;
     :func:`extrusion_stats` summarises a list of outcomes for ``cert.stats``.
     """
-    from monitor.certify import extrusion
+    extrusion = _module("monitor.certify.extrusion")
     ext_margin = margin + tol.extrusion_slack + tol.pad(margin)
     rot = _rotations(plan, t0)
     outs: list[PairOutcome | None] = [None] * len(ext_items)
     if _SWEPT_FIRST and not bud.exhausted:
         # issue 12: the compiled exact swept test first, one call per pair
         # (monitor.certify.extrusion_swept); what it cannot settle goes to the Python checker
-        from monitor.certify.extrusion_swept import decide_pair
+        decide_pair = _module("monitor.certify.extrusion_swept").decide_pair
         n_fast = 0
         for k, (_i, ga, gb, ((ta, oa), (tb, ob))) in enumerate(ext_items):
             Ra, Rb = rot(ga.body_id, True), rot(gb.body_id, True)
@@ -1992,8 +2072,7 @@ def extrusion_stats(outs: list[PairOutcome]) -> dict[str, Any]:
     """
     if not outs:
         return {}
-    from monitor.certify.extrusion import search_summary
-    summ = search_summary(outs)
+    summ = _module("monitor.certify.extrusion").search_summary(outs)
     # bounded size (certificates are logged): at most 64 span/body-pair entries, 32 names each
     sb = summ["sbounds"]
     if len(sb) > 64:
@@ -2082,6 +2161,71 @@ def _approx(ga: Any, gb: Any) -> float:
     return float(ga.shape.approx_error) + float(gb.shape.approx_error)
 
 
+def _candidate_times(cands: list[float], spans: list[tuple[float, float]], tol: Tolerances) -> np.ndarray:
+    """(T,) sorted distinct witness candidate times (s) of :func:`_checked_result`.
+
+    ``cands`` and, per span ``(a, b)``, ``np.linspace(a, b, k)`` (k = 1 for an empty span, else
+    ``max(2, tol.witness_candidates)``). ``cands`` is extended in place.
+    """
+    for a, b in spans:
+        k = 1 if b <= a else max(2, tol.witness_candidates)
+        cands += np.linspace(a, b, k).tolist()   # Python floats: the same values, cheaper set/sort
+    return np.array(sorted(set(cands)))
+
+
+def _earliest_candidate(cands: list[float], spans: list[tuple[float, float]]) -> float | None:
+    """``_candidate_times(cands, spans, tol)[0]`` without the linspaces, or None where that is not sure.
+
+    ``np.linspace(a, b, k)`` starts with ``0 * step + a`` (``0 * (b - a) + a`` for k = 1), which
+    is ``a`` itself for a finite, non-zero ``a`` and a finite ``b - a`` (a zero ``a`` may turn
+    -0.0 into 0.0; an overflowing span gives NaN); its other entries are ``>= a`` (monotone
+    rounding). So, with finite ``cands``, the smallest distinct candidate is ``min`` over
+    ``cands`` and the spans' starts, in the same order (``set`` keeps the first of equal
+    values, ``min`` returns the first). None otherwise (the caller builds every candidate).
+    Issue 12 (tunnel gate): the first candidate, the checker's exact first contact, confirms
+    every tunnel violation, and 8 of 9 candidates were built unused.
+    """
+    isfinite = math.isfinite
+    for x in cands:
+        if not isfinite(x):
+            return None
+    firsts = list(cands)
+    for a, b in spans:
+        if not (a != 0.0 and isfinite(a) and isfinite(b - a)):
+            return None
+        firsts.append(a)
+    return float(min(firsts)) if firsts else None
+
+
+def _find_witness_of(plan: Any, ga: Any, gb: Any, cands: list[float], spans: list[tuple[float, float]],
+                     margin: float, tol: Tolerances, budget: Budget) -> Witness | None:
+    """``_find_witness(plan, ga, gb, _candidate_times(cands, spans, tol), margin, tol, budget)``.
+
+    When :func:`_find_witness` would pose its first candidate alone (a Plan without quaternion
+    tracks), that candidate comes from :func:`_earliest_candidate` and the others are built only
+    if it does not confirm: the same poses (``body_poses`` of the same one-time array, then of the
+    rest), tests and witness.
+    """
+    cls = _plan_class()
+    first = None
+    if cls is not None and type(plan) is cls and not plan._quat_tracks:
+        first = _earliest_candidate(cands, spans)
+    if first is None:
+        return _find_witness(plan, ga, gb, _candidate_times(cands, spans, tol), margin, tol, budget)
+    shape_distance = _module("monitor.geometry.distance").shape_distance
+    slack = _approx(ga, gb)
+    t_first = np.array([first])
+    pos, rot = plan.body_poses(t_first)
+    w = _confirm(shape_distance, ga, gb, t_first, pos, rot, margin, slack, tol, budget)
+    if w is not None or budget.exhausted:
+        return w
+    times = _candidate_times(cands, spans, tol)
+    if len(times) <= 1:
+        return None      # (the one candidate, posed and tested above)
+    pos, rot = plan.body_poses(times[1:])
+    return _confirm(shape_distance, ga, gb, times[1:], pos, rot, margin, slack, tol, budget)
+
+
 def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
                   tol: Tolerances, budget: Budget | None = None) -> Witness | None:
     """Earliest candidate time whose confirmed distance is below margin.
@@ -2089,7 +2233,7 @@ def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
     The exact static upper bound plus the shapes' over-approximation (circumscribed
     geoms) must be below the margin. Stops (None) when ``budget`` runs out.
     """
-    from monitor.geometry.distance import shape_distance
+    shape_distance = _module("monitor.geometry.distance").shape_distance
 
     slack = _approx(ga, gb)
     first = 0
@@ -2108,6 +2252,21 @@ def _find_witness(plan: Any, ga: Any, gb: Any, times: np.ndarray, margin: float,
     return _confirm(shape_distance, ga, gb, times[first:], pos, rot, margin, slack, tol, budget)
 
 
+def _module(name: str) -> Any:
+    """The module ``name``, imported on first use (``sys.modules`` after that).
+
+    The engine imports its checkers lazily (its own import stays light); a ``from ... import``
+    statement in a per-window function costs ~1-3 us per call (issue 12, tunnel gate). The
+    module, not the function, is looked up, so a monkeypatched module attribute is seen.
+    """
+    m = sys.modules.get(name)
+    if m is None:
+        import importlib
+
+        m = importlib.import_module(name)
+    return m
+
+
 def _confirm(shape_distance: Any, ga: Any, gb: Any, times: np.ndarray, pos: np.ndarray, rot: np.ndarray,
              margin: float, slack: float, tol: Tolerances, budget: Budget | None) -> Witness | None:
     """:func:`_find_witness`'s loop over candidate ``times`` (T,) posed at ``pos`` (T, nbody, 3), ``rot``."""
@@ -2117,7 +2276,11 @@ def _confirm(shape_distance: Any, ga: Any, gb: Any, times: np.ndarray, pos: np.n
         d = shape_distance(ga.shape, (rot[k, ga.body_id], pos[k, ga.body_id]),
                            gb.shape, (rot[k, gb.body_id], pos[k, gb.body_id]), tolerances=tol)
         if d.upper + slack < margin:
-            return Witness(float(t), (ga.name, gb.name), 0.5 * (d.p_a + d.p_b), float(d.upper + slack))
+            # = Witness(time, geoms, point, distance), field for field (see _WindowPairs.kernel_witness)
+            w = _new(Witness)
+            w.__dict__.update(time=float(t), geoms=(ga.name, gb.name), point=0.5 * (d.p_a + d.p_b),
+                              distance=float(d.upper + slack))
+            return w
     return None
 
 
