@@ -464,8 +464,10 @@ def _flags_and_chains(st: _ModelStructure, changes: np.ndarray) -> tuple:
             for bodies, parents in st.levels:
                 moving[bodies] = own_moving[bodies] | moving[parents]
                 rotating[bodies] = own_rot[bodies] | rotating[parents]
-    moving.setflags(write=False)
-    rotating.setflags(write=False)
+    # sealed over bytes (once per pattern: the result is cached per structure): the engine keys its
+    # per-scene flag cache on the identity of a Plan's ``_moving``, so it must never change
+    moving = sealed(moving)
+    rotating = sealed(rotating)
     key = moving.tobytes()
     chains = st.chains.get(key)
     if chains is None:
