@@ -604,8 +604,9 @@ _FAST_MAX_COORD = 1e9
 geometry's coordinate limit (``monitor.geometry.distance._MAX_COORD``; not imported here, the
 engine's import stays light; ``tests/test_redteam_10.py`` checks the two agree)."""
 _PACK_TOL_SCALE = 3
-"""Index of the rounding scale in ``MotionPack.tol`` (``monitor.motion.kernel.TOL_SCALE``): the
-largest waypoint position of any body (m) plus the window's motion bound, 0 when nothing moves."""
+"""Index of the rounding scale in ``MotionPack.tol`` (``monitor.motion.kernel.TOL_SCALE``): an upper
+bound (m) of every body origin and reference point over the window plus the window's motion bound
+(from the midpoint poses and the whole-window bounds; ``Plan._scale``), 0 when nothing moves."""
 _PACK_TOL_QMAG = 4
 """Index of max |qpos| + max |qpos0| in ``MotionPack.tol`` (``monitor.motion.kernel.TOL_QMAG``): a
 slide / free joint (or a BodyMotion body) beyond 1e9 m when nothing moves."""
@@ -1992,7 +1993,7 @@ def _rotations(plan: Any, t0: float) -> Any:
 
     The rotation of such a body is constant over the window. A
     :class:`~monitor.motion.plan.Plan` has it already: its waypoint FK rotations
-    (``_wp_mat[0]``; the same at every waypoint). A
+    (``_wp0``, row 0 of ``_wp_mat``; the same at every waypoint). A
     :class:`~monitor.motion.bodymotion.BodyMotion`: its first waypoint quaternion
     (``quat[0]``, normalised; a translating body's quaternions are equal bit for bit), by
     ``quat_to_mat`` (one vectorised call) or, with ``fast=True`` (the compiled first pass,
@@ -2001,8 +2002,8 @@ def _rotations(plan: Any, t0: float) -> Any:
     """
     cls = _plan_class()
     if cls is not None and type(plan) is cls:
-        wm = plan._wp_mat
-        return lambda b, fast=False: wm[0, b]
+        wm = plan._wp0[1]    # FK at the first waypoint only (row 0 of _wp_mat: the same numbers)
+        return lambda b, fast=False: wm[b]
     bm = sys.modules.get("monitor.motion.bodymotion")
     if bm is not None and type(plan) is getattr(bm, "BodyMotion", None):
         mats: list = []
