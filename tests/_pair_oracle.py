@@ -18,6 +18,7 @@ import re
 
 import mujoco
 import numpy as np
+import redteam_oracle as O
 
 KINDS = ("sphere", "capsule", "box", "cylinder", "ellipsoid", "mesh")
 
@@ -227,6 +228,48 @@ def oracle_pairs(model, info, mode: str) -> set[tuple[int, int]]:
                 continue
             out.add((a, b))
     return out
+
+
+def anchor_dropped(m, pairs, depth: float = -1e-9) -> set:
+    """The pairs of ``pairs`` that ``"all"`` drops by its documented rule: a world geom and a geom of a
+    world child moved only by rotational joints sharing one anchor, the anchor inside both geoms (at
+    least ``depth`` m inside the true geoms: the scene tests its circumscribed shapes)."""
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+    weld = m.body_weldid
+    out = set()
+    for a, b in pairs:
+        wa, wb = weld[m.geom_bodyid[a]], weld[m.geom_bodyid[b]]
+        child = wb if wa == 0 else wa
+        if (wa == 0) == (wb == 0) or weld[m.body_parentid[child]] != 0:
+            continue
+        jnts = np.flatnonzero(m.jnt_bodyid == child)
+        rot = (int(mujoco.mjtJoint.mjJNT_BALL), int(mujoco.mjtJoint.mjJNT_HINGE))
+        if not len(jnts) or not np.isin(m.jnt_type[jnts], rot).all():
+            continue
+        anchor = d.xanchor[jnts[0]]
+        if not (d.xanchor[jnts] == anchor).all():
+            continue
+        pa = O.geom_pose(m, a, d.geom_xmat[a].reshape(3, 3), d.geom_xpos[a])
+        pb = O.geom_pose(m, b, d.geom_xmat[b].reshape(3, 3), d.geom_xpos[b])
+        if min(O.depth(pa, anchor), O.depth(pb, anchor)) >= depth:
+            out.add((a, b))
+    return out
+
+
+def rotating_qpos(m, rng, K: int) -> np.ndarray:
+    """(K, nq) waypoints from ``qpos0``: each hinge turned linearly by up to +-2 rad, each ball joint
+    about a random axis by 1.5 rad (no slide or free coordinate changes)."""
+    q = np.repeat(m.qpos0[None], K, axis=0)
+    for j in range(m.njnt):
+        a = m.jnt_qposadr[j]
+        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+            q[:, a] += np.linspace(0.0, rng.uniform(-2.0, 2.0), K)
+        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
+            axis = rng.normal(size=3)
+            for k in range(K):
+                q[k, a:a + 4] = O.axis_quat(axis, 1.5 * k / (K - 1))
+    return q
 
 
 def mujoco_contact_pairs(xml_with_margin: str) -> set[tuple[int, int]]:

@@ -22,7 +22,14 @@ import mujoco
 import numpy as np
 import pytest
 import redteam_oracle as O
-from _pair_oracle import mujoco_contact_pairs, oracle_pairs, random_model, rotating_chain_xml
+from _pair_oracle import (
+    anchor_dropped,
+    mujoco_contact_pairs,
+    oracle_pairs,
+    random_model,
+    rotating_chain_xml,
+    rotating_qpos,
+)
 
 import monitor
 from monitor import scene as S
@@ -33,33 +40,6 @@ def _scene(m, **kw):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # non-convex random meshes
         return monitor.Scene.from_model(m, **kw)
-
-
-def _anchor_dropped(m, pairs, depth: float = -1e-9) -> set:
-    """The pairs of ``pairs`` that ``"all"`` drops by its documented rule: a world geom and a geom of a
-    world child moved only by rotational joints sharing one anchor, the anchor inside both geoms (at
-    least ``depth`` m inside the true geoms: the scene tests its circumscribed shapes)."""
-    d = mujoco.MjData(m)
-    mujoco.mj_kinematics(m, d)
-    weld = m.body_weldid
-    out = set()
-    for a, b in pairs:
-        wa, wb = weld[m.geom_bodyid[a]], weld[m.geom_bodyid[b]]
-        child = wb if wa == 0 else wa
-        if (wa == 0) == (wb == 0) or weld[m.body_parentid[child]] != 0:
-            continue
-        jnts = np.flatnonzero(m.jnt_bodyid == child)
-        rot = (int(mujoco.mjtJoint.mjJNT_BALL), int(mujoco.mjtJoint.mjJNT_HINGE))
-        if not len(jnts) or not np.isin(m.jnt_type[jnts], rot).all():
-            continue
-        anchor = d.xanchor[jnts[0]]
-        if not (d.xanchor[jnts] == anchor).all():
-            continue
-        pa = O.geom_pose(m, a, d.geom_xmat[a].reshape(3, 3), d.geom_xpos[a])
-        pb = O.geom_pose(m, b, d.geom_xmat[b].reshape(3, 3), d.geom_xpos[b])
-        if min(O.depth(pa, anchor), O.depth(pb, anchor)) >= depth:
-            out.add((a, b))
-    return out
 
 
 @pytest.mark.parametrize("seed", [16, 40, 51])
@@ -75,8 +55,8 @@ def test_candidate_pairs_are_mujocos_filter_in_small_row_blocks(monkeypatch, see
     assert got == {p for p in mujoco_contact_pairs(random_model(seed, margin=100.0)[0]) if p[0] != p[1]}
     got_all = set(map(tuple, _scene(m, pairs="all").pair_ids.tolist()))
     want_all = oracle_pairs(m, info, "all")
-    assert got_all == want_all - _anchor_dropped(m, want_all - got_all)
-    must = _anchor_dropped(m, want_all, depth=1e-6)
+    assert got_all == want_all - anchor_dropped(m, want_all - got_all)
+    must = anchor_dropped(m, want_all, depth=1e-6)
     assert must and not must & got_all
 
 
@@ -148,17 +128,8 @@ def test_rotating_only_windows_never_certify_a_verified_violation(seed):
     rng = np.random.default_rng(seed)
     m = mujoco.MjModel.from_xml_string(rotating_chain_xml(rng))
     scene = _scene(m, pairs="all")
-    K = 6
-    q = np.repeat(m.qpos0[None], K, axis=0)
-    for j in range(m.njnt):
-        a = m.jnt_qposadr[j]
-        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
-            q[:, a] += np.linspace(0.0, 2.0, K) * rng.uniform(-1, 1)
-        else:
-            axis = rng.normal(size=3)
-            for k in range(K):
-                q[k, a:a + 4] = O.axis_quat(axis, 1.5 * k / (K - 1))
-    times = np.linspace(0.0, 1.0, K)
+    q = rotating_qpos(m, rng, 6)
+    times = np.linspace(0.0, 1.0, len(q))
     plan = monitor.Plan(times, q, m)
     orc = O.PlanOracle(m, times, q)
     best = min(O.motion_min(orc, ga, gb, 0.0, 1.0, n=40, refine=1).upper

@@ -10,12 +10,10 @@ path (_no_extrusion_route off, _kernel_decided off) under the same test budget.
 from __future__ import annotations
 
 import sys
-import warnings
 
-import mujoco
 import numpy as np
 import redteam_oracle as O
-from armfuzz import _key, _old_path, model_xml
+from armfuzz import _key, _old_path, seeded_cases
 
 import monitor
 from monitor.certify.common import Budget
@@ -36,27 +34,7 @@ def main() -> None:
     """Run the seeds given on the command line; print the counts."""
     s0, n = int(sys.argv[1]), int(sys.argv[2])
     st = dict(cases=0, false_cert=0, auto_vs_old=0, uncertain=0, violation=0, certified=0)
-    for seed in range(s0, s0 + n):
-        rng = np.random.default_rng(seed)
-        m = mujoco.MjModel.from_xml_string(model_xml(rng))
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = monitor.Scene.from_model(m, pairs=str(rng.choice(["mujoco", "all"])))
-        if not len(scene.pair_ids):
-            continue
-        K = int(rng.integers(2, 13))
-        amp = rng.uniform(0.2, 2.5)
-        q = np.repeat(m.qpos0[None], K, axis=0)
-        for j in range(m.njnt):
-            a = m.jnt_qposadr[j]
-            if m.jnt_type[j] == 3:
-                q[:, a] += np.cumsum(rng.uniform(-amp, amp, K)) / np.sqrt(K) * 0.8
-            else:
-                axis = rng.normal(size=3)
-                for k in range(K):
-                    q[k, a:a + 4] = O.axis_quat(axis, amp * k / max(K - 1, 1) * rng.uniform(0.3, 1.0))
-        times = np.linspace(0.0, 1.0, K)
-        plan = monitor.Plan(times, q, m)
+    for seed, (m, scene, times, q, plan) in seeded_cases(s0, n):
         orc = O.PlanOracle(m, times, q)
         best = np.inf
         for ga, gb in scene.pair_ids.tolist():

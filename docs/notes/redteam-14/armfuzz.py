@@ -43,35 +43,44 @@ def _key(c):
             None if w is None else (w.time, tuple(w.geoms), tuple(np.round(w.point, 15).tolist())))
 
 
+def seeded_case(seed: int):
+    """(model, scene, times (K,), qpos (K, nq), Plan) of one seed, or None (no candidate pair)."""
+    rng = np.random.default_rng(seed)
+    m = mujoco.MjModel.from_xml_string(model_xml(rng))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = monitor.Scene.from_model(m, pairs=str(rng.choice(["mujoco", "all"])))
+    if not len(scene.pair_ids):
+        return None
+    K = int(rng.integers(2, 13))
+    amp = rng.uniform(0.2, 2.5)
+    q = np.repeat(m.qpos0[None], K, axis=0)
+    for j in range(m.njnt):
+        a = m.jnt_qposadr[j]
+        if m.jnt_type[j] == 3:
+            q[:, a] += np.cumsum(rng.uniform(-amp, amp, K)) / np.sqrt(K) * 0.8
+        else:
+            axis = rng.normal(size=3)
+            for k in range(K):
+                q[k, a:a + 4] = O.axis_quat(axis, amp * k / max(K - 1, 1) * rng.uniform(0.3, 1.0))
+    times = np.linspace(0.0, 1.0, K)
+    return m, scene, times, q, monitor.Plan(times, q, m)
+
+
+def seeded_cases(s0: int, n: int):
+    """(seed, seeded_case(seed)) for the seeds s0 .. s0 + n - 1 that have a candidate pair."""
+    for seed in range(s0, s0 + n):
+        case = seeded_case(seed)
+        if case is not None:
+            yield seed, case
+
+
 def main() -> None:
     """Run the seeds given on the command line; print the counts."""
     s0, n = int(sys.argv[1]), int(sys.argv[2])
     st = dict(cases=0, false_cert=0, bad_witness=0, auto_vs_old=0, auto_vs_tol=0, certified=0, violation=0,
               uncertain=0, errors=0)
-    for seed in range(s0, s0 + n):
-        rng = np.random.default_rng(seed)
-        try:
-            m = mujoco.MjModel.from_xml_string(model_xml(rng))
-        except ValueError:
-            continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = monitor.Scene.from_model(m, pairs=str(rng.choice(["mujoco", "all"])))
-        if not len(scene.pair_ids):
-            continue
-        K = int(rng.integers(2, 13))
-        amp = rng.uniform(0.2, 2.5)
-        q = np.repeat(m.qpos0[None], K, axis=0)
-        for j in range(m.njnt):
-            a = m.jnt_qposadr[j]
-            if m.jnt_type[j] == 3:
-                q[:, a] += np.cumsum(rng.uniform(-amp, amp, K)) / np.sqrt(K) * 0.8
-            else:
-                axis = rng.normal(size=3)
-                for k in range(K):
-                    q[k, a:a + 4] = O.axis_quat(axis, amp * k / max(K - 1, 1) * rng.uniform(0.3, 1.0))
-        times = np.linspace(0.0, 1.0, K)
-        plan = monitor.Plan(times, q, m)
+    for seed, (m, scene, times, q, plan) in seeded_cases(s0, n):
         orc = O.PlanOracle(m, times, q)
         # pre-filter with sampled MuJoCo distances (not the last word: capsule-box always kept)
         d = mujoco.MjData(m)

@@ -14,9 +14,7 @@ import sys
 import warnings
 
 import mujoco
-import numpy as np
-import redteam_oracle as O
-from _pair_oracle import mujoco_contact_pairs, oracle_pairs, random_model
+from _pair_oracle import anchor_dropped, mujoco_contact_pairs, oracle_pairs, random_model
 
 import monitor
 from monitor import scene as S
@@ -54,21 +52,7 @@ def main() -> None:
             stats[f"pairs_{mode}"] += len(want)
             miss, extra = want - got, got - want
             if mode == "all" and miss:
-                d = mujoco.MjData(m)
-                mujoco.mj_kinematics(m, d)
-                weld = m.body_weldid
-                ok = set()
-                for a, b in miss:
-                    wa, wb = weld[m.geom_bodyid[a]], weld[m.geom_bodyid[b]]
-                    child = wb if wa == 0 else wa
-                    if (wa == 0) != (wb == 0) and weld[m.body_parentid[child]] == 0:
-                        jt = m.jnt_type[m.jnt_bodyid == child]
-                        anchors = d.xanchor[np.flatnonzero(m.jnt_bodyid == child)]
-                        if len(jt) and np.isin(jt, (1, 3)).all() and (anchors == anchors[0]).all():
-                            pa = O.geom_pose(m, a, d.geom_xmat[a].reshape(3, 3), d.geom_xpos[a])
-                            pb = O.geom_pose(m, b, d.geom_xmat[b].reshape(3, 3), d.geom_xpos[b])
-                            if min(O.depth(pa, anchors[0]), O.depth(pb, anchors[0])) >= -1e-9:
-                                ok.add((a, b))
+                ok = anchor_dropped(m, miss)
                 stats["dropped_all"] += len(ok)
                 miss -= ok
             if miss or extra:
