@@ -1,6 +1,6 @@
 """Red team 14: "auto" against the previous path on every kind of joint (armcert's route test).
 
-Usage: PYTHONPATH=<tree>:<tree>/tests:docs/notes/redteam-14 python routefuzz.py SEED0 NSEEDS
+Usage: PYTHONPATH=<tree>:<tree>/tests:docs/notes/redteam-14 python routefuzz.py SEED0 NSEEDS [NBODY]
 
 Per random model (tests/_pair_oracle.py: free / ball / hinge / slide / mocap / welded bodies), plans
 of three kinds: still (every waypoint qpos0 plus one fixed random offset), rotation only (hinge /
@@ -28,6 +28,7 @@ from monitor.certify import engine
 def main() -> None:
     """Run the seeds given on the command line; print the counts."""
     s0, n = int(sys.argv[1]), int(sys.argv[2])
+    big = int(sys.argv[3]) if len(sys.argv) > 3 else None   # bodies (+0..19), one geom each at most
     st = dict(cases=0, differ=0, whole_route=0, false_cert=0, certified=0, violation=0, uncertain=0)
     calls = []
     real = engine._no_extrusion_route
@@ -40,7 +41,8 @@ def main() -> None:
     engine._no_extrusion_route = spy
     for seed in range(s0, s0 + n):
         rng = np.random.default_rng(seed)
-        xml, _ = random_model(seed, int(rng.integers(1, 12)), 2)
+        xml, _ = (random_model(seed, int(rng.integers(1, 12)), 2) if big is None
+                  else random_model(seed, big + int(rng.integers(0, 20)), 1))
         m = mujoco.MjModel.from_xml_string(xml)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
