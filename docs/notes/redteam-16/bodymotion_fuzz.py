@@ -17,26 +17,17 @@ from monitor.certify import engine
 sys.path.insert(0, "/work/wt/rt16/tests")
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 import redteam_oracle as O  # noqa: E402
-from onecall_fuzz import fmt  # noqa: E402
+from onecall_fuzz import (MOVING, certify_and_print, fmt, oracle_check, random_shape, settings,  # noqa: E402
+                         static_lines)
 
 
 def make(rng):
-    lines = ['<mujoco><option><flag contact="disable"/></option><worldbody>']
-    for i in range(int(rng.integers(1, 4))):
-        kind = rng.choice(["box", "capsule", "sphere"])
-        size = {"box": rng.uniform(0.05, 0.3, 3), "capsule": rng.uniform(0.03, 0.2, 2),
-                "sphere": rng.uniform(0.05, 0.3, 1)}[kind]
-        q = rng.normal(size=4)
-        lines.append(f'<geom name="s{i}" type="{kind}" size="{fmt(size)}" pos="{fmt(rng.uniform(-0.6, 0.6, 3))}" '
-                     f'quat="{fmt(q / np.linalg.norm(q))}"/>')
+    lines = static_lines(rng)
     nb = int(rng.integers(1, 4))
     for b in range(nb):
-        kind = rng.choice(["box", "capsule", "sphere"])
-        size = {"box": rng.uniform(0.03, 0.15, 3), "capsule": rng.uniform(0.02, 0.1, 2),
-                "sphere": rng.uniform(0.03, 0.15, 1)}[kind]
-        q = rng.normal(size=4)
+        kind, size, q = random_shape(rng, MOVING)
         lines.append(f'<body name="b{b}" mocap="true"><geom name="g{b}" type="{kind}" size="{fmt(size)}" '
-                     f'pos="{fmt(rng.uniform(-0.05, 0.05, 3))}" quat="{fmt(q / np.linalg.norm(q))}"/></body>')
+                     f'pos="{fmt(rng.uniform(-0.05, 0.05, 3))}" quat="{fmt(q)}"/></body>')
     lines.append("</worldbody></mujoco>")
     return "\n".join(lines)
 
@@ -82,37 +73,12 @@ def main(n, seed, off=False, oracle=False):
             print(i, "motion-error", type(e).__name__, str(e)[:80])
             continue
         scene = monitor.Scene.from_model(m, pairs="all")
-        margin = float(rng.choice([0.0, 0.001, 0.02]))
-        meth = str(rng.choice(["auto", "auto", "extrusion", "toleranced"]))
-        og = str(rng.choice(["violation", "deepen"]))
-        try:
-            c = monitor.certify(scene, bm, margin=margin, epsilon=1e-3, method=meth, ongoing=og)
-        except Exception as e:   # noqa: BLE001
-            print(i, "error", type(e).__name__, str(e)[:120])
+        margin, meth, og = settings(rng)
+        c = certify_and_print(i, scene, bm, margin, meth, og, {}, nc)
+        if c is None:
             continue
-        d = c.to_dict()
-        d["stats"].pop("wall_seconds", None)
-        print(i, repr(d))
-        v = c.verdict.value
-        nc[v] = nc.get(v, 0) + 1
         if oracle and og == "violation":
-            orc = O.TrajectoryOracle(m, bm)
-            if v == "certified":
-                for ga in range(m.ngeom):
-                    for gb in range(ga + 1, m.ngeom):
-                        if m.geom_bodyid[ga] == m.geom_bodyid[gb]:
-                            continue
-                        r_ = O.motion_min(orc, ga, gb, float(times[0]), float(times[-1]), n=80, refine=1)
-                        if r_.upper < margin - 1e-9:
-                            bad += 1
-                            print(i, "FALSE-CERTIFIED", ga, gb, r_.upper, r_.time, modes)
-            elif v == "violation" and c.witness is not None:
-                w = c.witness
-                ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, nm) for nm in w.geoms]
-                a, b = orc.geoms(w.time, tuple(ids))
-                ud = O.upper_distance(a, b)
-                if not (O.check_witness(a, b, ud, 1e-9) and ud.upper < margin + 1e-6):
-                    print(i, "WITNESS?", w.time, w.geoms, w.distance, ud.upper)
+            bad += oracle_check(i, m, c, O.TrajectoryOracle(m, bm), float(times[0]), float(times[-1]), margin)
     print("summary", seed, nc, "oracle-bad", bad, file=sys.stderr)
 
 

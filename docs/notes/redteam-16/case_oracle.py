@@ -1,6 +1,6 @@
 """Red team 16: re-run one onecall_fuzz.py case and compare every pair's claimed clearance with the
 dense-sampling oracle (tests/redteam_oracle.py). Usage: case_oracle.py SEED I[,J...]"""
-import sys, numpy as np, mujoco
+import sys, mujoco
 sys.path.insert(0, "/work/wt/rt16/docs/notes/redteam-16"); sys.path.insert(0, "/work/wt/rt16/tests")
 import monitor, onecall_fuzz as F, redteam_oracle as O
 seed, want = int(sys.argv[1]), [int(x) for x in sys.argv[2].split(",")]

@@ -1,9 +1,8 @@
 """Red team 16, idea (2): probes of the scene flag cache (model copies sharing Plan._moving, a plan of
 another model, an unpickled plan, the seal, in-place edits with and without Scene.sync). Run in both trees
 and diff."""
-import pickle, copy
+import pickle
 import mujoco, numpy as np, monitor
-from monitor.certify import engine
 XML = '''<mujoco><worldbody><geom name="w" type="box" size=".1 .1 .1" pos="0.5 0 0"/>
 <body name="a" pos="0 0 0"><joint name="ja" type="slide" axis="1 0 0"/><geom name="ga" type="sphere" size=".1"/></body>
 <body name="b" pos="0 0.5 0"><joint name="jb" type="slide" axis="0 1 0"/><geom name="gb" type="sphere" size=".1"/></body>

@@ -27,22 +27,35 @@ def fmt(v):
     return " ".join(f"{x:.17g}" for x in np.atleast_1d(v))
 
 
-def make(rng):
+STATIC = ((0.05, 0.3), (0.03, 0.2), (0.05, 0.3))     # size ranges (box, capsule, sphere) of static shapes
+MOVING = ((0.03, 0.15), (0.02, 0.1), (0.03, 0.15))   # and of moving ones
+
+
+def random_shape(rng, ranges):
+    """(kind, size, unit quaternion): the draws in a fixed order (every size range is drawn)."""
+    kind = rng.choice(["box", "capsule", "sphere"])
+    size = {"box": rng.uniform(*ranges[0], 3), "capsule": rng.uniform(*ranges[1], 2),
+            "sphere": rng.uniform(*ranges[2], 1)}[kind]
+    q = rng.normal(size=4)
+    return kind, size, q / np.linalg.norm(q)
+
+
+def static_lines(rng):
+    """The MJCF opening and 1-3 random static world geoms (s0, s1, ...), as a list of lines."""
     lines = ['<mujoco><option><flag contact="disable"/></option><worldbody>']
     for i in range(int(rng.integers(1, 4))):
-        kind = rng.choice(["box", "capsule", "sphere"])
-        size = {"box": rng.uniform(0.05, 0.3, 3), "capsule": rng.uniform(0.03, 0.2, 2),
-                "sphere": rng.uniform(0.05, 0.3, 1)}[kind]
-        q = rng.normal(size=4)
+        kind, size, q = random_shape(rng, STATIC)
         lines.append(f'<geom name="s{i}" type="{kind}" size="{fmt(size)}" pos="{fmt(rng.uniform(-0.6, 0.6, 3))}" '
-                     f'quat="{fmt(q / np.linalg.norm(q))}"/>')
+                     f'quat="{fmt(q)}"/>')
+    return lines
+
+
+def make(rng):
+    lines = static_lines(rng)
     rot_modes = []
     nb = int(rng.integers(1, 4))
     for b in range(nb):
-        kind = rng.choice(["box", "capsule", "sphere"])
-        size = {"box": rng.uniform(0.03, 0.15, 3), "capsule": rng.uniform(0.02, 0.1, 2),
-                "sphere": rng.uniform(0.03, 0.15, 1)}[kind]
-        q = rng.normal(size=4)
+        kind, size, q = random_shape(rng, MOVING)
         free = rng.random() < 0.3
         lines.append(f'<body name="b{b}" pos="{fmt(rng.uniform(-0.1, 0.1, 3))}">')
         if free:
@@ -57,7 +70,7 @@ def make(rng):
             else:
                 rot_modes.append(("slide", "none"))
         lines.append(f'<geom name="g{b}" type="{kind}" size="{fmt(size)}" pos="{fmt(rng.uniform(-0.05, 0.05, 3))}" '
-                     f'quat="{fmt(q / np.linalg.norm(q))}"/></body>')
+                     f'quat="{fmt(q)}"/></body>')
     lines.append("</worldbody></mujoco>")
     return "\n".join(lines), rot_modes
 
@@ -105,6 +118,62 @@ def qpos_for(rng, m, rot_modes, K):
     return q
 
 
+def settings(rng):
+    """(margin m, method, ongoing) drawn in a fixed order."""
+    margin = float(rng.choice([0.0, 0.001, 0.02]))
+    meth = str(rng.choice(["auto", "auto", "extrusion", "toleranced"]))
+    og = str(rng.choice(["violation", "deepen"]))
+    return margin, meth, og
+
+
+def certify_and_print(i, scene, traj, margin, meth, og, kw, counts):
+    """Certify, print "<i> <to_dict() without wall time>" (or the typed error), count the verdict;
+    the certificate or None."""
+    try:
+        c = monitor.certify(scene, traj, margin=margin, epsilon=1e-3, method=meth, ongoing=og, **kw)
+    except Exception as e:   # noqa: BLE001
+        print(i, "error", type(e).__name__, str(e)[:120])
+        return None
+    d = c.to_dict()
+    d["stats"].pop("wall_seconds", None)
+    print(i, repr(d))
+    counts[c.verdict.value] = counts.get(c.verdict.value, 0) + 1
+    return c
+
+
+def oracle_check(i, m, c, orc, w0, w1, margin):
+    """Problems (printed) of certificate ``c`` against the dense-sampling oracle ``orc`` on [w0, w1]:
+    a certified call with a pair the oracle proves closer than ``margin`` or closer than the pair's
+    claimed clearance; a violation witness that is not a verified contact below margin at its time."""
+    bad = 0
+    v = c.verdict.value
+    if v == "certified":
+        claimed = {tuple(p.geoms): p.clearance for p in c.pairs}
+        for ga in range(m.ngeom):
+            for gb in range(ga + 1, m.ngeom):
+                if m.geom_bodyid[ga] == m.geom_bodyid[gb]:
+                    continue
+                r_ = O.motion_min(orc, ga, gb, w0, w1, n=80, refine=1)
+                if r_.upper < margin - 1e-9:
+                    bad += 1
+                    print(i, "FALSE-CERTIFIED", ga, gb, r_.upper, r_.time)
+                names = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, ga),
+                         mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, gb))
+                cl = claimed.get(names, claimed.get(names[::-1]))
+                if cl is not None and cl > r_.upper + 1e-9:
+                    bad += 1
+                    print(i, "CLEARANCE-ABOVE-ORACLE", names, cl, r_.upper, r_.time)
+    elif v == "violation" and c.witness is not None:
+        w = c.witness
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, nm) for nm in w.geoms]
+        a, b = orc.geoms(w.time, tuple(ids))
+        ud = O.upper_distance(a, b)
+        if not (O.check_witness(a, b, ud, 1e-9) and ud.upper < margin + 1e-6):
+            bad += 1
+            print(i, "WITNESS?", w.time, w.geoms, w.distance, ud.upper)
+    return bad
+
+
 def main(n, seed, off=False, oracle=False):
     if off:
         engine._ONE_CALL = False
@@ -128,9 +197,7 @@ def main(n, seed, off=False, oracle=False):
             print(i, "plan-error", type(e).__name__, str(e)[:80])
             continue
         scene = monitor.Scene.from_model(m, pairs="all")
-        margin = float(rng.choice([0.0, 0.001, 0.02]))
-        meth = str(rng.choice(["auto", "auto", "extrusion", "toleranced"]))
-        og = str(rng.choice(["violation", "deepen"]))
+        margin, meth, og = settings(rng)
         kw = {}
         r = rng.random()
         if r < 0.15:
@@ -140,44 +207,12 @@ def main(n, seed, off=False, oracle=False):
             kw["window"] = (a, float(times[-1]))
         if rng.random() < 0.05:
             kw["window"] = (float(times[1]), float(times[1]))      # zero-length window
-        try:
-            c = monitor.certify(scene, plan, margin=margin, epsilon=1e-3, method=meth, ongoing=og, **kw)
-        except Exception as e:   # noqa: BLE001
-            print(i, "error", type(e).__name__, str(e)[:120])
+        c = certify_and_print(i, scene, plan, margin, meth, og, kw, nc)
+        if c is None:
             continue
-        d = c.to_dict()
-        d["stats"].pop("wall_seconds", None)
-        print(i, repr(d))
-        v = c.verdict.value if hasattr(c.verdict, "value") else str(c.verdict)
-        nc[v] = nc.get(v, 0) + 1
         if oracle and og == "violation":
             w0, w1 = kw.get("window", (float(times[0]), float(times[-1])))
-            orc = O.PlanOracle(m, times, qpos)
-            if v == "certified":
-                claimed = {tuple(p.geoms): p.clearance for p in c.pairs}
-                for ga in range(m.ngeom):
-                    for gb in range(ga + 1, m.ngeom):
-                        if m.geom_bodyid[ga] == m.geom_bodyid[gb]:
-                            continue
-                        if m.geom_bodyid[ga] == 0 and m.geom_bodyid[gb] == 0:
-                            continue
-                        r_ = O.motion_min(orc, ga, gb, w0, w1, n=80, refine=1)
-                        if r_.upper < margin - 1e-9:
-                            bad += 1
-                            print(i, "FALSE-CERTIFIED", ga, gb, r_.upper, r_.time)
-                        names = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, ga),
-                                 mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, gb))
-                        cl = claimed.get(names, claimed.get(names[::-1]))
-                        if cl is not None and cl > r_.upper + 1e-9:
-                            bad += 1
-                            print(i, "CLEARANCE-ABOVE-ORACLE", names, cl, r_.upper, r_.time)
-            elif v == "violation" and c.witness is not None:
-                w = c.witness
-                ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, nm) for nm in w.geoms]
-                a, b = orc.geoms(w.time, tuple(ids))
-                ud = O.upper_distance(a, b)
-                if not (O.check_witness(a, b, ud, 1e-9) and ud.upper < margin + 1e-6):
-                    print(i, "WITNESS?", w.time, w.geoms, w.distance, ud.upper)
+            bad += oracle_check(i, m, c, O.PlanOracle(m, times, qpos), w0, w1, margin)
     print("summary", seed, nc, "oracle-bad", bad, file=sys.stderr)
 
 
