@@ -474,8 +474,8 @@ def test_pair_bound_relative_to_the_common_ancestor_holds_on_dense_samples():
 
 def test_rounding_scale_equals_its_definition_with_static_bodies():
     """The pack's rounding scale (``tol[TOL_SCALE]``, ``batch(BATCH_SCALE)``) is exactly its
-    definition, ``max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` (poses at
-    the window's midpoint m by ``tree_poses``, W the whole-window bound at scale 0), equals
+    definition, ``(max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|) * SCALE_ROUND_UP``
+    (poses at the window's midpoint m by ``tree_poses``, W the whole-window bound at scale 0), equals
     ``Plan._scale`` (MuJoCo FK + the plan's own numpy bounds, 1e-9), and is at least (i) the
     former definition (max over waypoints and bodies of |origin| by MuJoCo FK, + max W +
     3 max |ref|: pads only grow) and (ii) every body's |origin| and |reference point| at 64
@@ -516,7 +516,8 @@ def test_rounding_scale_equals_its_definition_with_static_bodies():
                  np.empty((1, nbody, 3, 3)), tr, np.empty((1, nbody)))
         whole = tr[0]
         per_body = np.linalg.norm(pos_m[0], axis=-1) + 2.0 * rho + whole
-        assert scale == float(per_body.max()) + float(whole.max()) + 3.0 * float(rho.max())
+        defined = float(per_body.max()) + float(whole.max()) + 3.0 * float(rho.max())
+        assert scale == defined * KN.SCALE_ROUND_UP
         assert scale == pytest.approx(plan._scale, rel=1e-9)
         wp_pos, _ = plan.body_poses(plan.times)           # MuJoCo FK at every waypoint
         former = float(np.linalg.norm(wp_pos, axis=-1).max()) + float(whole.max()) + 3.0 * float(rho.max())

@@ -115,6 +115,13 @@ TOL_SCALE = 3
 TOL_QMAG = 4
 TOL_PATHMAG = 5
 
+SCALE_ROUND_UP = 1.0 + 2.0**-30
+"""Factor on the rounding scale (``batch(BATCH_SCALE)``; ``plan._SCALE_ROUND_UP``, the same value):
+the midpoint origins and the scale-0 whole-window bounds are rounded (FK, norms, sums), so without
+it the scale fell 1-2 ulps below the former definition and below a body's FK origin (red team 16:
+31 of 4000 plans with a far static body and a child moving by ulps of its distance). 2**-30 is
+~4e6 ulps, far above the rounding of any FK chain, and changes pads by ~1e-9 of scale_pad * S."""
+
 
 # ------------------------------------------------------------------ small helpers
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -1039,8 +1046,8 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
     * ``BATCH_POSES``: tree_poses at the N times t0: pos, rot. Returns 0.
     * ``BATCH_SCALE``: the rounding scale of the trajectory (m), as ``Plan._scale``: from the
       whole-window bounds computed with scale 0 and the poses at the window's midpoint,
-      ``max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` (no FK at the
-      waypoints; ``inf`` if a term is NaN). ``mp.tol[3]`` must be 0 when this is called.
+      ``(max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|) * SCALE_ROUND_UP`` (no FK
+      at the waypoints; ``inf`` if a term is NaN). ``mp.tol[3]`` must be 0 when this is called.
       pos/rot/trans/angle: (1, nbody, ...) scratch; on return they hold the whole-window
       poses at the midpoint and bounds.
     """
@@ -1077,7 +1084,7 @@ def batch(mp, mode: int, t0: np.ndarray, t1: np.ndarray, pos: np.ndarray, rot: n
             body = v
         elif v != v:               # NaN (overflowing coordinates): no finite scale
             body = math.inf
-    scale = body + whole + 3.0 * ref_norm
+    scale = (body + whole + 3.0 * ref_norm) * SCALE_ROUND_UP    # (rounding: see SCALE_ROUND_UP)
     return scale if scale == scale else math.inf
 
 

@@ -106,8 +106,12 @@ rel_pad * Theta + abs_pad (radians).
 formula). With m the window's midpoint, x_b(m) body b's FK origin there, W_b its
 whole-window translation bound computed with scale 0 and rho_b = ||ref_b||:
 
-    S = max_b (||x_b(m)|| + 2 rho_b + W_b) + max_b W_b + 3 max_b rho_b.
+    S = (max_b (||x_b(m)|| + 2 rho_b + W_b) + max_b W_b + 3 max_b rho_b) * (1 + 2^-30).
 
+(The factor covers the rounding of the computed terms: x_b(m) is a rounded FK origin and W_b
+carries no FK-rounding pad at scale 0, so without it S fell 1-2 ulps below the former definition
+and below a computed origin on a far static body whose child moves by a few ulps of its
+distance; red team 16. 2^-30 is ~4e6 ulps, far above any FK chain's rounding.)
 (a) S bounds every origin and reference point over the window: by (1) about the
 reference point, ||x_b(t) - x_b(m)|| <= W_b + chord(Theta_b) rho_b <= W_b + 2 rho_b, so
 ||x_b(t)|| <= max_b (||x_b(m)|| + 2 rho_b + W_b) for every t, and
@@ -149,6 +153,9 @@ _FREE = int(mujoco.mjtJoint.mjJNT_FREE)
 _BALL = int(mujoco.mjtJoint.mjJNT_BALL)
 _SLIDE = int(mujoco.mjtJoint.mjJNT_SLIDE)
 _HINGE = int(mujoco.mjtJoint.mjJNT_HINGE)
+_SCALE_ROUND_UP = 1.0 + 2.0**-30
+"""The rounding scale's factor for its own rounding (module docstring, "The rounding scale";
+``monitor.motion.kernel.SCALE_ROUND_UP``, the same value: the compiled pack's scale)."""
 
 
 def _ref_points(model: mujoco.MjModel) -> np.ndarray:
@@ -691,8 +698,8 @@ class Plan(WindowTimes):
     def _scale(self) -> float:
         """Coordinate magnitude of the plan (m), for the rounding pads of the bounds.
 
-        ``S = max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|`` with m the
-        window's midpoint, x_b(m) the FK origin there and W_b body b's whole-window bound
+        ``S = (max_b (|x_b(m)| + 2 |ref_b| + W_b) + max_b W_b + 3 max_b |ref_b|) * (1 + 2**-30)``
+        with m the window's midpoint, x_b(m) the FK origin there and W_b body b's whole-window bound
         computed with scale 0 (module docstring, "Rounding"); ``inf`` if a term is NaN.
         The compiled pack computes the same formula (``batch(BATCH_SCALE)``).
         """
@@ -703,7 +710,7 @@ class Plan(WindowTimes):
             rho = self._st.ref_norms
             per_body = np.linalg.norm(x_m, axis=-1) + 2.0 * rho + whole
             scale = (float(np.max(per_body, initial=0.0)) + float(np.max(whole, initial=0.0))
-                     + 3.0 * self._st.ref_norm)
+                     + 3.0 * self._st.ref_norm) * _SCALE_ROUND_UP
             self._scale_cache = scale if scale == scale else math.inf
         return self._scale_cache
 
