@@ -128,3 +128,28 @@ def test_a_control_callback_keeps_the_loop():
     # without the callback the same tail is different (the test can tell the two apart)
     other, _ = _oracle(m, d, np.array([0.5]), 2, brake, 15, 1e-9)
     assert not np.array_equal(other, want)
+
+
+def test_first_at_rest_equals_the_per_row_rule():
+    """``_first_at_rest`` (the tail's stop rule) against the per-row definition, in plain Python.
+
+    Oracle: the first row whose every entry has ``abs(v) <= vel_tol`` (a NaN compares False),
+    else None. Seeded rows with NaN, +-inf, +-0.0 and entries on both sides of ``vel_tol``,
+    strided views as the tail passes them, and ``vel_tol`` in {1e-3, 0, -0.0, inf, NaN}.
+    """
+    from monitor.gate import _first_at_rest
+
+    rng = np.random.default_rng(12)
+    found = {"row": 0, "none": 0, "later_row": 0}
+    for t in range(600):
+        k, nv = int(rng.integers(1, 40)), int(rng.integers(1, 7))
+        full = rng.normal(size=(k, nv + 3)) * 10.0 ** rng.uniform(-4.5, -1.5, size=(k, 1))
+        for value, p in ((np.nan, 0.03), (np.inf, 0.01), (-np.inf, 0.01), (0.0, 0.05), (-0.0, 0.05)):
+            full[rng.random(full.shape) < p] = value
+        qvel = full[:, 2:2 + nv]  # a strided view, as rows[:, 1 + nq:ncol]
+        vel_tol = (1e-3, 1e-3, 0.0, -0.0, np.inf, np.nan)[t % 6]
+        want = next((i for i, row in enumerate(qvel.tolist()) if all(abs(v) <= vel_tol for v in row)), None)
+        got = _first_at_rest(qvel, vel_tol)
+        assert got == want, (t, got, want)
+        found["none" if want is None else "row" if want == 0 else "later_row"] += 1
+    assert min(found.values()) >= 30, found
