@@ -1305,7 +1305,9 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     there are critical as usual). A malformed record makes its windows unverifiable. A valid
     record is still the run's unsigned claim (an added record shrinking an obstacle reads like
     a genuine edit): the windows from the first edit are one unverifiable finding unless
-    ``trust_model_edits`` (the auditor trusts the run's edit records), then a note.
+    ``trust_model_edits`` (the auditor trusts the run's edit records) or the log's signature
+    verified with ``key`` (every record covered, signed close: the records are the key holder's
+    own), then a note.
 
     Args:
         contents: a read log.
@@ -1467,7 +1469,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     scene_pairs = Counter(_pair_key(p) for p in scene.candidate_pairs) if scene is not None else None
     edits, edits_bad_from = _model_edits(contents, model, find, notes)
     replay_edits = list(edits)  # the loop below consumes edits; the re-simulation applies them again
-    if edits and not trust_model_edits:
+    # a log whose every record a valid signature covers, closed and signed (key given): the edit
+    # records are the gate's own, as authentic as the rest; the unsigned-log reason for refusing
+    # them (an added record shrinking an obstacle reads like a genuine edit) does not apply
+    signed_edits = bool(edits) and signature.get("status") == "verified"
+    if signed_edits and not trust_model_edits:
+        notes.append(f"model edit records ({len(edits)}) are covered by the log's valid signature: "
+                     f"accepted as the run's edits")
+    if edits and not trust_model_edits and not signed_edits:
         first_edit = edits[0][0]
         n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
                       for c in certs)

@@ -378,3 +378,28 @@ def test_a_window_logged_uncertain_that_certifies_now_is_a_non_critical_mismatch
     assert "claimed less" in m["reason"]
     assert ver["critical"] == 0 and not _findings(ver, "critical")
     assert code == 0
+
+
+def test_signed_model_edit_records_need_no_trust_flag(tmp_path):
+    """Unsigned, an edit record is the run's claim (a forger's added record reads the same), so the
+    edited windows are unverifiable without ``trust_model_edits``. Signed and verified with the key,
+    the records are the key holder's own: accepted, with a note; a wrong key or no key: as unsigned."""
+    key = b"0123456789abcdef0123456789abcdef"
+    m = mujoco.MjModel.from_xml_string(BOUNCE)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = -0.25, 1.0
+    path = tmp_path / "signed_edits.mcap"
+    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn", log_options={"key": key}) as g:
+        for k in range(4):
+            if k == 2:
+                m.body_mass[2] *= 1.5
+                m.geom_size[0, 0] *= 0.9     # a scene field: the pair's shapes are rebuilt
+            g.step(d, np.zeros(1))
+    assert read_log(path).model_edits
+    code, ver = _verify(path, key=key)
+    assert code == 0, ver["findings"]
+    assert any("covered by the log's valid signature" in n for n in ver["notes"])
+    code, ver = _verify(path)
+    assert code == 2 and _findings(ver, review.UNVERIFIABLE)
+    code, ver = _verify(path, key=b"another key, 16+ bytes long")
+    assert code == 1
