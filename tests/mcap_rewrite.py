@@ -81,3 +81,40 @@ def rewrite(src: Path, dst: Path, *, msg: Callable[[str, dict], Any] | None = No
         for k, (topic, payload) in enumerate(append or []):
             w.add_message(cmap[by_topic[topic]], last[0] + 1 + k, _compact(payload), last[1], last[2] + 1 + k)
         w.finish()
+
+
+def file_records(src: Path) -> list:
+    """Every schema, channel, message, metadata and attachment record of ``src`` in FILE order
+    (chunks opened; the digest seal dropped): a forger's view, where metadata sit among messages."""
+    from mcap.records import Attachment, Channel, Message, Metadata, Schema
+    from mcap.stream_reader import StreamReader
+
+    with open(src, "rb") as f:
+        recs = [r for r in StreamReader(f, emit_chunks=False).records
+                if isinstance(r, (Schema, Channel, Message, Metadata, Attachment))]
+    return [r for r in recs if not (type(r).__name__ == "Metadata" and r.name == METADATA_DIGEST)]
+
+
+def write_records(dst: Path, recs: list, *, chunked: bool = False) -> None:
+    """Write ``recs`` (as :func:`file_records` returns them, reordered / edited at will) in that order."""
+    from mcap.records import Attachment, Channel, Message, Metadata, Schema
+
+    with open(dst, "wb") as fo:
+        w = Writer(fo, use_chunking=chunked,
+                   compression=CompressionType.ZSTD if chunked else CompressionType.NONE)
+        w.start(library="rewrite")
+        smap: dict[int, int] = {}
+        cmap: dict[int, int] = {}
+        for r in recs:
+            if isinstance(r, Schema) and r.id not in smap:
+                smap[r.id] = w.register_schema(r.name, r.encoding, r.data)
+            elif isinstance(r, Channel) and r.id not in cmap:
+                cmap[r.id] = w.register_channel(r.topic, r.message_encoding, smap.get(r.schema_id, 0),
+                                                r.metadata)
+            elif isinstance(r, Message):
+                w.add_message(cmap[r.channel_id], r.log_time, r.data, r.publish_time, r.sequence)
+            elif isinstance(r, Metadata):
+                w.add_metadata(r.name, dict(r.metadata))
+            elif isinstance(r, Attachment):
+                w.add_attachment(r.create_time, r.log_time, r.name, r.media_type, r.data)
+        w.finish()
