@@ -27,6 +27,7 @@ import base64
 import html
 import io
 import math
+import re
 from collections import Counter
 from collections.abc import Callable
 from typing import Any
@@ -1474,15 +1475,14 @@ def verify(contents: LogContents, *, model_source: str = "auto", progress: bool 
     # them (an added record shrinking an obstacle reads like a genuine edit) does not apply
     signed_edits = bool(edits) and signature.get("status") == "verified"
     if signed_edits and not trust_model_edits:
-        notes.append(f"model edit records ({len(edits)}) are covered by the log's valid signature: "
-                     f"accepted as the run's edits")
+        notes.append(_signed_edits_note(len(edits)))
     if edits and not trust_model_edits and not signed_edits:
         first_edit = edits[0][0]
         n_after = sum(c["index"] >= first_edit and (edits_bad_from is None or c["index"] < edits_bad_from)
                       for c in certs)
         if n_after:
-            find(UNVERIFIABLE, f"{n_after} window(s) from index {first_edit} were certified on in-place "
-                               f"model edits the run logged: re-derived on them, but an unsigned log cannot "
+            find(UNVERIFIABLE, f"{n_after} window(s) from index {first_edit} {_UNSIGNED_EDITS}: re-derived "
+                               f"on them, but an unsigned log cannot "
                                f"show that the edits happened (an added edit record reads the same; "
                                f"trust_model_edits accepts them)")
     if edits or edits_bad_from is not None:
@@ -1650,8 +1650,23 @@ def signature_findings(contents: LogContents, key: bytes | None, find: Callable[
     return sig.to_json()
 
 
+_UNSIGNED_EDITS = "were certified on in-place model edits the run logged"
+"""Part of the reason of :func:`verify`'s finding on edit records it could not accept (found again by
+:func:`add_signature` once the signature verified)."""
+_UNSIGNED_EDITS_RE = re.compile(r"\d+ window\(s\) from index -?\d+ " + re.escape(_UNSIGNED_EDITS) + ": ")
+
+
+def _signed_edits_note(n: int) -> str:
+    return f"model edit records ({n}) are covered by the log's valid signature: accepted as the run's edits"
+
+
 def add_signature(ver: dict[str, Any], contents: LogContents, key: bytes | None) -> dict[str, Any]:
-    """Add the signature check to a :func:`verify` result made without it (``review --ray``)."""
+    """Add the signature check to a :func:`verify` result made without it (``review --ray``).
+
+    As in :func:`verify` with ``key``: when the signature verified (every record covered, signed
+    close), the finding on the log's model-edit records (unverifiable without a signature) is
+    dropped and the note says they were accepted.
+    """
     if ver.get("error") or "findings" not in ver:
         return ver
     before = len(ver["findings"])
@@ -1663,7 +1678,13 @@ def add_signature(ver: dict[str, Any], contents: LogContents, key: bytes | None)
     ver["signature"] = signature_findings(contents, key, find, ver["notes"])
     new = ver["findings"][before:]
     ver["critical"] = ver.get("critical", 0) + sum(f["severity"] == CRITICAL for f in new)
-    ver["unverifiable"] = ver.get("unverifiable", 0) + sum(f["severity"] == UNVERIFIABLE for f in new)
+    if ver["signature"].get("status") == "verified":
+        edits = [f for f in ver["findings"] if f["severity"] == UNVERIFIABLE and f["index"] is None
+                 and _UNSIGNED_EDITS_RE.match(f["reason"])]
+        if edits:
+            ver["findings"] = [f for f in ver["findings"] if f not in edits]
+            ver["notes"].append(_signed_edits_note(len(contents.model_edits)))
+    ver["unverifiable"] = sum(f["severity"] == UNVERIFIABLE for f in ver["findings"])
     return ver
 
 

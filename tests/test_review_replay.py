@@ -403,3 +403,27 @@ def test_signed_model_edit_records_need_no_trust_flag(tmp_path):
     assert code == 2 and _findings(ver, review.UNVERIFIABLE)
     code, ver = _verify(path, key=b"another key, 16+ bytes long")
     assert code == 1
+
+
+def test_ray_path_accepts_signed_model_edits_like_the_plain_path(tmp_path):
+    """``review --ray`` verifies without the key, then adds the signature (``add_signature``): a
+    verified signature drops the edit finding as :func:`review.verify` with the key does; a wrong key
+    leaves it (and is critical itself)."""
+    key = b"0123456789abcdef0123456789abcdef"
+    m = mujoco.MjModel.from_xml_string(BOUNCE)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = -0.25, 1.0
+    path = tmp_path / "signed_edits_ray.mcap"
+    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn", log_options={"key": key}) as g:
+        for k in range(4):
+            if k == 2:
+                m.geom_size[0, 0] *= 0.9
+            g.step(d, np.zeros(1))
+    contents = read_log(path)
+    ver = review.verify(contents)
+    assert review.verify_exit_code(ver) == 2 and _findings(ver, review.UNVERIFIABLE)
+    ver = review.add_signature(ver, contents, key)
+    assert review.verify_exit_code(ver) == 0, ver["findings"]
+    assert any("covered by the log's valid signature" in n for n in ver["notes"])
+    ver = review.add_signature(review.verify(contents), contents, b"another key, 16+ bytes long")
+    assert review.verify_exit_code(ver) == 1 and _findings(ver, review.UNVERIFIABLE)
