@@ -380,21 +380,31 @@ def test_a_window_logged_uncertain_that_certifies_now_is_a_non_critical_mismatch
     assert code == 0
 
 
-def test_signed_model_edit_records_need_no_trust_flag(tmp_path):
-    """Unsigned, an edit record is the run's claim (a forger's added record reads the same), so the
-    edited windows are unverifiable without ``trust_model_edits``. Signed and verified with the key,
-    the records are the key holder's own: accepted, with a note; a wrong key or no key: as unsigned."""
-    key = b"0123456789abcdef0123456789abcdef"
+_EDIT_KEY = b"0123456789abcdef0123456789abcdef"
+
+
+@pytest.fixture(scope="module")
+def signed_edits(tmp_path_factory):
+    """A bounce run logged with a key (``_EDIT_KEY``) whose model is edited in place before step 2."""
     m = mujoco.MjModel.from_xml_string(BOUNCE)
     d = mujoco.MjData(m)
     d.qpos[0], d.qvel[0] = -0.25, 1.0
-    path = tmp_path / "signed_edits.mcap"
-    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn", log_options={"key": key}) as g:
+    path = tmp_path_factory.mktemp("signed_edits") / "signed_edits.mcap"
+    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn",
+              log_options={"key": _EDIT_KEY}) as g:
         for k in range(4):
             if k == 2:
                 m.body_mass[2] *= 1.5
                 m.geom_size[0, 0] *= 0.9     # a scene field: the pair's shapes are rebuilt
             g.step(d, np.zeros(1))
+    return path, _EDIT_KEY
+
+
+def test_signed_model_edit_records_need_no_trust_flag(signed_edits):
+    """Unsigned, an edit record is the run's claim (a forger's added record reads the same), so the
+    edited windows are unverifiable without ``trust_model_edits``. Signed and verified with the key,
+    the records are the key holder's own: accepted, with a note; a wrong key or no key: as unsigned."""
+    path, key = signed_edits
     assert read_log(path).model_edits
     code, ver = _verify(path, key=key)
     assert code == 0, ver["findings"]
@@ -405,20 +415,11 @@ def test_signed_model_edit_records_need_no_trust_flag(tmp_path):
     assert code == 1
 
 
-def test_ray_path_accepts_signed_model_edits_like_the_plain_path(tmp_path):
+def test_ray_path_accepts_signed_model_edits_like_the_plain_path(signed_edits):
     """``review --ray`` verifies without the key, then adds the signature (``add_signature``): a
     verified signature drops the edit finding as :func:`review.verify` with the key does; a wrong key
     leaves it (and is critical itself)."""
-    key = b"0123456789abcdef0123456789abcdef"
-    m = mujoco.MjModel.from_xml_string(BOUNCE)
-    d = mujoco.MjData(m)
-    d.qpos[0], d.qvel[0] = -0.25, 1.0
-    path = tmp_path / "signed_edits_ray.mcap"
-    with Gate(m, log=path, frame_skip=50, allowed=None, on_violation="warn", log_options={"key": key}) as g:
-        for k in range(4):
-            if k == 2:
-                m.geom_size[0, 0] *= 0.9
-            g.step(d, np.zeros(1))
+    path, key = signed_edits
     contents = read_log(path)
     ver = review.verify(contents)
     assert review.verify_exit_code(ver) == 2 and _findings(ver, review.UNVERIFIABLE)
