@@ -484,14 +484,6 @@ def _geom_shape(model: Any, g: int, facets: int, tol: Tolerances) -> ConvexShape
     raise UnsupportedGeometryError(f"geom {g} has unknown type {name!r}")
 
 
-def _sealed_once(arr: np.ndarray) -> np.ndarray:
-    """``arr`` if it already lies over immutable ``bytes``, else a sealed copy."""
-    base = arr
-    while isinstance(base, np.ndarray):
-        base = base.base
-    return arr if isinstance(base, bytes) and not arr.flags.writeable else sealed(np.ascontiguousarray(arr))
-
-
 class Scene:
     """Convex shapes of every geom of an ``MjModel`` plus the pairs to certify.
 
@@ -523,8 +515,8 @@ class Scene:
         # sealed over immutable bytes (a copy, once per build): the engine caches the scene's packs by
         # the identity of these arrays, and a read-only array that owns its memory can be made
         # writable again and edited under the cache (red team 10's open item)
-        pair_ids = _sealed_once(pair_ids)
-        body_static = _sealed_once(body_static)
+        pair_ids = sealed(pair_ids)
+        body_static = sealed(body_static)
         self.model = model
         self.geoms = geoms
         self.pair_ids = pair_ids
@@ -563,7 +555,7 @@ class Scene:
         state = dict(state)
         for name in ("pair_ids", "body_static"):
             if isinstance(state.get(name), np.ndarray):
-                state[name] = _sealed_once(state[name])
+                state[name] = sealed(state[name])
         if state.get("_sorted_pairs") is not None:
             state["_sorted_pairs"] = state["pair_ids"]
         self.__dict__.update(state)

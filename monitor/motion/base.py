@@ -110,8 +110,14 @@ def sealed(arr: np.ndarray) -> np.ndarray:
         arr: any ndarray (the trajectory's own, just validated).
 
     Returns:
-        a read-only C-contiguous array, same dtype, shape and values.
+        a read-only C-contiguous array, same dtype, shape and values: ``arr`` itself when it is
+        already one over ``bytes`` (nothing can edit it), else a copy.
     """
+    base = arr
+    while isinstance(base, np.ndarray):
+        base = base.base
+    if isinstance(base, bytes) and not arr.flags.writeable and arr.flags.c_contiguous:
+        return arr
     return np.frombuffer(arr.tobytes(), dtype=arr.dtype).reshape(arr.shape)
 
 
