@@ -238,9 +238,10 @@ class Rollout:
         rows[0] = key[:ncol]
         warn = self._s_warn
         unstable = warn.tobytes()
+        step, get_state = mujoco.mj_step, mujoco.mj_getState  # (read once per window, not per substep)
         for k in range(1, nstep + 1):
-            mujoco.mj_step(m, s)
-            mujoco.mj_getState(m, s, rows[k], _WINDOW_ROW)
+            step(m, s)
+            get_state(m, s, rows[k], _WINDOW_ROW)
         if warn.tobytes() != unstable:
             raise InvalidInputError(
                 f"the predicted window from t = {float(rows[0, 0])!r} s ({nstep} substep(s) under ctrl = "
@@ -448,25 +449,41 @@ class Rollout:
         # Substep 1 exactly as the loop runs it (a tail at rest stops here).
         mujoco.mj_step(m, s)
         mujoco.mj_getState(m, s, rows[1], _FULL)
-        if n == 1 or np.abs(rows[1, 1 + nq:ncol]).max() <= vel_tol:
+        if n == 1 or _row_at_rest(rows[1, 1 + nq:ncol].tolist(), vel_tol):
             return rows[:2, :ncol]
         # Substeps 2..n in one rollout call from the scratch's state after substep 1.
         bufs = self._tail_bufs
         if bufs is None or bufs[0].shape[1] != n - 1:
-            # (user inputs held over the tail, warm start, warning counters: views of the scratch)
-            bufs = self._tail_bufs = (np.empty((1, n - 1, self._n_user)), np.empty((1, nv)), s.warning.number,
-                                      s.qacc_warmstart)
-        user, warm, counters, s_warm = bufs
+            # (user inputs held over the tail, warm start, warning counters: views of the scratch,
+            # and the counters' bytes when all are 0)
+            counters = s.warning.number
+            bufs = self._tail_bufs = (np.empty((1, n - 1, self._n_user)), np.empty((1, nv)), counters,
+                                      s.qacc_warmstart, bytes(counters.nbytes))
+        user, warm, counters, s_warm, no_warning = bufs
         mujoco.mj_getState(m, s, user[0, 0], _USER)
         user[0, 1:] = user[0, 0]
         warm[0] = s_warm
         counters[:] = 0
         self._roll.rollout([m], [s], n - 1, _USER, rows[1:2], warm, user, rows[None, 2:], None, None)
-        if counters.any():
+        if counters.tobytes() != no_warning:  # some counter is not 0 (integers: bytes 0 <=> value 0)
             return None
         first = _first_at_rest(rows[2:, 1 + nq:ncol], vel_tol)
         end = n if first is None else 2 + first  # the first substep that passes
         return rows[:end + 1, :ncol]
+
+
+def _row_at_rest(qvel: list[float], vel_tol: float) -> bool:
+    """Whether every ``|v| <= vel_tol`` in one row of qvel given as a list (the stop rule of one substep).
+
+    The same answer as ``np.abs(row).max() <= vel_tol``, without two numpy calls on a few entries
+    (~1.2 µs against 0.3-0.9): a NaN entry fails (numpy's ``max`` is then NaN, and ``NaN <= tol``
+    is False), as does any entry above ``vel_tol``; a NaN ``vel_tol`` fails every row in both.
+    Python floats are the float64 values exactly (``tolist``), compared in the same IEEE order.
+    """
+    for v in qvel:
+        if not abs(v) <= vel_tol:
+            return False
+    return True
 
 
 def _first_at_rest(qvel: np.ndarray, vel_tol: float) -> int | None:
@@ -597,10 +614,12 @@ def hold_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
             if a.size:
                 length = gear0[a] * data.qpos[adr]
                 ctrl[a] = -(bias0[a] + b1 * length) / gain
+    # ndarray.clip is what np.clip calls for an ndarray (numpy's _wrapfunc), without its
+    # argument handling and dispatch: the same clip ufunc, the same floats
     if limited is None:  # every actuator limited
-        return np.clip(ctrl, lo, hi)
+        return ctrl.clip(lo, hi)
     if limited.size:
-        ctrl[limited] = np.clip(ctrl[limited], lo[limited], hi[limited])
+        ctrl[limited] = ctrl[limited].clip(lo[limited], hi[limited])
     return ctrl
 
 
