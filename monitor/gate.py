@@ -491,13 +491,15 @@ def _first_at_rest(qvel: np.ndarray, vel_tol: float) -> int | None:
 
     The braking tail's stop rule. A NaN entry fails its row (as ``max(|row|) <= vel_tol`` does).
     Without numpy's per-row reduction over nv columns (slow for short rows: ~10 µs for a
-    125-substep Arm tail): a row passes only if its first entry does, so only those rows are
-    tested whole (few or none while the bodies move).
+    125-substep Arm tail): a row passes only if its first entry does, so only the first column
+    is tested for every row (three numpy calls on K entries: ~1 µs against ~3 for the whole
+    (K, nv) block), and only the rows whose first entry passes are tested whole (few or none
+    while the bodies move); ``nonzero`` gives them in increasing order, so the first of them
+    that passes whole is the first row that passes.
     """
-    ok = np.abs(qvel) <= vel_tol  # (K, nv)
-    cand = np.flatnonzero(ok[:, 0])
+    cand = (np.abs(qvel[:, 0]) <= vel_tol).nonzero()[0]  # rows whose first entry passes, (c,) increasing
     if cand.size:
-        cand = cand[ok[cand].all(axis=1)]
+        cand = cand[(np.abs(qvel[cand]) <= vel_tol).all(axis=1)]
     return int(cand[0]) if cand.size else None
 
 
