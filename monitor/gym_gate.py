@@ -293,7 +293,8 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     def _as_inner(self, a: Any) -> np.ndarray:
         """A gate-made action of the env's own action space (hold, brake), clipped to it and cast."""
         space = self._inner_space
-        return np.asarray(np.clip(np.asarray(a, dtype=np.float64), space.low, space.high), dtype=space.dtype)
+        # ndarray.clip: what np.clip calls for an ndarray, without its dispatch (same values)
+        return np.asarray(np.asarray(a, dtype=np.float64).clip(space.low, space.high), dtype=space.dtype)
 
     def _inner_action(self, c: Any, what: str) -> np.ndarray:
         """``c = T(action)`` checked: a finite numeric array of the env's own action shape."""
@@ -413,7 +414,9 @@ class SafetyGate(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             return
         expected = np.asarray(applied, dtype=np.float64)
         ctrl = self._unwrapped.data.ctrl
-        if ctrl.shape != expected.shape or not (ctrl == expected).all():
+        # equal shapes (1-D: data.ctrl is (nu,)): the lists of Python floats compare element by element
+        # with float ==, as (ctrl == expected).all() does (NaN unequal, -0.0 == 0.0), in one C call
+        if ctrl.shape != expected.shape or ctrl.tolist() != expected.tolist():
             raise InvalidInputError(
                 f"env: after the step data.ctrl = {np.array2string(ctrl)} but the gate certified ctrl = "
                 f"{np.array2string(expected)}: something between SafetyGate and "

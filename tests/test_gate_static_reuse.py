@@ -63,3 +63,29 @@ def test_static_fallback_windows_give_the_general_paths_reports():
         assert s_fast[k] == s_slow[k], k
     assert s_slow["static_reused"] == 0
     assert (hits >= 3).all()  # the path was taken before and after each context change
+
+
+def test_pairs_moving_memo_equals_the_formula():
+    """``Gate._pairs_moving`` (memoised on its last call) against ``moving[body_a] | moving[body_b]``.
+
+    Oracle: the formula computed afresh. Seeded calls that repeat the last ``moving`` (memo hits),
+    change it, and switch between body-id arrays of different contents (a rebuilt scene); the
+    result is read-only and ``all`` is ``either.all()``.
+    """
+    g = Gate(mujoco.MjModel.from_xml_path(str(scene_path("tunnel"))), margin=0.001)
+    rng = np.random.default_rng(15)
+    pools = [tuple(rng.integers(0, 6, size=(2, p))) for p in (1, 4, 9)]
+    moving = rng.random(6) < 0.5
+    hits = 0
+    for t in range(300):
+        if t % 5 == 0:
+            moving = rng.random(6) < 0.7
+        body_a, body_b = pools[int(rng.integers(len(pools)))] if t % 7 == 0 else pools[0]
+        memo = g._moving_memo
+        either, all_move = g._pairs_moving(moving.copy(), body_a, body_b)
+        want = moving[body_a] | moving[body_b]
+        hits += memo is not None and g._moving_memo is memo
+        assert either.tobytes() == want.tobytes() and either.shape == want.shape
+        assert all_move is bool(want.all())
+        assert not either.flags.writeable
+    assert 100 <= hits <= 250, hits  # both memo hits and misses

@@ -153,3 +153,27 @@ def test_first_at_rest_equals_the_per_row_rule():
         assert got == want, (t, got, want)
         found["none" if want is None else "row" if want == 0 else "later_row"] += 1
     assert min(found.values()) >= 30, found
+
+
+def test_row_at_rest_equals_the_max_rule():
+    """``_row_at_rest`` (the stop rule at the tail's first substep) against numpy's ``max(|row|) <= vel_tol``.
+
+    Oracle: the rule as the tail wrote it before (``np.abs(row).max() <= vel_tol``). Seeded rows of
+    1-30 entries with NaN, +-inf, +-0.0 and entries on both sides of ``vel_tol``, given as
+    ``tolist()`` of a strided view as the tail passes them; ``vel_tol`` in {1e-3, 0, -0.0, inf, NaN}.
+    """
+    from monitor.gate import _row_at_rest
+
+    rng = np.random.default_rng(13)
+    found = {True: 0, False: 0}
+    for t in range(600):
+        nv = int(rng.integers(1, 31))
+        full = rng.normal(size=(2, nv + 3)) * 10.0 ** rng.uniform(-4.5, -2.0)
+        for value, p in ((np.nan, 0.01), (np.inf, 0.005), (-np.inf, 0.005), (0.0, 0.05), (-0.0, 0.05)):
+            full[rng.random(full.shape) < p] = value
+        row = full[1, 2:2 + nv]  # a strided view, as rows[1, 1 + nq:ncol]
+        vel_tol = (1e-3, 1e-3, 0.0, -0.0, np.inf, np.nan)[t % 6]
+        want = bool(np.abs(row).max() <= vel_tol)
+        assert _row_at_rest(row.tolist(), vel_tol) is want, (t, row, vel_tol)
+        found[want] += 1
+    assert min(found.values()) >= 100, found

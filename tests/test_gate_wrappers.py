@@ -208,3 +208,40 @@ def test_gym_make_chain_and_observation_wrappers_pass():
 def test_gate_over_a_gate_is_refused():
     with pytest.raises(InvalidInputError, match=r"wrapper monitor\.gym_gate\.SafetyGate"):
         SafetyGate(SafetyGate(gym.make("monitor/Tunnel-v0")))
+
+
+def test_applied_ctrl_check_is_elementwise_float_equality():
+    """The applied-control check after a step raises exactly when ``(data.ctrl == certified).all()`` is False.
+
+    Oracle: numpy's element-wise ``==`` (NaN unequal to itself, -0.0 equal to 0.0), on seeded
+    (nu,) pairs of Pusher-v5 controls that are equal, equal up to the sign of zero, NaN in the same
+    place, or different in one entry.
+    """
+    env = SafetyGate(gym.make("Pusher-v5"), pairs="mujoco")
+    env.reset(seed=0)
+    ctrl = env.unwrapped.data.ctrl
+    rng = np.random.default_rng(14)
+    raised = {True: 0, False: 0}
+    for t in range(200):
+        certified = rng.uniform(-2.0, 2.0, size=ctrl.shape)
+        certified[rng.random(ctrl.shape) < 0.2] = 0.0
+        live = certified.copy()
+        kind = t % 4
+        if kind == 1:
+            live[live == 0.0] = -0.0
+        elif kind == 2:
+            i = int(rng.integers(ctrl.size))
+            live[i] = certified[i] = np.nan
+        elif kind == 3:
+            live[int(rng.integers(ctrl.size))] += 1e-12
+        ctrl[:] = live
+        want = not (ctrl == certified).all()
+        try:
+            env._check_applied_ctrl(certified)
+            got = False
+        except InvalidInputError:
+            got = True
+        assert got is want, (t, live, certified)
+        raised[want] += 1
+    assert min(raised.values()) >= 50, raised
+    env.close()
