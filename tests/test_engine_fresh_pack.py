@@ -1,4 +1,4 @@
-"""engine._window_kernel with a NEW motion pack of the type the dispatcher typed last (issue 12, helper gatepath).
+"""engine._window_kernel with a NEW motion pack of the last typed type (issue 12, helper gatepath).
 
 A gate certifies a new Plan per window, so every window's motion pack is a new object; when it is of
 the same class and its fields have numba's type fingerprint of the pack the dispatcher last typed
@@ -32,8 +32,8 @@ from _switch_cases import cert_key, tunnel_gate_keys  # noqa: E402
 
 _XML = """<mujoco><worldbody>
   <geom name="wall" type="box" size="0.05 1 1" pos="0.6 0 0"/>
-  <body name="a" pos="0 0 0"><joint name="x" type="slide" axis="1 0 0"/><joint name="r" type="hinge" axis="0 0 1"/>
-    <geom name="ga" type="box" size="0.1 0.05 0.05"/></body>
+  <body name="a" pos="0 0 0"><joint name="x" type="slide" axis="1 0 0"/>
+    <joint name="r" type="hinge" axis="0 0 1"/><geom name="ga" type="box" size="0.1 0.05 0.05"/></body>
   <body name="b" pos="0 0.5 0"><joint name="y" type="slide" axis="1 0 0"/>
     <geom name="gb" type="capsule" size="0.05 0.1"/></body>
 </worldbody></mujoco>"""

@@ -108,6 +108,21 @@ for mname, m in list(sys.modules.items()):
             if av is raw:
                 setattr(m, an, timed)
 
+acc = np.zeros(len(marks))
+cnt = np.zeros(len(marks))
+nsteps = 0
+
+
+def charge() -> None:
+    """Charge one timed step's marks (``T``) to their statements."""
+    global nsteps
+    for (i, ta), (_, tb) in zip(T, T[1:]):
+        if i >= 0:
+            acc[i] += tb - ta
+            cnt[i] += 1
+    nsteps += 1
+
+
 if kind == "tunnel":
     import mujoco  # noqa: E402
 
@@ -116,9 +131,6 @@ if kind == "tunnel":
     model = mujoco.MjModel.from_xml_path(str(_scene_file("tunnel")))
     gate = Gate(model, margin=0.001)
     d = mujoco.MjData(model)
-    acc = np.zeros(len(marks))
-    cnt = np.zeros(len(marks))
-    nsteps = 0
     for rep in [1000] + list(range(blocks)):
         mujoco.mj_resetDataKeyframe(model, d, 0)
         gate.reset()
@@ -126,13 +138,8 @@ if kind == "tunnel":
             target = 0.3 if (k // 100) % 2 == 0 else -0.3
             T.clear()
             gate.step(d, np.clip([12.0 * (target - d.qpos[0])], -6.0, 6.0), nstep=1)
-            if rep == 1000:
-                continue
-            for (i, ta), (_, tb) in zip(T, T[1:]):
-                if i >= 0:
-                    acc[i] += tb - ta
-                    cnt[i] += 1
-            nsteps += 1
+            if rep != 1000:
+                charge()
 else:
     import gymnasium as gym  # noqa: E402
 
@@ -140,9 +147,6 @@ else:
     from monitor.gym_gate import SafetyGate  # noqa: E402
 
     env = SafetyGate(gym.make({"arm": "monitor/Arm-v0", "pusher": "Pusher-v5"}[kind]), pairs="mujoco")
-    acc = np.zeros(len(marks))
-    cnt = np.zeros(len(marks))
-    nsteps = 0
     for rep in [1000] + list(range(blocks)):
         env.reset(seed=rep)
         env.action_space.seed(rep)
@@ -152,13 +156,8 @@ else:
             _, _, te, tr, _ = env.step(a)
             if te or tr:
                 env.reset()
-            if rep == 1000:
-                continue
-            for (i, ta), (_, tb) in zip(T, T[1:]):
-                if i >= 0:
-                    acc[i] += tb - ta
-                    cnt[i] += 1
-            nsteps += 1
+            if rep != 1000:
+                charge()
 print(f"{qual}: {nsteps} steps; µs per STEP (calls per step) by statement (the time until the next mark)")
 for i, (ln, col, txt) in enumerate(marks):
     if acc[i] / nsteps / 1e3 >= 0.3:
