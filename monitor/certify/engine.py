@@ -87,6 +87,7 @@ def _kernels() -> Any:
     """The :mod:`monitor.certify.kernels` module (imported on first use: it imports numba)."""
     if not _KS:
         from monitor.certify import kernels
+        _FINGERPRINT[0] = _fingerprint_function()
         _KS.append(kernels)
     return _KS[0]
 
@@ -888,8 +889,8 @@ class _WindowPairs:
 
 _WK_DIRECT: list = [None, None]
 """Per ``rows`` kind (slot 0: None, slot 1: an array): (dispatcher, number of its overloads, entry
-point, gp, mp, pairs, fixed, moving) of the last :func:`_window_kernel` call of that kind that went
-through numba's dispatcher (see there)."""
+point, gp, mp, pairs, fixed, moving, type(mp), :func:`_pack_fingerprint` of mp) of the last
+:func:`_window_kernel` call of that kind that went through numba's dispatcher (see there)."""
 
 _WK_ROWS = 16
 """Position of ``rows`` among :func:`monitor.certify.kernels.window_kernel`'s arguments."""
@@ -908,16 +909,20 @@ def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarr
     are the very objects of the last call of that kind that went through the dispatcher, and
     that dispatcher still has the overloads it had then -- one, or two that differ in nothing but
     the type of ``rows`` (so the one that ran is the one of this kind) -- the overload's entry
-    point is called directly: what the dispatcher itself calls after typing. Anything else
-    (another pack or flag array, a monkeypatched or non-numba ``window_kernel``, other overloads)
-    goes through the dispatcher. The packs and flag arrays are never modified in place (the
-    kernels only read them).
+    point is called directly: what the dispatcher itself calls after typing. The motion pack may
+    also be another one of the same class whose fields have numba's type fingerprint of that
+    call's pack (:func:`_pack_fingerprint`: the key under which the dispatcher itself would find
+    its type; the gate's new pack per window). Anything else (another scene pack, pair or flag
+    array, a pack of another type, a monkeypatched or non-numba ``window_kernel``, other
+    overloads) goes through the dispatcher. The packs and flag arrays are never modified in
+    place (the kernels only read them).
     """
     wk = KS.window_kernel
     slot = 0 if rest[-2] is None else 1
     d = _WK_DIRECT[slot]
-    if (d is not None and d[0] is wk and d[3] is gp and d[4] is mp and d[5] is pairs and d[6] is fixed
-            and d[7] is moving and len(wk.overloads) == d[1]):
+    if (d is not None and d[0] is wk and d[3] is gp and d[5] is pairs and d[6] is fixed
+            and d[7] is moving and len(wk.overloads) == d[1]
+            and (d[4] is mp or (type(mp) is d[8] and d[9] is not None and _pack_fingerprint(mp) == d[9]))):
         return d[2](gp, mp, pairs, fixed, moving, *rest)
     out = wk(gp, mp, pairs, fixed, moving, *rest)
     if type(wk).__name__ == "CPUDispatcher":
@@ -929,8 +934,46 @@ def _window_kernel(KS: Any, gp: Any, mp: Any, pairs: np.ndarray, fixed: np.ndarr
                 # process; a numba without these attributes keeps the dispatcher path)
                 ep = _ENTRY_POINTS[id(wk)] = (wk, len(ovl), _entry_points_by_rows(ovl))
             if ep[2][slot] is not None:
-                _WK_DIRECT[slot] = (wk, len(ovl), ep[2][slot], gp, mp, pairs, fixed, moving)
+                _WK_DIRECT[slot] = (wk, len(ovl), ep[2][slot], gp, mp, pairs, fixed, moving, type(mp),
+                                    _pack_fingerprint(mp))
     return out
+
+
+def _pack_fingerprint(mp: Any) -> bytes | None:
+    """Numba's type fingerprint of the motion pack's fields (a plain tuple of its arrays), or None.
+
+    ``numba._dispatcher.compute_fingerprint`` is what numba's dispatcher computes for a tuple
+    argument (the motion pack) before it looks its type up: equal fingerprints get the same numba
+    type there (the fingerprint is the key of its type cache; for an array it encodes ndim, layout
+    C / F / A, writeable and dtype, not alignment, which numba's lookup does not tell apart either;
+    a value it cannot encode, e.g. an object array, raises and the dispatcher types it the slow way).
+    A named tuple's type is its class and its fields' types, so a pack of the very same class whose
+    fields' fingerprint equals that of the pack the dispatcher typed has that pack's type, and
+    the overload the dispatcher chose for it is the one it would choose again (issue 12, gate:
+    the gate's packs are new per window, of one type per model structure; typing the arguments
+    cost ~5 us per window). None (no shortcut) when numba lacks the function or cannot encode a field.
+    """
+    fp = _FINGERPRINT[0]
+    if fp is None:
+        return None
+    try:
+        return fp(tuple(mp))
+    except Exception:  # noqa: BLE001 - not encodable: the dispatcher types it
+        return None
+
+
+def _fingerprint_function() -> Any:
+    """``numba._dispatcher.compute_fingerprint`` when this numba has it (a private API), else None."""
+    try:
+        from numba import _dispatcher
+    except ImportError:
+        return None
+    fp = getattr(_dispatcher, "compute_fingerprint", None)
+    return fp if callable(fp) else None
+
+
+_FINGERPRINT: list = [None]
+"""[``numba._dispatcher.compute_fingerprint`` or None], set when :func:`_kernels` first loads the kernels."""
 
 
 def _entry_points_by_rows(ovl: Any) -> tuple:
