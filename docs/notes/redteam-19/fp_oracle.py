@@ -272,3 +272,85 @@ print("B:", dict(stats))
 print("B findings (fingerprint equal, typeof differs / outputs differ):", dict(findings))
 for k, v in examples.items():
     print("   e.g.", k, v)
+
+# C. The builders: Plans / BodyMotions built from odd inputs (non-native byte order, masked, array
+# subclass, F-order, read-only, float32, int, unaligned) -- does any field of their pack carry one of the
+# two fingerprint collisions above (non-native byte order, a masked or other ndarray subclass)?
+from monitor.certify import kernels as KS_  # noqa: E402
+
+m, scene = small_scene()
+rng = np.random.default_rng(7)
+q = np.tile(m.qpos0, (3, 1))
+q[:, 0] = [0.0, 0.2, 0.45]
+pos = np.zeros((3, m.nbody, 3))
+quat = np.zeros((3, m.nbody, 4))
+quat[..., 0] = 1.0
+pos[:, 1, 0] = [0.0, 0.2, 0.45]
+ODD = {"big-endian": lambda a: a.astype(a.dtype.newbyteorder(">")), "masked": lambda a: np.ma.masked_array(a),
+       "subclass": lambda a: a.view(Sub), "F-order": np.asfortranarray, "read-only": ro,
+       "float32": lambda a: a.astype(np.float32), "unaligned": unaligned, "memmap": memmap}
+n_built = n_bad = 0
+ref_plan_fp = fpf(KS_.trajectory_pack(monitor.Plan([0.0, 0.05, 0.1], q, m)))
+ref_bm_fp = fpf(KS_.trajectory_pack(monitor.BodyMotion([0.0, 0.05, 0.1], pos, quat)))
+for oname, fn in ODD.items():
+    for kind in ("Plan times", "Plan qpos", "BodyMotion pos", "BodyMotion quat", "BodyMotion times"):
+        try:
+            t = fn(np.array([0.0, 0.05, 0.1]))
+            if kind.startswith("Plan"):
+                traj = monitor.Plan(t if kind == "Plan times" else [0.0, 0.05, 0.1],
+                                    fn(q) if kind == "Plan qpos" else q, m)
+                ref = ref_plan_fp
+            else:
+                traj = monitor.BodyMotion(t if kind == "BodyMotion times" else [0.0, 0.05, 0.1],
+                                          fn(pos) if kind == "BodyMotion pos" else pos,
+                                          fn(quat) if kind == "BodyMotion quat" else quat)
+                ref = ref_bm_fp
+            mp = KS_.trajectory_pack(traj)
+        except Exception as exc:  # noqa: BLE001
+            print(f"C: {kind} {oname}: refused ({type(exc).__name__})")
+            continue
+        n_built += 1
+        odd = [f for f, a in zip(mp._fields, mp) if type(a) is not np.ndarray or not a.dtype.isnative]
+        if odd or fpf(mp) != ref or ty(mp) != ty(packs[0][1]):
+            n_bad += 1
+            print(f"C: {kind} {oname}: odd fields {odd}, fingerprint equal {fpf(mp) == ref}")
+print(f"C: {n_built} packs built from odd inputs, {n_bad} with a field that is not a native plain ndarray"
+      " or another type")
+
+# D. End to end: a mutated pack (values and numba type kept: unaligned / subclass / memmap / NaN /
+# writable copy) injected as a new Plan's cached pack; certify with the shortcut and with the
+# dispatcher for every pack (engine._FINGERPRINT = [None]); whole certificates compared.
+m, scene = small_scene()
+plans = []
+for _ in range(4):
+    q = np.tile(m.qpos0, (3, 1))
+    q[:, 0] = np.sort(rng.uniform(-0.2, 0.6, 3))
+    q[:, 2] = rng.uniform(-0.3, 0.6, 3)
+    plans.append(q)
+fp0 = engine._FINGERPRINT[0]
+n_cert = n_diff = n_hit = 0
+for mname, fn, keeps in MUTATIONS:
+    if not keeps or mname in ("big-endian", "masked", "F-order", "non-contiguous"):
+        continue
+    for q in plans:
+        base = monitor.Plan([0.0, 0.05, 0.1], q, m)
+        monitor.certify(scene, base, margin=0.01)          # records the slot with this plan's pack
+        mp0 = KS_.trajectory_pack(base)
+        for i in range(len(mp0)):
+            mut = type(mp0)(*(fn(x) if k == i else x for k, x in enumerate(mp0)))
+            if ty(mut) != ty(mp0):
+                continue
+            keys = []
+            for fpv in (fp0, None):
+                engine._FINGERPRINT[0] = fpv
+                p = monitor.Plan([0.0, 0.05, 0.1], q, m)
+                KS_._MOTION_PACKS[p] = (mut, {})
+                d = engine._WK_DIRECT[0]
+                n_hit += fpv is not None and d is not None and d[4] is not mut and fpf(mut) == d[9]
+                keys.append(repr({k: v for k, v in monitor.certify(scene, p, margin=0.01).to_dict().items()
+                                  if k != "stats"}))  # (stats: wall time)
+            engine._FINGERPRINT[0] = fp0
+            n_cert += 1
+            n_diff += keys[0] != keys[1]
+print(f"D: {n_cert} mutated packs certified both ways, {n_hit} met the slot by fingerprint, "
+      f"{n_diff} certificates differ")
