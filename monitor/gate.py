@@ -479,7 +479,11 @@ def _row_at_rest(qvel: list[float], vel_tol: float) -> bool:
     (~1.2 µs against 0.3-0.9): a NaN entry fails (numpy's ``max`` is then NaN, and ``NaN <= tol``
     is False), as does any entry above ``vel_tol``; a NaN ``vel_tol`` fails every row in both.
     Python floats are the float64 values exactly (``tolist``), compared in the same IEEE order.
+    ``vel_tol`` is taken as a Python float first: numpy 2 compares a Python float with a numpy
+    float32 / float16 scalar in that narrower type (NEP 50), where numpy's form compares in float64
+    (red team 19: a row just above a float32 tolerance passed).
     """
+    vel_tol = float(vel_tol)
     for v in qvel:
         if not abs(v) <= vel_tol:
             return False

@@ -952,6 +952,14 @@ def _pack_fingerprint(mp: Any) -> bytes | None:
     the overload the dispatcher chose for it is the one it would choose again (issue 12, gate:
     the gate's packs are new per window, of one type per model structure; typing the arguments
     cost ~5 us per window). None (no shortcut) when numba lacks the function or cannot encode a field.
+
+    The fingerprint is not ``numba.typeof``: it encodes neither an array's byte order nor its class
+    (an ndarray subclass), so a field in non-native byte order or a masked array fingerprints as the
+    native plain array although ``typeof`` refuses it (red team 19; once the native pack's fingerprint
+    is in numba's dispatcher cache, which types the pack through it, the dispatcher runs such a pack
+    too, on the raw bytes, as the shortcut does). The packer
+    (:mod:`monitor.motion.pack`) gives every field as a native-order plain ndarray whatever the
+    Plan's / BodyMotion's inputs, so such a pack never reaches the kernels.
     """
     fp = _FINGERPRINT[0]
     if fp is None:
