@@ -185,3 +185,34 @@ def test_only_a_pack_of_the_recorded_type_skips_the_dispatcher(monkeypatch):
     assert engine._pack_fingerprint(fresh_mp) is None
     assert route(mp) == "direct"
     assert route(fresh_mp) == "dispatcher"
+
+
+def test_motion_pack_fields_are_native_plain_arrays_for_odd_plan_inputs():
+    """The shortcut's premise (red team 19): numba's fingerprint encodes neither byte order nor an
+    ndarray subclass, so every motion pack field must be a plain, aligned, native-order ndarray (or a
+    Python / numpy scalar) whatever the Plan was built from: big-endian, masked, float32, F-order and
+    non-contiguous waypoints and times give such packs, with the same fingerprint as the plain plan's."""
+    m = mujoco.MjModel.from_xml_string(_XML)
+    base = _plans(m, 1, 19)[0]
+    times, qpos = np.array(base.times), np.array(base.qpos)
+    odd = {
+        "big-endian": (times.astype(">f8"), qpos.astype(">f8")),
+        "masked": (np.ma.masked_array(times), np.ma.masked_array(qpos)),
+        "float32": (times.astype(np.float32), qpos.astype(np.float32)),
+        "F-order": (times, np.asfortranarray(qpos)),
+        "non-contiguous": (np.repeat(times, 2)[::2], np.repeat(qpos, 2, axis=1)[:, ::2]),
+    }
+    KS = engine._kernels()
+    ref, _ = KS.trajectory_pack_memo(monitor.Plan(times, qpos, m))
+    fp_ref = engine._pack_fingerprint(ref)
+    for name, (t, q) in odd.items():
+        mp, _ = KS.trajectory_pack_memo(monitor.Plan(t, q, m))
+        assert mp is not None, name
+        for field, x in zip(type(mp)._fields, mp):
+            if isinstance(x, np.ndarray):
+                assert type(x) is np.ndarray, (name, field, type(x))
+                assert x.dtype.isnative and x.flags.aligned, (name, field, x.dtype)
+            else:
+                assert isinstance(x, (int, float, bool, np.generic)), (name, field, type(x))
+        if fp_ref is not None:
+            assert engine._pack_fingerprint(mp) == fp_ref, name
