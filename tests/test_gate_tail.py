@@ -177,3 +177,42 @@ def test_row_at_rest_equals_the_max_rule():
         assert _row_at_rest(row.tolist(), vel_tol) is want, (t, row, vel_tol)
         found[want] += 1
     assert min(found.values()) >= 100, found
+
+
+def test_a_tail_with_ongoing_pairs_is_reused_only_from_its_start():
+    """Red team 18: a committed tail whose certificate judged pairs by the ongoing-contact rule
+    (in contact at the TAIL's start) covers a later window only from waypoint 0; from waypoint
+    k > 0 such a pair may have lifted off, and the window alone would call a re-contact a new
+    contact. Those windows are certified afresh, under the same committed brake.
+
+    Oracle: the same tunnel run twice, once as it is and once with every committed tail's
+    certificate reporting an ongoing pair (``stats["ongoing"] = 1``): the applied controls and the
+    motion must be the same, the reuse past a tail's start must be replaced by fresh certificates
+    (``tail_ongoing_fresh``), and every window must still be certified.
+    """
+    import dataclasses
+
+    m = mujoco.MjModel.from_xml_path(str(scene_path("tunnel")))
+
+    def run(mark_ongoing: bool):
+        d = mujoco.MjData(m)
+        mujoco.mj_resetDataKeyframe(m, d, 0)
+        gate = Gate(m)
+        applied = []
+        for _ in range(40):
+            r = gate.step(d, np.array([5.0]))
+            applied.append((np.asarray(r.applied_ctrl).tobytes(), r.applied_verdict, d.qpos.tobytes()))
+            tail = gate._tail
+            if mark_ongoing and tail is not None and not tail[1].stats.get("ongoing", 0):
+                cert = dataclasses.replace(tail[1], stats={**tail[1].stats, "ongoing": 1})
+                gate._tail = (tail[0], cert, tail[2])
+        return applied, gate.summary()
+
+    plain, s_plain = run(False)
+    marked, s_marked = run(True)
+    assert [a[0] for a in marked] == [a[0] for a in plain]          # the same controls applied
+    assert [a[2] for a in marked] == [a[2] for a in plain]          # the same motion
+    assert all(a[1] == "certified" for a in marked)
+    assert s_plain["replaced"] == s_marked["replaced"] > 0
+    assert s_plain["tail_ongoing_fresh"] == 0 < s_marked["tail_ongoing_fresh"]
+    assert s_marked["tail_reused"] + s_marked["tail_ongoing_fresh"] == s_plain["tail_reused"]
