@@ -30,6 +30,7 @@ import collections
 import json
 import math
 import sys
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -71,14 +72,14 @@ class Counts:
                 f"tails_audited={c['tail_audited']:4d} findings={c['finding']} unresolved={c['unresolved']} "
                 f"replay_mismatch={c['replay_mismatch']} rows_mismatch={c['rows_mismatch']} "
                 f"tail_rows_mismatch={c['tail_rows_mismatch']} ctrl_mismatch={c['ctrl_mismatch']} "
-                f"nan_not_refused={c['nan_not_refused']} replaced={c['replaced']} "
+                f"nan_not_refused={c['nan_not_refused']} log_mismatch={c['log_mismatch']} replaced={c['replaced']} "
                 f"applied_not_certified={c['applied_not_certified']} "
                 f"violations_confirmed={c['violation_confirmed_by_oracle']}/{c['violation_proposals']} "
                 f"min_slack_m={self.min_margin:.3g}")
 
     def bad(self) -> int:
         c = self.c
-        return (c["finding"] + c["replay_mismatch"] + c["rows_mismatch"] + c["ctrl_mismatch"]
+        return (c["finding"] + c["replay_mismatch"] + c["log_mismatch"] + c["rows_mismatch"] + c["ctrl_mismatch"]
                 + c["nan_not_refused"] + c["tail_rows_mismatch"])
 
 
@@ -86,7 +87,12 @@ class Counts:
 def thresholds(oracle: PathOracle, q0: np.ndarray, pairs, margin: float, tol: float) -> np.ndarray:
     """Per pair: the weakest clearance the gate's certificate can mean for a window starting at q0."""
     b = oracle.start_distance(q0, pairs)
-    return np.where(b[:, 0] > margin + ONGOING_BAND, margin, -tol)
+    thr = np.where(b[:, 0] > margin + ONGOING_BAND, margin, -tol)
+    ONGOING_COUNT[0] += int(np.sum(thr < margin))
+    return thr
+
+
+ONGOING_COUNT = [0]  # (motion, pair) audits that used the ongoing-contact threshold -penetration_tol
 
 
 def audit_motion(cnt: Counts, oracle: PathOracle, rows: np.ndarray, pairs, thr: np.ndarray,
@@ -146,6 +152,7 @@ class StepAuditor:
         self.oracle = PathOracle(model)
         self.scratch = mujoco.MjData(model)
         self.pairs = None
+        self.applied_log: list[tuple[np.ndarray, bool]] = []  # (data.ctrl after the step, replaced)
 
     def _pairs(self):
         if self.pairs is None:
@@ -166,6 +173,7 @@ class StepAuditor:
         cnt.c["steps"] += 1
         pairs = self._pairs()
         ctrl = np.array(data.ctrl)
+        self.applied_log.append((ctrl.copy(), bool(report.replaced)))
         where = {"step": step_no, "time": float(data.time)}
         if (expected_ctrl is not None and not report.replaced
                 and not np.allclose(expected_ctrl, ctrl, rtol=1e-5, atol=1e-6)):  # gymnasium rescales in float32
@@ -243,6 +251,8 @@ def schedule(kind: str, low: np.ndarray, high: np.ndarray, n: int, rng: np.rando
     out = []
     if kind == "random":
         return [rng.uniform(low, high) for _ in range(n)]
+    if kind == "huge":  # finite but far outside the box (1e30): clamped by ctrlrange / ClipAction
+        return [mid + 1e30 * rng.choice([-1.0, 1.0], size=len(low)) for _ in range(n)]
     signs = rng.choice([-1.0, 1.0], size=len(low))
     for k in range(n):
         if kind == "hold" and k % 15 == 0:
@@ -321,8 +331,24 @@ def run_gym(name: str, make, steps: dict, seed: int, *, frame_skip_change: int |
         if term or trunc:
             env.reset()
     cnt.pairs_info = pair_info(env.gate, u.model)
+    path = env.gate.log_path
     env.close()
+    if path is not None:
+        compare_log(cnt, path, aud.applied_log)
     return cnt
+
+
+def compare_log(cnt: Counts, path, applied: list) -> None:
+    """The log's action records against what the env received (``data.ctrl``), step by step."""
+    from monitor.log.reader import read_log
+
+    acts = read_log(path).messages.get("/monitor/action", [])
+    cnt.c["log_actions"] = len(acts)
+    if len(acts) != len(applied):
+        cnt.add_detail("log_mismatch", note=f"{len(acts)} action records for {len(applied)} steps")
+    for k, (rec, (ctrl, replaced)) in enumerate(zip(acts, applied)):
+        if np.asarray(rec["applied"], float).tobytes() != ctrl.tobytes() or bool(rec["replaced"]) != replaced:
+            cnt.add_detail("log_mismatch", step=k, logged=rec["applied"], got=ctrl.tolist())
 
 
 def run_plain(name: str, scene: str, steps: dict, seed: int, nstep: int, reset, **gate_kw) -> Counts:
@@ -378,7 +404,9 @@ def pair_info(gate, model) -> dict:
 
 
 def workloads(quick: bool):
-    n = (lambda r, h, b: {"random": r, "hold": h, "bang": b})
+    def n(r: int, h: int, b: int, huge: int = 2) -> dict:
+        return {"random": r, "hold": h, "bang": b, "huge": huge}
+
     S = n(12, 12, 6) if quick else n(120, 60, 30)
     Sh = n(6, 6, 4) if quick else n(60, 45, 15)   # humanoids: expensive steps
     out = []
@@ -387,8 +415,10 @@ def workloads(quick: bool):
                    "HumanoidStandup-v5"]:
         sched = Sh if env_id.startswith("Humanoid") else S
         out.append((env_id, lambda e=env_id, s=sched: run_gym(e, lambda: SafetyGate(gym.make(e)), s, 0)))
-    out.append(("monitor/Arm-v0", lambda: run_gym("monitor/Arm-v0",
-                                                  lambda: SafetyGate(gym.make("monitor/Arm-v0")), S, 1)))
+    logdir = Path(tempfile.mkdtemp(prefix="rt18-"))
+    out.append(("monitor/Arm-v0 (logged)", lambda: run_gym(
+        "monitor/Arm-v0 (logged)", lambda: SafetyGate(gym.make("monitor/Arm-v0"), log=str(logdir / "arm.mcap")),
+        S, 1)))
     out.append(("Arm-v0 on_violation=warn (oracle control)", lambda: run_gym(
         "Arm-v0 on_violation=warn (oracle control)",
         lambda: SafetyGate(gym.make("monitor/Arm-v0"), on_violation="warn"), n(0, 8, 2) if quick
@@ -443,6 +473,7 @@ def main(argv=None) -> int:
             if d["kind"] not in ("unresolved", "rows_quat_normalised"):
                 print("   ", json.dumps(d, default=str))
     tot = sum(c.bad() for c in allc)
+    print(f"(motion, pair) audits at the ongoing-contact threshold -penetration_tol: {ONGOING_COUNT[0]}")
     agg = collections.Counter()
     for c in allc:
         agg.update(c.c)
