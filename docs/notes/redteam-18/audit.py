@@ -62,24 +62,29 @@ class Counts:
         self.min_margin = math.inf  # smallest (oracle upper - threshold) over audited certified motions
 
     def add_detail(self, kind: str, **kw) -> None:
+        """Count ``kind`` and keep its first five details."""
         self.c[kind] += 1
         if len([d for d in self.details if d["kind"] == kind]) < 5:
             self.details.append({"kind": kind, **kw})
 
     def line(self) -> str:
+        """One summary line."""
         c = self.c
         return (f"{self.name:44s} steps={c['steps']:4d} certified_windows_audited={c['win_audited']:4d} "
                 f"tails_audited={c['tail_audited']:4d} findings={c['finding']} unresolved={c['unresolved']} "
                 f"replay_mismatch={c['replay_mismatch']} rows_mismatch={c['rows_mismatch']} "
                 f"tail_rows_mismatch={c['tail_rows_mismatch']} ctrl_mismatch={c['ctrl_mismatch']} "
-                f"nan_not_refused={c['nan_not_refused']} log_mismatch={c['log_mismatch']} replaced={c['replaced']} "
+                f"nan_not_refused={c['nan_not_refused']} log_mismatch={c['log_mismatch']} "
+                f"replaced={c['replaced']} "
                 f"applied_not_certified={c['applied_not_certified']} "
                 f"violations_confirmed={c['violation_confirmed_by_oracle']}/{c['violation_proposals']} "
                 f"min_slack_m={self.min_margin:.3g}")
 
     def bad(self) -> int:
+        """Irregular outcomes (findings and mismatches)."""
         c = self.c
-        return (c["finding"] + c["replay_mismatch"] + c["log_mismatch"] + c["rows_mismatch"] + c["ctrl_mismatch"]
+        return (c["finding"] + c["replay_mismatch"] + c["log_mismatch"] + c["rows_mismatch"]
+                + c["ctrl_mismatch"]
                 + c["nan_not_refused"] + c["tail_rows_mismatch"])
 
 
@@ -139,6 +144,7 @@ def tail_rows(model, scratch, state, brake, nmax: int, vel_tol: float) -> np.nda
 
 
 def get_state(model, data) -> np.ndarray:
+    """(S,) integration state of ``data``."""
     s = np.empty(mujoco.mj_stateSize(model, _STATE))
     mujoco.mj_getState(model, data, s, _STATE)
     return s
@@ -169,6 +175,7 @@ class StepAuditor:
 
     def after_step(self, data: mujoco.MjData, state0: np.ndarray, nstep: int, report,
                    expected_ctrl: np.ndarray | None, step_no: int) -> None:
+        """Audit one gated step that just ran (``state0``: the integration state before it)."""
         cnt, m, g = self.cnt, self.model, self.gate
         cnt.c["steps"] += 1
         pairs = self._pairs()
@@ -176,13 +183,14 @@ class StepAuditor:
         self.applied_log.append((ctrl.copy(), bool(report.replaced)))
         where = {"step": step_no, "time": float(data.time)}
         if (expected_ctrl is not None and not report.replaced
-                and not np.allclose(expected_ctrl, ctrl, rtol=1e-5, atol=1e-6)):  # gymnasium rescales in float32
+                and not np.allclose(expected_ctrl, ctrl, rtol=1e-5, atol=1e-6)):  # float32 rescaling
             cnt.add_detail("ctrl_mismatch", expected=expected_ctrl.tolist(), got=ctrl.tolist(), **where)
         if not np.array_equal(np.asarray(report.applied_ctrl, float), ctrl):
             cnt.add_detail("ctrl_mismatch", certified=np.asarray(report.applied_ctrl).tolist(),
                            got=ctrl.tolist(), **where)
         rows = replay(m, self.scratch, state0, ctrl, nstep)
-        if not (np.array_equal(self.scratch.qpos, data.qpos) and np.array_equal(self.scratch.qvel, data.qvel)):
+        s = self.scratch
+        if not (np.array_equal(s.qpos, data.qpos) and np.array_equal(s.qvel, data.qvel)):
             cnt.add_detail("replay_mismatch", **where)
         if report.replaced:
             cnt.c["replaced"] += 1
@@ -245,8 +253,11 @@ class StepAuditor:
 # ----------------------------------------------------------------------------- action schedules
 def schedule(kind: str, low: np.ndarray, high: np.ndarray, n: int, rng: np.random.Generator,
              over: float = 1.0) -> list[np.ndarray]:
-    """Actions: random (uniform), hold (extreme sign patterns held 15 steps: limits, floor, each other),
-    bang (max magnitude, sign flipped every 2 steps). ``over`` > 1 leaves the box (wrapped envs clip)."""
+    """Seeded action schedule of one kind.
+
+    Kinds: random (uniform), hold (extreme sign patterns held 15 steps: limits, floor, each other),
+    bang (max magnitude, sign flipped every 2 steps). ``over`` > 1 leaves the box (wrapped envs clip).
+    """
     mid, half = 0.5 * (low + high), 0.5 * (high - low)
     out = []
     if kind == "random":
@@ -290,6 +301,7 @@ def _expected_ctrl_fn(env):
 
 def run_gym(name: str, make, steps: dict, seed: int, *, frame_skip_change: int | None = None,
             over: float = 1.0) -> Counts:
+    """Audit a gymnasium workload (``make()`` builds the gated env)."""
     cnt = Counts(name)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -352,6 +364,7 @@ def compare_log(cnt: Counts, path, applied: list) -> None:
 
 
 def run_plain(name: str, scene: str, steps: dict, seed: int, nstep: int, reset, **gate_kw) -> Counts:
+    """Audit ``Gate.step`` on ``models/<scene>``."""
     cnt = Counts(name)
     model = mujoco.MjModel.from_xml_path(str(Path(monitor.__file__).resolve().parents[1] / "models" / scene
                                              / "scene.xml"))
@@ -404,6 +417,7 @@ def pair_info(gate, model) -> dict:
 
 
 def workloads(quick: bool):
+    """(name, runner) of every workload."""
     def n(r: int, h: int, b: int, huge: int = 2) -> dict:
         return {"random": r, "hold": h, "bang": b, "huge": huge}
 
@@ -417,7 +431,8 @@ def workloads(quick: bool):
         out.append((env_id, lambda e=env_id, s=sched: run_gym(e, lambda: SafetyGate(gym.make(e)), s, 0)))
     logdir = Path(tempfile.mkdtemp(prefix="rt18-"))
     out.append(("monitor/Arm-v0 (logged)", lambda: run_gym(
-        "monitor/Arm-v0 (logged)", lambda: SafetyGate(gym.make("monitor/Arm-v0"), log=str(logdir / "arm.mcap")),
+        "monitor/Arm-v0 (logged)",
+        lambda: SafetyGate(gym.make("monitor/Arm-v0"), log=str(logdir / "arm.mcap")),
         S, 1)))
     out.append(("Arm-v0 on_violation=warn (oracle control)", lambda: run_gym(
         "Arm-v0 on_violation=warn (oracle control)",
@@ -450,6 +465,7 @@ def workloads(quick: bool):
 
 
 def main(argv=None) -> int:
+    """Run the workloads; print one line each."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer steps (< 3 min on this machine)")
     ap.add_argument("--only", default=None, help="run workloads whose name contains this")
@@ -482,7 +498,8 @@ def main(argv=None) -> int:
           f"irregular={tot} wall={time.perf_counter() - t0:.0f} s")
     if args.json:
         Path(args.json).write_text(json.dumps(
-            [{"name": c.name, "counts": dict(c.c), "details": c.details, "pairs": getattr(c, "pairs_info", {}),
+            [{"name": c.name, "counts": dict(c.c), "details": c.details,
+              "pairs": getattr(c, "pairs_info", {}),
               "unmonitored_contacts": dict(c.unmonitored_contacts.most_common(20)),
               "min_slack_m": c.min_margin} for c in allc], indent=1, default=str))
     return 1 if tot else 0

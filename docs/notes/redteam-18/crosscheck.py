@@ -33,6 +33,7 @@ from monitor.geometry.distance import shape_distance  # noqa: E402
 
 
 def random_qpos(model: mujoco.MjModel, rng: np.random.Generator, q0: np.ndarray) -> np.ndarray:
+    """A seeded random configuration (joint ranges, random unit quaternions)."""
     q = np.array(q0, float)
     for j in range(model.njnt):
         a, t = int(model.jnt_qposadr[j]), int(model.jnt_type[j])
@@ -50,10 +51,12 @@ def random_qpos(model: mujoco.MjModel, rng: np.random.Generator, q0: np.ndarray)
 
 
 def check(name: str, model: mujoco.MjModel, scene, configs: int, seed: int) -> dict:
+    """Compare the three distances over ``configs`` random configurations."""
     rng = np.random.default_rng(seed)
     orc = PathOracle(model)
     pairs = [tuple(int(x) for x in p) for p in scene.pair_ids]
-    out = {"pairs": 0, "inconsistent": 0, "library_closer": 0, "max_library_closer": 0.0, "conservative_library": 0, "mj_outside": 0, "unsupported": 0, "max_oracle_gap": 0.0}
+    out = {"pairs": 0, "inconsistent": 0, "library_closer": 0, "max_library_closer": 0.0,
+           "conservative_library": 0, "mj_outside": 0, "unsupported": 0, "max_oracle_gap": 0.0}
     d = mujoco.MjData(model)
     for _ in range(configs):
         q = random_qpos(model, rng, model.qpos0)
@@ -90,6 +93,7 @@ def check(name: str, model: mujoco.MjModel, scene, configs: int, seed: int) -> d
 
 
 def main() -> int:
+    """Run every model."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--configs", type=int, default=40)
     args = ap.parse_args()

@@ -33,7 +33,8 @@ chain (hinge anchor a_j, ball anchor, free joint: the body origin) plus the tran
 (slide |dq|, free |dpos|). With r0_j = max over the interval's two ends of |centre - a_j| + the geom's
 bounding radius, Q = sum of the rotation increments and D0 = sum_j |dq_j| r0_j + translations,
 |p - a_j| <= r0_j + 2 D on the interval, so the speed is at most D = D0 / (1 - 2 Q) when Q < 1/2
-(else the interval is bisected first). Signed distance changes at most by the two geoms' speeds.
+(else points of the same path are inserted first: ``_refine_rows``). Signed distance changes at most
+by the two geoms' speeds.
 """
 
 from __future__ import annotations
@@ -92,6 +93,7 @@ class Interp:
                 self.quat_slices.append(slice(a, a + 4))
 
     def __call__(self, qa: np.ndarray, qb: np.ndarray, s: float) -> np.ndarray:
+        """Qpos at parameter s (lerp, slerp for quaternions)."""
         q = qa + s * (qb - qa)
         for sl in self.quat_slices:
             q[sl] = _slerp(qa[sl], qb[sl], s)
@@ -307,6 +309,7 @@ class PathOracle:
         self.samples = 0
 
     def geom(self, g: int) -> GeomModel:
+        """The oracle's description of geom g (cached)."""
         if g not in self._geoms:
             self._geoms[g] = geom_model(self.model, g)
         return self._geoms[g]
@@ -373,6 +376,7 @@ class PathOracle:
 
         ``max_samples`` caps the poses evaluated between rows: what is still open then is "unresolved".
         """
+        rows = self._refine_rows(np.asarray(rows, float), sorted({g for p in pairs for g in p}))
         budget_end = self.samples + len(rows) + max_samples
         P = len(pairs)
         res = [PairVerdict("clear", math.inf, 0.0, float(thresholds[i])) for i in range(P)]
@@ -405,8 +409,8 @@ class PathOracle:
                 open_ = idx[~(lo_mid > thresholds[idx]) & ~done]
                 if open_.size == 0:
                     continue
-                if depth >= MAX_DEPTH or self.samples >= budget_end or (depth >= 4 and np.all(np.isinf(b0[open_, 0]))
-                                          and np.all(np.isinf(b1[open_, 0]))):
+                stuck = depth >= 4 and np.all(np.isinf(b0[open_, 0])) and np.all(np.isinf(b1[open_, 0]))
+                if depth >= MAX_DEPTH or self.samples >= budget_end or stuck:
                     for i in open_:
                         if res[i].status == "clear":
                             res[i].status = "unresolved"
@@ -425,6 +429,33 @@ class PathOracle:
                 if cross_check:
                     r.mj_distance = self.mj_distance(rows, pairs[i], r.time_param)
         return res
+
+    def _refine_rows(self, rows: np.ndarray, gids: list[int]) -> np.ndarray:
+        """Insert points of the same path where a row interval rotates a chain by >= 1/4 rad in total.
+
+        The Lipschitz bound needs Q < 1/2 per interval. A lerp of a lerp sub-interval, and a slerp of
+        a slerp sub-interval (constant rate along one great arc), are the same path, so splitting an
+        interval into m equal parameter pieces changes nothing but the bound.
+        """
+        out = [rows[0]]
+        for k in range(len(rows) - 1):
+            qa, qb = rows[k], rows[k + 1]
+            Q = 0.0  # the largest total rotation increment of one geom's chain
+            for g in gids:
+                q = 0.0
+                for _j, t, adr in self.geom(g).chain:
+                    if t == HINGE:
+                        q += abs(qb[adr] - qa[adr])
+                    elif t == BALL:
+                        q += _angle(qa[adr:adr + 4], qb[adr:adr + 4])
+                    elif t == FREE:
+                        q += _angle(qa[adr + 3:adr + 7], qb[adr + 3:adr + 7])
+                Q = max(Q, q)
+            pieces = int(math.ceil(Q / 0.25)) if Q >= 0.25 else 1
+            for i in range(1, pieces):
+                out.append(self.interp(qa, qb, i / pieces))
+            out.append(qb)
+        return np.array(out)
 
     @staticmethod
     def _note(r: PairVerdict, upper: float, tp: float) -> None:
