@@ -54,3 +54,31 @@ def test_pusher_and_wrapped_ant_certified_motions_are_clear(audit):
         assert cnt.c["win_audited"] > 0
         assert cnt.bad() == 0, (cnt.name, cnt.details)
         assert cnt.c["nan_refused"] == 2
+
+
+@pytest.mark.slow
+def test_the_audit_catches_a_gate_that_calls_everything_certified(audit, monkeypatch):
+    """The audit can fail: relabel every certificate `certified` and it reports the wall hits."""
+    import dataclasses
+
+    from monitor.certify.types import Verdict
+    from monitor.gate import Gate
+
+    orig_certify, orig_init = Gate._certify, Gate.__init__
+
+    def always_certified(self, plan):
+        cert, us = orig_certify(self, plan)
+        return dataclasses.replace(cert, verdict=Verdict.CERTIFIED), us
+
+    def init(self, *a, **k):
+        orig_init(self, *a, **k)
+        self._joint_tail = False  # every window through _certify
+
+    monkeypatch.setattr(Gate, "_certify", always_certified)
+    monkeypatch.setattr(Gate, "__init__", init)
+    cnt = audit.run_plain("tunnel planted", "tunnel", {"random": 30, "hold": 30, "bang": 10}, 6, 1,
+                          lambda m, d: mujoco.mj_resetDataKeyframe(m, d, 0), margin=0.001)
+    hits = [d for d in cnt.details if d["kind"] == "finding"]
+    assert cnt.c["finding"] > 0 and hits
+    # cross-check of the oracle's verified witness with MuJoCo's own distance (sphere-box here)
+    assert all(d["mj_geomDistance"] < d["threshold"] for d in hits)
