@@ -231,6 +231,22 @@ class StepAuditor:
             res = self.oracle.audit(rows, pairs, thr, cross_check=False, max_samples=300)
             hit = any(r.status == "finding" for r in res)
             cnt.c[f"applied_{report.applied_verdict}_oracle_{'violation' if hit else 'clear'}"] += 1
+            if report.replaced and report.verdict == "uncertain":
+                # the gate applied an uncertified fallback instead of an uncertain proposal: what would
+                # the proposal have done? (a policy question for the lead, not a certificate)
+                prow = np.asarray(report.plan.qpos)
+                thr_p = thresholds(self.oracle, prow[0], pairs, g.margin, g.penetration_tol)
+                res_p = self.oracle.audit(prow, pairs, thr_p, cross_check=False, max_samples=300)
+                hit_p = any(r.status == "finding" for r in res_p)
+                cnt.c[f"uncertain_proposal_oracle_{'violation' if hit_p else 'clear'}_replaced_by_"
+                      f"{report.applied_verdict}"] += 1
+                if report.applied_verdict == "violation":
+                    worst = min(res_p, key=lambda r: r.min_upper - r.threshold)
+                    cnt.add_detail("uncertain_replaced_by_violation", proposal_oracle=worst.status,
+                                   proposal_min_slack=worst.min_upper - worst.threshold,
+                                   applied_oracle="violation" if hit else "clear",
+                                   unresolved_pairs=sum(r.status == "unresolved" for r in res_p),
+                                   block_reason=report.block_reason, **where)
             return
         audit_motion(cnt, self.oracle, rows, pairs, thr, "window", where)
         cnt.c["win_audited"] += 1
@@ -482,7 +498,7 @@ def main(argv=None) -> int:
         cnt = fn()
         allc.append(cnt)
         print(cnt.line() + f" ({time.perf_counter() - t:.1f} s)", flush=True)
-        ctrl_ = {k: v for k, v in cnt.c.items() if k.startswith("applied_") and "_oracle_" in k}
+        ctrl_ = {k: v for k, v in cnt.c.items() if "_oracle_" in k and "confirmed" not in k}
         if ctrl_:
             print("    oracle on applied windows that were not certified:", dict(sorted(ctrl_.items())))
         for d in cnt.details:
