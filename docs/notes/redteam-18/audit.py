@@ -19,6 +19,7 @@ Run (from a checkout; quick mode < 3 min on the 2 shared cores):
     PYTHONPATH=. python docs/notes/redteam-18/audit.py --quick
     PYTHONPATH=. python docs/notes/redteam-18/audit.py            # full: more steps per workload
     PYTHONPATH=. python docs/notes/redteam-18/audit.py --only Ant  # workloads whose name contains "Ant"
+    PYTHONPATH=. python docs/notes/redteam-18/audit.py --seed-offset 100   # other seeds, same workloads
 Prints one line per workload: steps, certified windows / tails audited, findings, and the other counts.
 Exit code 1 if any finding (or replay / rows / control mismatch, or an unrefused NaN) was seen.
 """
@@ -97,6 +98,7 @@ def thresholds(oracle: PathOracle, q0: np.ndarray, pairs, margin: float, tol: fl
     return thr
 
 
+SEED_OFFSET = [0]  # added to every workload's seed (--seed-offset)
 ONGOING_COUNT = [0]  # (motion, pair) audits that used the ongoing-contact threshold -penetration_tol
 
 
@@ -319,6 +321,7 @@ def run_gym(name: str, make, steps: dict, seed: int, *, frame_skip_change: int |
             over: float = 1.0) -> Counts:
     """Audit a gymnasium workload (``make()`` builds the gated env)."""
     cnt = Counts(name)
+    seed += SEED_OFFSET[0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = make()
@@ -382,6 +385,7 @@ def compare_log(cnt: Counts, path, applied: list) -> None:
 def run_plain(name: str, scene: str, steps: dict, seed: int, nstep: int, reset, **gate_kw) -> Counts:
     """Audit ``Gate.step`` on ``models/<scene>``."""
     cnt = Counts(name)
+    seed += SEED_OFFSET[0]
     model = mujoco.MjModel.from_xml_path(str(Path(monitor.__file__).resolve().parents[1] / "models" / scene
                                              / "scene.xml"))
     data = mujoco.MjData(model)
@@ -450,6 +454,11 @@ def workloads(quick: bool):
         "monitor/Arm-v0 (logged)",
         lambda: SafetyGate(gym.make("monitor/Arm-v0"), log=str(logdir / "arm.mcap")),
         S, 1)))
+    out.append(("monitor/Arm-v0 margin=5 mm (README example)", lambda: run_gym(
+        "monitor/Arm-v0 margin=5 mm (README example)",
+        lambda: SafetyGate(gym.make("monitor/Arm-v0"), on_violation="block", margin=0.005), S, 9)))
+    out.append(("Pusher-v5 margin=1 cm", lambda: run_gym(
+        "Pusher-v5 margin=1 cm", lambda: SafetyGate(gym.make("Pusher-v5"), margin=0.01), S, 10)))
     out.append(("Arm-v0 on_violation=warn (oracle control)", lambda: run_gym(
         "Arm-v0 on_violation=warn (oracle control)",
         lambda: SafetyGate(gym.make("monitor/Arm-v0"), on_violation="warn"), n(0, 8, 2) if quick
@@ -486,7 +495,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer steps (< 3 min on this machine)")
     ap.add_argument("--only", default=None, help="run workloads whose name contains this")
     ap.add_argument("--json", default=None, help="write per-workload counts and details here")
+    ap.add_argument("--seed-offset", type=int, default=0, help="added to every workload's seed")
     args = ap.parse_args(argv)
+    SEED_OFFSET[0] = args.seed_offset
     from monitor.warmup import ensure_warm
     ensure_warm()
     t0 = time.perf_counter()
