@@ -506,7 +506,9 @@ def main(argv=None) -> int:
         if args.only and args.only not in name:
             continue
         t = time.perf_counter()
+        before = ONGOING_COUNT[0]
         cnt = fn()
+        cnt.c["ongoing_threshold_audits"] = ONGOING_COUNT[0] - before
         allc.append(cnt)
         print(cnt.line() + f" ({time.perf_counter() - t:.1f} s)", flush=True)
         ctrl_ = {k: v for k, v in cnt.c.items() if "_oracle_" in k and "confirmed" not in k}
